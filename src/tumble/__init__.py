@@ -1,0 +1,34 @@
+"""tumble: rotational dynamics of rigid bodies, built on Euler's equations.
+
+Conventions (everywhere): SI units; attitude ``q`` is a unit Hamilton
+quaternion, scalar first ``[w, x, y, z]``, mapping body to inertial axes
+(``v_I = q ⊗ v_B ⊗ q*``); ``omega`` is the body's angular velocity relative to
+inertial space in body axes; torques are in body axes; inertia is the 3×3
+tensor about the centre of mass in body axes. See ``docs/conventions.md``.
+
+    >>> import numpy as np, tumble
+    >>> body = tumble.RigidBody(inertia=np.diag([1.0, 2.0, 3.0]))
+    >>> traj = tumble.simulate(body, [1e-3, 1.0, 1e-3], t=np.linspace(0, 100, 1001))
+"""
+
+from tumble import attitude, dynamics, integrate, torques
+from tumble._validate import ValidationError
+from tumble.body import RigidBody
+from tumble.integrate import SolverError
+from tumble.simulate import simulate
+from tumble.trajectory import Trajectory, load
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "RigidBody",
+    "SolverError",
+    "Trajectory",
+    "ValidationError",
+    "attitude",
+    "dynamics",
+    "integrate",
+    "load",
+    "simulate",
+    "torques",
+]

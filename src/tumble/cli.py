@@ -1,0 +1,264 @@
+"""The ``tumble`` command: run scenario files, the tennis-racket demo, inspect results.
+
+    tumble run SCENARIO.toml -o out.nc [--plot out.png] [--quiet]
+    tumble demo racket [-o racket.nc] [--plot racket.png] [--duration 20]
+    tumble info out.nc
+    tumble --version
+
+Exit codes: 0 success; 2 bad input (a one-line message per problem on
+stderr, naming the file, the key and the rule; nothing is written); 1 any
+other failure (the integrator gave up, a file could not be written, a bug).
+Results are written atomically (:func:`tumble.trajectory.write_atomic`).
+Documented in ``docs/cli.md``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+import tumble
+from tumble._validate import ValidationError, require_positive
+from tumble.analysis import flip_times, intermediate_rate
+from tumble.body import RigidBody
+from tumble.integrate import SolverError
+from tumble.scenario import load_scenario
+from tumble.simulate import simulate
+from tumble.trajectory import Trajectory, load, write_atomic
+
+__all__ = ["app"]
+
+app = typer.Typer(
+    name="tumble",
+    help="Rotational dynamics of rigid bodies (Euler's equations): run scenarios, demos, inspect results.",
+    no_args_is_help=True,
+    add_completion=False,
+    rich_markup_mode="markdown",
+    pretty_exceptions_show_locals=False,
+)
+demo_app = typer.Typer(help="Built-in demonstrations.", no_args_is_help=True, rich_markup_mode="markdown")
+app.add_typer(demo_app, name="demo")
+
+EXIT_BAD_INPUT = 2
+EXIT_FAILURE = 1
+
+# Tennis-racket demo: spin about the intermediate axis, perturbation on the
+# other two (rad/s, principal axes), and output rate. A flip of the default
+# T-handle at 10 rad/s lasts about 1/λ = 0.14 s (λ = |ω| √((I₂−I₁)(I₃−I₂)/(I₁I₃))
+# = 7.2 /s), so 200 samples per second put ~28 samples on each flip.
+_RACKET_SPIN = 10.0
+_RACKET_PERTURBATION = 1e-3
+_RACKET_SAMPLES_PER_SECOND = 200
+_RACKET_TOLERANCE = 1e-12
+
+_stderr = Console(stderr=True)
+
+
+# --------------------------------------------------------------------------
+# Commands
+# --------------------------------------------------------------------------
+
+
+def _show_version(value: bool) -> None:
+    if value:
+        typer.echo(f"tumble {tumble.__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def main(
+    version: Annotated[bool, typer.Option("--version", callback=_show_version, is_eager=True,
+                                          help="Print the version and exit.")] = False,
+) -> None:
+    """Rotational dynamics of rigid bodies, built on Euler's equations.
+
+    SI units; omega in body axes; attitude q = [w, x, y, z] (scalar first), body -> inertial.
+    """
+
+
+@app.command()
+def run(
+    scenario: Annotated[Path, typer.Argument(help="Scenario file (TOML); see docs/scenarios.md.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="NetCDF file to write (e.g. out.nc).")],
+    plot: Annotated[Path | None, typer.Option("--plot", help="Also write a PNG figure of the trajectory.")] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+) -> None:
+    """Validate and simulate a scenario, write the trajectory (NetCDF) and optionally a figure (PNG).
+
+    A bad scenario is reported on stderr (file, key, rule) with exit code 2, and nothing is written.
+    """
+    with _exit_codes():
+        spec = load_scenario(scenario)
+        problem = spec.build()  # every rule of the file is checked before anything runs
+        _check_outputs(output, plot, inputs=(scenario,))
+        with _progress_bar("simulating", enabled=not quiet) as progress:
+            traj = problem.simulate(progress=progress)
+        figure = traj.plot(title=spec.name) if plot is not None else None
+        _save(traj, output, figure, plot)
+    _print_rows([("scenario", f"{scenario}" + (f" ({spec.name})" if spec.name else "")),
+                 *_summary(traj), ("wrote", _written(output, plot))])
+
+
+@demo_app.command("racket")
+def racket(
+    output: Annotated[Path, typer.Option("-o", "--output", help="NetCDF file to write.")] = Path("racket.nc"),
+    plot: Annotated[Path, typer.Option("--plot", help="PNG figure of the flips to write.")] = Path("racket.png"),
+    duration: Annotated[float, typer.Option("--duration", help="Simulated time, s.")] = 20.0,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+) -> None:
+    """Tennis-racket (Dzhanibekov) effect: a T-handle spun about its intermediate axis flips over and over.
+
+    The default RigidBody.t_handle() starts at 10 rad/s about its intermediate principal axis
+    with 1e-3 rad/s about the other two, integrated by dop853 at rtol = atol = 1e-12. A flip
+    is a sign change of the intermediate-axis rate; the command prints their number and the
+    mean time between them.
+    """
+    with _exit_codes():
+        require_positive(duration, "--duration")
+        _check_outputs(output, plot)
+        body = RigidBody.t_handle()
+        omega_principal = np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
+        n = int(np.ceil(duration * _RACKET_SAMPLES_PER_SECOND))
+        with _progress_bar("simulating", enabled=not quiet) as progress:
+            traj = simulate(body, body.axes @ omega_principal, t=np.linspace(0.0, duration, n + 1),
+                            method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE, progress=progress)
+        flips = flip_times(traj, body)
+        _save(traj, output, _racket_figure(traj, body, flips), plot)
+    mean = f", mean time between flips {np.diff(flips).mean():.4g} s" if flips.size > 1 else ""
+    _print_rows([*_summary(traj), ("flips", f"{flips.size} in {duration:g} s{mean}"),
+                 ("wrote", _written(output, plot))])
+
+
+@app.command()
+def info(path: Annotated[Path, typer.Argument(help="NetCDF file written by tumble run / tumble demo.")]) -> None:
+    """Print what a trajectory file holds: times, bodies, method, solver info and drifts."""
+    with _exit_codes():
+        try:
+            traj = load(path)
+        except (OSError, ValueError) as exc:
+            raise ValidationError(f"{path}: not a readable tumble trajectory ({exc})") from None
+    inertia = traj.inertia.reshape(-1, 3, 3)
+    moments = np.linalg.eigvalsh(inertia)
+    bodies = "1" if traj.batch_size is None else f"{traj.batch_size} (batch)"
+    rows = [("file", str(path)), ("bodies", bodies)]
+    rows += [("moments" if i == 0 else "", f"{m[0]:.6g}, {m[1]:.6g}, {m[2]:.6g} kg m^2 (principal)")
+             for i, m in enumerate(moments[:5])]
+    if len(moments) > 5:
+        rows.append(("", f"... {len(moments) - 5} more"))
+    rows += _summary(traj)
+    rows += [("solver" if i == 0 else "", f"{key} = {value}") for i, (key, value) in enumerate(traj.info.items())]
+    _print_rows(rows)
+
+
+# --------------------------------------------------------------------------
+# Helpers
+# --------------------------------------------------------------------------
+
+
+@contextmanager
+def _exit_codes() -> Iterator[None]:
+    """Turn bad input into exit code 2 and known failures into exit code 1, each with a message on stderr."""
+    try:
+        yield
+    except ValidationError as exc:
+        _error(str(exc))
+        raise typer.Exit(EXIT_BAD_INPUT) from None
+    except (SolverError, OSError) as exc:
+        _error(str(exc))
+        raise typer.Exit(EXIT_FAILURE) from None
+
+
+def _error(message: str) -> None:
+    for line in message.splitlines():
+        typer.echo(f"error: {line}", err=True)
+
+
+def _check_outputs(output: Path, plot: Path | None, *, inputs: tuple[Path, ...] = ()) -> None:
+    """Refuse output paths that cannot be written or would overwrite an input (before any work)."""
+    for option, path in (("--output", output), ("--plot", plot)):
+        if path is None:
+            continue
+        if not path.parent.is_dir():
+            raise ValidationError(f"{option}: directory {str(path.parent)!r} does not exist")
+        if path.is_dir():
+            raise ValidationError(f"{option}: {str(path)!r} is a directory")
+        if any(path.resolve() == src.resolve() for src in inputs):
+            raise ValidationError(f"{option}: {str(path)!r} would overwrite the input file")
+    if plot is not None and output.resolve() == plot.resolve():
+        raise ValidationError("--plot: must differ from --output")
+
+
+@contextmanager
+def _progress_bar(description: str, *, enabled: bool) -> Iterator[Callable[[int, int], None] | None]:
+    """A rich progress bar on stderr, as a ``progress(done, total)`` callback; ``None`` when not a terminal."""
+    if not (enabled and _stderr.is_terminal):
+        yield None
+        return
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("samples"),
+               TimeRemainingColumn())
+    with Progress(*columns, console=_stderr, transient=True) as bar:
+        task = bar.add_task(description, total=None)
+        yield lambda done, total: bar.update(task, completed=done, total=total)
+
+
+def _save(traj: Trajectory, output: Path, figure, plot: Path | None) -> None:
+    """Write the NetCDF file and, if asked, the PNG figure, each atomically."""
+    traj.save(output)
+    if plot is not None:
+        write_atomic(plot, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+
+
+def _racket_figure(traj: Trajectory, body: RigidBody, flips: np.ndarray):
+    """Figure of the body rate in principal axes (rad/s) against time (s), the flips marked."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(9.0, 4.5), layout="constrained")
+    ax = fig.subplots()
+    principal = traj.omega @ body.axes  # ω_P = R_BPᵀ ω_B, row by row
+    ax.plot(traj.t, intermediate_rate(traj, body), lw=2.0, label=r"$\omega_2$ (intermediate axis)")
+    for k, style in ((0, "--"), (2, ":")):
+        ax.plot(traj.t, principal[:, k], style, label=rf"$\omega_{k + 1}$")
+    for i, t_flip in enumerate(flips):
+        ax.axvline(t_flip, color="0.6", lw=0.8, label="flip" if i == 0 else None)
+    ax.set_xlabel("time t (s)")
+    ax.set_ylabel("body rate, principal axes (rad/s)")
+    ax.set_title(f"T-handle spun about its intermediate axis: {flips.size} flips", loc="left")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper right", fontsize="small")
+    return fig
+
+
+def _max_abs(values: np.ndarray) -> float:
+    return float(np.max(np.abs(values)))
+
+
+def _summary(traj: Trajectory) -> list[tuple[str, str]]:
+    """Rows: output times, method and its settings, the largest relative change of T, |L| and L_I."""
+    options = ", ".join(f"{key} {traj.info[key]:g}" for key in ("rtol", "atol", "dt") if key in traj.info)
+    steps = f", {traj.info['n_steps']} steps" if "n_steps" in traj.info else ""
+    torque = traj.info.get("torque", "none")
+    rows = [
+        ("times", f"{traj.t[0]:g} to {traj.t[-1]:g} s, {len(traj)} samples"),
+        ("method", f"{traj.method or 'unknown'}" + (f" ({options})" if options else "") + steps),
+        ("drift", f"energy {_max_abs(traj.energy_drift):.3g}, |L| {_max_abs(traj.momentum_norm_drift):.3g}, "
+                  f"L_I {_max_abs(traj.momentum_inertial_drift):.3g} (max relative change)"),
+    ]
+    if torque != "none":
+        rows.append(("", f"(torque {torque} acts: T and |L| need not be conserved)"))
+    return rows
+
+
+def _written(output: Path, plot: Path | None) -> str:
+    return ", ".join(str(p) for p in (output, plot) if p is not None)
+
+
+def _print_rows(rows: list[tuple[str, str]]) -> None:
+    for label, value in rows:
+        typer.echo(f"{label:<10}{value}")

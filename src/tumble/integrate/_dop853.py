@@ -1,0 +1,156 @@
+"""Explicit Runge–Kutta of order 8 with adaptive steps: Dormand–Prince DOP853.
+
+The method of Hairer, Nørsett & Wanner, *Solving Ordinary Differential
+Equations I* (2nd ed., Springer 1993), §II.10: 12 stages (first same as last),
+an embedded error estimate that combines 5th- and 3rd-order estimators, and
+the step-size control used by scipy's ``solve_ivp(method="DOP853")``. The
+coefficients are read from SciPy, so the tableau is not retyped here.
+
+Error control: a step is accepted when ``‖err‖ ≤ 1`` with components scaled by
+``atol + rtol·max(|y|, |y_new|)``. Steps are shortened to land exactly on each
+output time (no interpolation), and the step the controller proposed is
+resumed after such a landing. The quaternion is normalised after every
+accepted step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+from scipy.integrate._ivp import dop853_coefficients as _coef
+
+from tumble.integrate._models import project, rhs
+
+ORDER = 8
+_STAGES = _coef.N_STAGES  # 12
+A = np.ascontiguousarray(_coef.A[:_STAGES, :_STAGES])
+B = np.ascontiguousarray(_coef.B)
+C = np.ascontiguousarray(_coef.C[:_STAGES])
+E3 = np.ascontiguousarray(_coef.E3)
+E5 = np.ascontiguousarray(_coef.E5)
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+_EXPONENT = -1.0 / 8.0  # the error estimate is of order 7
+
+# Status codes written to stats[b, 3].
+OK, STEP_TOO_SMALL, TOO_MANY_STEPS = 0, 1, 2
+
+
+@njit(cache=True)
+def _rms(v):
+    return math.sqrt(np.sum(v * v) / v.shape[0])
+
+
+@njit(cache=True)
+def initial_step(kind, t, y, f0, p, codes, rtol, atol, span):
+    """Hairer's starting step (HNW I, §II.4): based on ‖y‖, ‖f‖ and a difference estimate of ‖f'‖."""
+    scale = atol + np.abs(y) * rtol
+    d0, d1 = _rms(y / scale), _rms(f0 / scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, span)
+    f1 = np.empty_like(y)
+    rhs(kind, t + h0, y + h0 * f0, p, codes, f1)
+    d2 = _rms((f1 - f0) / scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, 1e-3 * h0)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / ORDER)
+    return min(100.0 * h0, h1, span)
+
+
+@njit(cache=True)
+def dop853_path(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
+    """Advance ``y`` (in place) through ``t_out``; ``out[j]`` = state at ``t_out[j]``.
+
+    ``stats`` = [steps, rejected steps, evaluations, status, next step size]:
+    the step size is carried in and out, so a run split in chunks continues
+    exactly as one run would (0 on entry means "choose a starting step").
+    """
+    n = y.shape[0]
+    K = np.empty((_STAGES + 1, n))
+    y_new, tmp = np.empty(n), np.empty(n)
+    out[0, :] = y
+    t = t_out[0]
+    rhs(kind, t, y, p, codes, K[0])
+    stats[2] += 1
+    h = stats[4]
+    if h <= 0.0 and t_out.shape[0] > 1:
+        h = initial_step(kind, t, y, K[0], p, codes, rtol, atol, t_out[-1] - t)
+        stats[2] += 1
+    j = 1
+    rejected_last = False
+    while j < t_out.shape[0]:
+        target = t_out[j]
+        # land on the output time when the proposed step reaches it or nearly (1 %)
+        landing = t + 1.01 * h >= target
+        step = target - t if landing else h
+        for s in range(1, _STAGES):
+            for i in range(n):
+                acc = 0.0
+                for r in range(s):
+                    acc += A[s, r] * K[r, i]
+                tmp[i] = y[i] + step * acc
+            rhs(kind, t + C[s] * step, tmp, p, codes, K[s])
+        for i in range(n):
+            acc = 0.0
+            for r in range(_STAGES):
+                acc += B[r] * K[r, i]
+            y_new[i] = y[i] + step * acc
+        rhs(kind, t + step, y_new, p, codes, K[_STAGES])
+        stats[2] += _STAGES
+        # Error norm (HNW I, eq. 10.17 as in scipy's DOP853).
+        e5 = 0.0
+        e3 = 0.0
+        for i in range(n):
+            scale = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+            a5 = 0.0
+            a3 = 0.0
+            for r in range(_STAGES + 1):
+                a5 += E5[r] * K[r, i]
+                a3 += E3[r] * K[r, i]
+            e5 += (a5 / scale) ** 2
+            e3 += (a3 / scale) ** 2
+        err = 0.0 if e5 == 0.0 else step * e5 / math.sqrt((e5 + 0.01 * e3) * n)
+        stats[0] += 1
+        if err <= 1.0:
+            factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**_EXPONENT)
+            if rejected_last:
+                factor = min(1.0, factor)
+            h_next = step * factor
+            h = max(h, h_next) if landing else h_next
+            t = target if landing else t + step
+            y[:] = y_new
+            project(kind, y)
+            K[0, :] = K[_STAGES]
+            rejected_last = False
+            if landing:
+                out[j, :] = y
+                j += 1
+        else:
+            stats[1] += 1
+            h = step * max(MIN_FACTOR, SAFETY * err**_EXPONENT)
+            rejected_last = True
+            if h < 10.0 * np.finfo(np.float64).eps * max(abs(t), 1.0):
+                stats[3] = STEP_TOO_SMALL
+                return
+        if stats[0] >= max_steps:
+            stats[3] = TOO_MANY_STEPS
+            return
+    stats[4] = h
+
+
+@njit(cache=True, parallel=True)
+def dop853_batch(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
+    """Integrate the bodies ``y[b]`` in parallel, each with its own step sizes.
+
+    ``p`` has one row per body, or a single row shared by all; ``stats[b]``
+    is body ``b``'s statistics row (see :func:`dop853_path`).
+    """
+    shared = p.shape[0] == 1
+    for b in prange(y.shape[0]):
+        if stats[b, 3] == OK:
+            dop853_path(kind, y[b], t_out, rtol, atol, max_steps, p[0] if shared else p[b], codes, out[:, b, :], stats[b])

@@ -1,0 +1,447 @@
+"""The result of a simulation: sampled attitude and body rate, and their invariants.
+
+A :class:`Trajectory` holds one rigid body, or a batch of ``N`` bodies, at the
+output times ``t`` (``n`` samples):
+
+==========  ================  ====================================================
+field       shape             meaning
+==========  ================  ====================================================
+``t``       (n,)              output times, s
+``q``       (n, [N,] 4)       attitude: unit Hamilton quaternion, scalar first
+                              ``[w, x, y, z]``, body → inertial
+                              (``v_I = q ⊗ v_B ⊗ q*``)
+``omega``   (n, [N,] 3)       angular velocity relative to inertial, rad/s,
+                              body axes
+``inertia`` ([N,] 3, 3)       inertia tensor about the centre of mass, kg m²,
+                              body axes (one tensor may serve a whole batch)
+==========  ================  ====================================================
+
+The invariants of torque-free motion (kinetic energy ``T = ½ ω·Iω``, angular
+momentum ``L = I ω``) and their drifts are derived on demand with
+:mod:`tumble.dynamics`. A trajectory converts to an :class:`xarray.Dataset`,
+saves to NetCDF-4 atomically and plots with matplotlib's object-oriented API.
+The layout is described in ``docs/trajectory.md``.
+"""
+
+from __future__ import annotations
+
+import datetime
+import operator
+import os
+import stat
+import tempfile
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ._validate import ValidationError, as_array
+from .dynamics import angular_momentum, angular_momentum_inertial, kinetic_energy
+
+if TYPE_CHECKING:
+    import xarray
+    from matplotlib.figure import Figure
+
+__all__ = ["Trajectory", "load", "write_atomic"]
+
+CONVENTIONS = (
+    "quaternion: Hamilton, scalar-first [w,x,y,z], body->inertial; omega in body axes; SI units"
+)
+_ENGINE = "h5netcdf"  # NetCDF-4 (HDF5) reader and writer used by save() and load()
+_INFO_PREFIX = "solver_"  # global attributes of the NetCDF file that hold Trajectory.info
+_AXES = ["x", "y", "z"]
+_COMPONENTS = ["w", "x", "y", "z"]
+# Panel (b) of plot() shows |drift| on a symlog scale, linear below this value
+# (under float64's rounding, 2.2e-16) and logarithmic above: exact zeros stay
+# on the plot and every drift above rounding gets its own decade.
+_DRIFT_LINTHRESH = 1e-16
+
+
+def _readonly(a: np.ndarray) -> np.ndarray:
+    """Return ``a`` marked read-only (``a`` must be owned by the caller)."""
+    a.setflags(write=False)
+    return a
+
+
+def _relative(change: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """``change / |reference|``, or ``change`` itself where ``reference == 0``."""
+    scale = np.abs(reference)
+    return _readonly(np.divide(change, scale, out=np.array(change, dtype=np.float64), where=scale > 0))
+
+
+def _check_info(info: Any) -> dict:
+    """Copy ``info``, checking that it maps non-empty strings to floats, ints or strings."""
+    if not isinstance(info, Mapping):
+        raise ValidationError(f"info: must be a dict, got {type(info).__name__}")
+    out = {}
+    for key, value in info.items():
+        if not isinstance(key, str) or not key:
+            raise ValidationError(f"info: keys must be non-empty strings, got {key!r}")
+        if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (int, float, str, np.integer, np.floating)
+        ):
+            raise ValidationError(
+                f"info[{key!r}]: must be a float, an int or a string, got {type(value).__name__}"
+            )
+        out[key] = value.item() if isinstance(value, np.generic) else value
+    return out
+
+
+@dataclass(frozen=True, eq=False, repr=False)
+class Trajectory:
+    """Samples of the rotational state of one rigid body or a batch of bodies.
+
+    Parameters
+    ----------
+    t : array_like, shape (n,)
+        Output times, s, strictly monotonic (``t[0]`` is the start).
+    q : array_like, shape (n, 4) or (n, N, 4)
+        Attitude, unit Hamilton quaternion, scalar first ``[w, x, y, z]``,
+        mapping body to inertial axes: ``v_I = q ⊗ v_B ⊗ q*``.
+    omega : array_like, shape (n, 3) or (n, N, 3)
+        Angular velocity of the body relative to inertial space, rad/s, in
+        body axes.
+    inertia : array_like, shape (3, 3) or (N, 3, 3)
+        Inertia tensor about the centre of mass, kg m², in body axes. A single
+        (3, 3) tensor is shared by every body of a batch.
+    method : str
+        How the samples were made: ``"rk4"``, ``"dop853"``, ``"exact"``, ...
+    info : dict
+        Solver settings and statistics (``rtol``, ``atol``, ``dt``,
+        ``n_steps``, ...); values are floats, ints or strings.
+
+    The arrays are copied as float64 and stored read-only. Invalid input
+    raises :class:`tumble.ValidationError` naming the field.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    omega: np.ndarray
+    inertia: np.ndarray
+    method: str = ""
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        t = as_array(self.t, "t")
+        if t.ndim != 1 or t.size == 0:
+            raise ValidationError(f"t: must be a 1-D array of at least one time, got shape {t.shape}")
+        step = np.diff(t)
+        if not (np.all(step > 0) or np.all(step < 0)):
+            raise ValidationError("t: must be strictly increasing or strictly decreasing")
+        n = t.size
+        q = as_array(self.q, "q", tail=(4,))
+        if q.ndim not in (2, 3) or q.shape[0] != n:
+            raise ValidationError(
+                f"q: must have shape (n, 4) or (n, N, 4) with n = len(t) = {n}, got {q.shape}"
+            )
+        omega = as_array(self.omega, "omega", tail=(3,))
+        if omega.shape[:-1] != q.shape[:-1]:
+            raise ValidationError(
+                f"omega: must have shape {q.shape[:-1] + (3,)} to match q, got {omega.shape}"
+            )
+        inertia = as_array(self.inertia, "inertia", tail=(3, 3))
+        batch = q.shape[1:-1]
+        if inertia.shape[:-2] not in ((), batch):
+            allowed = "(3, 3)" + (f" or ({batch[0]}, 3, 3)" if batch else "")
+            raise ValidationError(f"inertia: must have shape {allowed}, got {inertia.shape}")
+        if not isinstance(self.method, str):
+            raise ValidationError(f"method: must be a string, got {type(self.method).__name__}")
+        for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
+            object.__setattr__(self, name, _readonly(np.array(value, dtype=np.float64)))
+        object.__setattr__(self, "info", _check_info(self.info))
+
+    def __len__(self) -> int:
+        """Number of output times ``n``."""
+        return self.t.size
+
+    def __repr__(self) -> str:
+        bodies = "" if self.batch_size is None else f", batch_size={self.batch_size}"
+        return (
+            f"Trajectory(method={self.method!r}, n={len(self)}, "
+            f"t=[{self.t[0]:g}, {self.t[-1]:g}] s{bodies})"
+        )
+
+    @property
+    def batch_size(self) -> int | None:
+        """Number ``N`` of bodies in a batch, or ``None`` for a single body."""
+        return None if self.q.ndim == 2 else self.q.shape[1]
+
+    def body(self, i: int) -> Trajectory:
+        """The trajectory of body ``i`` of a batch (negative ``i`` counts from the end)."""
+        n_bodies = self.batch_size
+        if n_bodies is None:
+            raise ValidationError("i: body(i) needs a batch; this Trajectory holds a single body")
+        i = operator.index(i)
+        if not -n_bodies <= i < n_bodies:
+            raise IndexError(f"i: body {i} is out of range for a batch of {n_bodies}")
+        inertia = self.inertia if self.inertia.ndim == 2 else self.inertia[i]
+        return Trajectory(self.t, self.q[:, i], self.omega[:, i], inertia, self.method, self.info)
+
+    # -- invariants ------------------------------------------------------------------
+
+    @cached_property
+    def energy(self) -> np.ndarray:
+        """Rotational kinetic energy ``T = ½ ω·Iω``, J, shape (n, [N])."""
+        return _readonly(kinetic_energy(self.inertia, self.omega))
+
+    @cached_property
+    def momentum_body(self) -> np.ndarray:
+        """Angular momentum ``L = I ω`` about the centre of mass, N m s, body axes, (n, [N,] 3)."""
+        return _readonly(angular_momentum(self.inertia, self.omega))
+
+    @cached_property
+    def momentum_inertial(self) -> np.ndarray:
+        """Angular momentum ``L_I = R(q) I ω``, N m s, inertial axes, shape (n, [N,] 3).
+
+        Constant in torque-free motion.
+        """
+        return _readonly(angular_momentum_inertial(self.inertia, self.omega, self.q))
+
+    @cached_property
+    def momentum_norm(self) -> np.ndarray:
+        """Magnitude ``|L|`` of the angular momentum (the same in every frame), N m s, (n, [N])."""
+        return _readonly(np.linalg.norm(self.momentum_body, axis=-1))
+
+    @property
+    def energy_drift(self) -> np.ndarray:
+        """Relative change of kinetic energy from the first sample, ``(T - T₀) / T₀``.
+
+        Dimensionless, shape (n, [N]). Where ``T₀ = 0`` (a body at rest) the
+        absolute change ``T - T₀`` (J) is returned instead.
+        """
+        return _relative(self.energy - self.energy[0], self.energy[0])
+
+    @property
+    def momentum_norm_drift(self) -> np.ndarray:
+        """Relative change of ``|L|`` from the first sample, ``(|L| - |L₀|) / |L₀|``.
+
+        Dimensionless, shape (n, [N]); the absolute change (N m s) where ``|L₀| = 0``.
+        """
+        return _relative(self.momentum_norm - self.momentum_norm[0], self.momentum_norm[0])
+
+    @property
+    def momentum_inertial_drift(self) -> np.ndarray:
+        """Relative change of the inertial momentum vector, ``|L_I - L_I₀| / |L_I₀|``.
+
+        Dimensionless and ≥ 0, shape (n, [N]). It sees errors of direction
+        (attitude) as well as of magnitude. Where ``L_I₀ = 0`` the absolute
+        change ``|L_I - L_I₀|`` (N m s) is returned instead.
+        """
+        change = np.linalg.norm(self.momentum_inertial - self.momentum_inertial[0], axis=-1)
+        return _relative(change, np.linalg.norm(self.momentum_inertial[0], axis=-1))
+
+    # -- xarray and NetCDF ------------------------------------------------------------
+
+    def to_xarray(self) -> xarray.Dataset:
+        """Return the trajectory as an :class:`xarray.Dataset`.
+
+        Dimensions ``time``, ``body`` (batches only), ``axis`` (x, y, z),
+        ``axis2`` (x, y, z: the column index of ``inertia``) and ``component``
+        (w, x, y, z). Every variable has ``units`` and ``description``
+        attributes, and ``frame`` where it has one. Global attributes:
+        ``conventions``, ``method``, ``solver_<key>`` for each entry of
+        ``info``, ``tumble_version`` and ``created`` (ISO 8601, UTC). The
+        dataset shares this trajectory's read-only arrays.
+        """
+        import xarray as xr
+
+        lead = ("time",) if self.batch_size is None else ("time", "body")
+        inertia_dims = ("axis", "axis2") if self.inertia.ndim == 2 else ("body", "axis", "axis2")
+
+        def variable(dims, data, units, description, frame=None):
+            attrs = {"units": units, "description": description}
+            if frame is not None:
+                attrs["frame"] = frame
+            return xr.Variable(dims, data, attrs)
+
+        data_vars = {
+            "omega": variable(lead + ("axis",), self.omega, "rad/s",
+                              "angular velocity of the body relative to inertial space", "body"),
+            "q": variable(lead + ("component",), self.q, "1",
+                          "attitude: unit Hamilton quaternion, scalar first, v_I = q v_B q*",
+                          "body->inertial"),
+            "inertia": variable(inertia_dims, self.inertia, "kg m2",
+                                "inertia tensor about the centre of mass", "body"),
+            "energy": variable(lead, self.energy, "J",
+                               "rotational kinetic energy T = 1/2 omega.I omega"),
+            "momentum_body": variable(lead + ("axis",), self.momentum_body, "N m s",
+                                      "angular momentum L = I omega", "body"),
+            "momentum_inertial": variable(lead + ("axis",), self.momentum_inertial, "N m s",
+                                          "angular momentum L_I = R(q) I omega", "inertial"),
+        }
+        coords = {
+            "time": ("time", self.t, {"units": "s", "description": "output time"}),
+            "axis": ("axis", _AXES),
+            "axis2": ("axis2", _AXES),
+            "component": ("component", _COMPONENTS),
+        }
+        if self.batch_size is not None:
+            coords["body"] = ("body", np.arange(self.batch_size), {"description": "index in the batch"})
+        attrs = {
+            "conventions": CONVENTIONS,
+            "method": self.method,
+            **{_INFO_PREFIX + key: value for key, value in self.info.items()},
+            "tumble_version": _tumble_version(),
+            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        }
+        return xr.Dataset(data_vars, coords, attrs)
+
+    @classmethod
+    def from_xarray(cls, ds: xarray.Dataset) -> Trajectory:
+        """Rebuild a trajectory from a dataset made by :meth:`to_xarray`.
+
+        Reads ``time``, ``q``, ``omega`` and ``inertia`` exactly (derived
+        variables are recomputed), ``method`` and the ``solver_*`` attributes
+        (into ``info``).
+        """
+        missing = [name for name in ("time", "q", "omega", "inertia") if name not in ds.variables]
+        if missing:
+            raise ValidationError(f"ds: not a tumble trajectory (missing {', '.join(missing)})")
+        ds = ds.sel(axis=_AXES, axis2=_AXES, component=_COMPONENTS)
+        info = {
+            key[len(_INFO_PREFIX):]: value
+            for key, value in ds.attrs.items()
+            if key.startswith(_INFO_PREFIX)
+        }
+        return cls(
+            t=ds["time"].values,
+            q=ds["q"].transpose("time", ..., "component").values,
+            omega=ds["omega"].transpose("time", ..., "axis").values,
+            inertia=ds["inertia"].transpose(..., "axis", "axis2").values,
+            method=str(ds.attrs.get("method", "")),
+            info=info,
+        )
+
+    def save(self, path: str | os.PathLike) -> None:
+        """Write the trajectory to ``path`` as NetCDF-4 (HDF5, via h5netcdf), atomically.
+
+        The file is written under a temporary name in the same directory and
+        renamed onto ``path`` only when complete (:func:`write_atomic`), so an
+        interrupted save leaves any previous file at ``path`` untouched. Read it
+        back with :func:`tumble.load`.
+        """
+        ds = self.to_xarray()
+        write_atomic(path, lambda tmp_path: ds.to_netcdf(tmp_path, engine=_ENGINE))
+
+    # -- figure ------------------------------------------------------------------------
+
+    def plot(self, *, title: str | None = None) -> Figure:
+        """Return a matplotlib figure of the trajectory (nothing is shown or saved).
+
+        Panels, against time (s): (a) body rates ω_x, ω_y, ω_z (rad/s, body
+        axes); (b) absolute values of the relative drifts of T and |L|
+        (symlog scale, linear below 1e-16, so exact zeros show); (c) direction
+        of the inertial angular momentum, ``L_I / |L_I|`` (inertial axes).
+        For a batch, body 0 is plotted and the title says so.
+        Save the figure with ``fig.savefig(path)``, or atomically with
+        :func:`write_atomic`.
+        """
+        from matplotlib.figure import Figure
+
+        traj = self if self.batch_size is None else self.body(0)
+        if title is None:
+            title = f"tumble trajectory ({self.method or 'unknown method'})"
+        if self.batch_size is not None:
+            title += f" — body 0 of {self.batch_size}"
+
+        fig = Figure(figsize=(8.0, 9.0), layout="constrained")
+        ax_rate, ax_drift, ax_direction = fig.subplots(3, 1, sharex=True)
+        for k, name in enumerate(_AXES):
+            ax_rate.plot(traj.t, traj.omega[:, k], label=rf"$\omega_{name}$")
+        ax_rate.set_title("(a) body rates", loc="left")
+        ax_rate.set_ylabel("ω, body axes (rad/s)")
+
+        ax_drift.plot(traj.t, np.abs(traj.energy_drift), label=r"$|T - T_0|/T_0$")
+        ax_drift.plot(traj.t, np.abs(traj.momentum_norm_drift), label=r"$||L| - |L_0||/|L_0|$")
+        ax_drift.set_yscale("symlog", linthresh=_DRIFT_LINTHRESH)
+        ax_drift.set_ylim(bottom=0.0)
+        ax_drift.set_title(
+            f"(b) drift of the invariants (symlog scale, linear below {_DRIFT_LINTHRESH:g})", loc="left"
+        )
+        ax_drift.set_ylabel("|relative drift| (1)")
+
+        momentum = traj.momentum_inertial
+        norm = np.linalg.norm(momentum, axis=-1, keepdims=True)
+        direction = np.divide(momentum, norm, out=np.zeros_like(momentum), where=norm > 0)
+        for k, name in enumerate(_AXES):
+            ax_direction.plot(traj.t, direction[:, k], label=rf"$L_{name}/|L|$")
+        ax_direction.set_title("(c) direction of the angular momentum", loc="left")
+        ax_direction.set_ylabel("$L_I/|L_I|$, inertial axes (1)")
+        ax_direction.set_xlabel("time t (s)")
+
+        for ax in (ax_rate, ax_drift, ax_direction):
+            ax.grid(True, alpha=0.3)
+            ax.legend(loc="best", fontsize="small")
+        fig.suptitle(title)
+        return fig
+
+
+def _tumble_version() -> str:
+    """``tumble.__version__``, or ``"unknown"`` when the package does not define it."""
+    import tumble
+
+    return str(getattr(tumble, "__version__", "unknown"))
+
+
+def load(path: str | os.PathLike) -> Trajectory:
+    """Read a trajectory written by :meth:`Trajectory.save` (arrays bitwise equal)."""
+    import xarray as xr
+
+    ds = xr.load_dataset(path, engine=_ENGINE, decode_timedelta=False)
+    return Trajectory.from_xarray(ds)
+
+
+def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
+    """Write a file atomically: ``write(tmp_path)`` fills a temporary file, renamed onto ``path``.
+
+    The temporary file (suffix ``.tmp``) is made in the directory of ``path``,
+    so :func:`os.replace` is an atomic rename: readers see either the old file
+    or the complete new one, never a partial file. On any exception, including
+    ``KeyboardInterrupt``, the temporary file is removed, a pre-existing
+    ``path`` is left untouched, and the exception propagates. The new file gets
+    the permissions of the file it replaces, or the default ``0o666 & ~umask``.
+
+    ``write`` must not infer the format from the file name, which ends in
+    ``.tmp``: e.g. ``write_atomic("fig.png", lambda p: fig.savefig(p, format="png"))``.
+
+    Raises ``FileNotFoundError`` if the directory of ``path`` does not exist.
+    """
+    path = os.fspath(path)
+    directory = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise FileNotFoundError(f"path: directory {directory!r} does not exist (writing {path!r})")
+    with tempfile.NamedTemporaryFile(
+        dir=directory, prefix=f".{os.path.basename(path)}.", suffix=".tmp", delete=False
+    ) as tmp:
+        tmp_path = tmp.name
+    try:
+        write(tmp_path)
+        _set_mode(tmp_path, path)
+        fd = os.open(tmp_path, os.O_RDWR)
+        try:
+            os.fsync(fd)  # the data reach the disk before the rename makes them visible
+        finally:
+            os.close(fd)
+        os.replace(tmp_path, path)
+    except BaseException:
+        try:
+            os.remove(tmp_path)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def _set_mode(tmp_path: str, path: str) -> None:
+    """Give ``tmp_path`` the permissions of ``path``, or those a plain ``open`` would give.
+
+    ``NamedTemporaryFile`` creates files readable by their owner only (0o600).
+    """
+    try:
+        mode = stat.S_IMODE(os.stat(path).st_mode)
+    except FileNotFoundError:
+        umask = os.umask(0)  # the umask can only be read by setting it
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    os.chmod(tmp_path, mode)
