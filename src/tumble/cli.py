@@ -231,12 +231,13 @@ def _racket_figure(traj: Trajectory, body: RigidBody, flips: np.ndarray):
     ax.set_ylabel("body rate, principal axes (rad/s)")
     ax.set_title(f"T-handle spun about its intermediate axis: {flips.size} flips", loc="left")
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper right", fontsize="small")
+    fig.legend(loc="outside right upper", fontsize="small")
     return fig
 
 
-def _max_abs(values: np.ndarray) -> float:
-    return float(np.max(np.abs(values)))
+def _drift(drift: np.ndarray, initial: np.ndarray) -> str:
+    """Largest |relative change|, or "n/a" where the initial value is 0 (the drift is then absolute)."""
+    return "n/a" if np.any(initial == 0.0) else f"{np.max(np.abs(drift)):.3g}"
 
 
 def _summary(traj: Trajectory) -> list[tuple[str, str]]:
@@ -247,8 +248,9 @@ def _summary(traj: Trajectory) -> list[tuple[str, str]]:
     rows = [
         ("times", f"{traj.t[0]:g} to {traj.t[-1]:g} s, {len(traj)} samples"),
         ("method", f"{traj.method or 'unknown'}" + (f" ({options})" if options else "") + steps),
-        ("drift", f"energy {_max_abs(traj.energy_drift):.3g}, |L| {_max_abs(traj.momentum_norm_drift):.3g}, "
-                  f"L_I {_max_abs(traj.momentum_inertial_drift):.3g} (max relative change)"),
+        ("drift", f"energy {_drift(traj.energy_drift, traj.energy[0])}, "
+                  f"|L| {_drift(traj.momentum_norm_drift, traj.momentum_norm[0])}, "
+                  f"L_I {_drift(traj.momentum_inertial_drift, traj.momentum_norm[0])} (max relative change)"),
     ]
     if torque != "none":
         rows.append(("", f"(torque {torque} acts: T and |L| need not be conserved)"))

@@ -60,8 +60,8 @@ from tumble.trajectory import Trajectory
 
 __all__ = ["Problem", "Scenario", "ScenarioError", "load_scenario", "parse_scenario", "run_scenario"]
 
-# Most output times a scenario may ask for (10⁷ samples of a 7-float state are
-# 560 MB): a guard against a typo such as step = 1e-9 exhausting memory.
+# Most output times a scenario may ask for (10⁷ samples of t, q and ω are
+# 640 MB): a guard against a typo such as step = 1e-9 exhausting memory.
 MAX_SAMPLES = 10_000_000
 # The output times of [time] step reach `stop` when (stop - start)/step is a
 # whole number to within this many steps (floating-point rounding of the ratio).
@@ -269,7 +269,7 @@ class Initial(_Table):
             raise ValueError("give the initial attitude as q or as euler, not both")
         return euler
 
-    def attitude(self) -> np.ndarray:
+    def quaternion(self) -> np.ndarray:
         """``q0``: unit quaternion ``[w, x, y, z]``, body → inertial (``q`` is normalised)."""
         if self.euler is not None:
             return self.euler.quaternion()
@@ -467,7 +467,7 @@ class Scenario(_Table):
             body = self.body.build()
         attitude_keys = {"q": "initial.q", "seq": "initial.euler.seq", "angles": "initial.euler.angles"}
         with _blame(self.source, "initial", attitude_keys):
-            q0 = self.initial.attitude()
+            q0 = self.initial.quaternion()
         models = []
         for i, entry in enumerate(self.torque):
             with _blame(self.source, f"torque[{i}]", entry.argument_keys(f"torque[{i}]")):
@@ -522,7 +522,8 @@ def load_scenario(path) -> Scenario:
     except OSError as exc:
         raise ScenarioError(source, [("", f"cannot read the file ({exc.strerror or exc})")]) from None
     except UnicodeDecodeError as exc:
-        raise ScenarioError(source, [("", f"not UTF-8 text, as TOML requires ({exc.reason} at byte {exc.start})")]) from None
+        rule = f"not UTF-8 text, as TOML requires ({exc.reason} at byte {exc.start})"
+        raise ScenarioError(source, [("", rule)]) from None
     return parse_scenario(text, source=source)
 
 

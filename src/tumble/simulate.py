@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from tumble import attitude, integrate, torques
+from tumble import _rigid, attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
 from tumble.body import RigidBody
 from tumble.trajectory import Trajectory
@@ -90,14 +90,14 @@ def simulate(
     q_bp = attitude.from_matrix(axes)                              # (B, 4)
     if len(bodies) == 1:
         axes, q_bp = axes[:1], q_bp[:1]
-    y0 = np.empty((n or 1, integrate.STATE_SIZE[integrate.RIGID]))
+    y0 = np.empty((n or 1, _rigid.STATE_SIZE))
     y0[:, :4] = attitude.multiply(q0, q_bp)
     y0[:, 4:] = np.einsum("bji,bj->bi", axes, omega0)
-    p, codes = _parameters(bodies, model)
+    rigid = _rigid.build(bodies, model)
 
     with torques.registered(model):
         states, stats = integrate.solve(
-            integrate.RIGID, y0, times, p, codes, method=method, dt=dt, rtol=rtol, atol=atol,
+            rigid, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
             max_steps=max_steps, serial=model is not None and model.needs_python, progress=progress,
         )
 
@@ -148,12 +148,3 @@ def _batch_size(bodies, inertia, omega0, q0) -> int | None:
     if len(set(sizes.values())) > 1:
         raise ValidationError(f"batch sizes disagree: {sizes}")
     return next(iter(sizes.values()), None)
-
-
-def _parameters(bodies, model) -> tuple[np.ndarray, np.ndarray]:
-    """Parameter rows ``[I₁, I₂, I₃, torque program…]`` (one per distinct body) and the program codes."""
-    rows, codes = [], None
-    for b in bodies:
-        codes, params = torques.compile_program(model, b.axes, offset=3)
-        rows.append(np.concatenate([b.moments, params]))
-    return np.ascontiguousarray(rows), codes

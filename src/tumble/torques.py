@@ -281,21 +281,30 @@ def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, p, o):
 
 @njit(cache=True)
 def _tabulated(t, p, o):
+    """Interpolate a Tabulated block at ``t`` (index arithmetic only: no array views in the hot loop)."""
     n = int(p[o])
-    times = p[o + 3 : o + 3 + n]
-    values = p[o + 3 + n : o + 3 + 4 * n]
-    if t <= times[0]:
+    t0 = o + 3  # times at p[t0 : t0 + n], values (n, 3) row-major after them
+    v0 = t0 + n
+    if t <= p[t0]:
         k, f = 0, 0.0
-    elif t >= times[n - 1]:
+    elif t >= p[t0 + n - 1]:
         k, f = n - 1, 0.0
     else:
-        k = np.searchsorted(times, t, side="right") - 1
-        f = 0.0 if p[o + 2] != 0.0 else (t - times[k]) / (times[k + 1] - times[k])
-    a, b, c = values[3 * k], values[3 * k + 1], values[3 * k + 2]
+        lo, hi = 0, n - 1  # invariant: p[t0 + lo] <= t < p[t0 + hi]
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if p[t0 + mid] <= t:
+                lo = mid
+            else:
+                hi = mid
+        k = lo
+        f = 0.0 if p[o + 2] != 0.0 else (t - p[t0 + k]) / (p[t0 + k + 1] - p[t0 + k])
+    i = v0 + 3 * k
+    a, b, c = p[i], p[i + 1], p[i + 2]
     if f != 0.0:
-        a += f * (values[3 * k + 3] - a)
-        b += f * (values[3 * k + 4] - b)
-        c += f * (values[3 * k + 5] - c)
+        a += f * (p[i + 3] - a)
+        b += f * (p[i + 4] - b)
+        c += f * (p[i + 5] - c)
     return a, b, c
 
 

@@ -24,7 +24,6 @@ import numpy as np
 
 from tumble._validate import ValidationError, require_positive
 from tumble.integrate import _dop853, _rk4
-from tumble.integrate._models import RIGID, STATE_SIZE  # noqa: F401  (re-exported)
 
 __all__ = ["METHODS", "Method", "SolverError", "solve"]
 
@@ -71,11 +70,11 @@ def check_options(method: str, *, dt, rtol, atol, max_steps) -> Method:
     return m
 
 
-def solve(kind, y0, t, p, codes, *, method, dt=None, rtol=None, atol=None,
+def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
           max_steps=10**9, serial=False, progress=None):
-    """Integrate model ``kind`` for a batch of states ``y0`` (N, n) through output times ``t``.
+    """Integrate ``model`` (see :mod:`tumble._model`) for a batch of states ``y0`` (N, n) through ``t``.
 
-    ``p`` is (N, n_p) or (1, n_p) shared. Returns ``(states, stats)``: states
+    Returns ``(states, stats)``: states
     of shape (len(t), N, n) and a dict of statistics summed over the batch.
     ``serial=True`` runs body after body on one core (needed when the model
     calls back into Python). ``progress(done, total)`` is called after each
@@ -90,7 +89,7 @@ def solve(kind, y0, t, p, codes, *, method, dt=None, rtol=None, atol=None,
     if progress is not None and n_out > 2:
         bounds = np.unique(np.linspace(0, n_out - 1, min(_CHUNKS, n_out - 1) + 1).astype(int)).tolist()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        _run_chunk(method, kind, y, t[lo:hi + 1], p, codes, out[lo:hi + 1], stats,
+        _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
                    dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, serial=serial)
         _raise_on_failure(stats, t)
         if progress is not None:
@@ -104,20 +103,19 @@ def solve(kind, y0, t, p, codes, *, method, dt=None, rtol=None, atol=None,
     }
 
 
-def _run_chunk(method, kind, y, t, p, codes, out, stats, *, dt, rtol, atol, max_steps, serial):
-    shared = p.shape[0] == 1
+def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, serial):
     if method == "rk4":
         if serial:
             for b in range(y.shape[0]):
-                stats[b, 0] += _rk4.rk4_path(kind, y[b], t, dt, p[0 if shared else b], codes, out[:, b])
+                stats[b, 0] += _rk4.rk4_path(model, b, y[b], t, dt, out[:, b])
         else:
-            _rk4.rk4_batch(kind, y, t, dt, p, codes, out, stats)
+            _rk4.rk4_batch(model, y, t, dt, out, stats)
         stats[:, 2] = 4 * stats[:, 0]
     elif serial:
         for b in range(y.shape[0]):
-            _dop853.dop853_path(kind, y[b], t, rtol, atol, max_steps, p[0 if shared else b], codes, out[:, b], stats[b])
+            _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, out[:, b], stats[b])
     else:
-        _dop853.dop853_batch(kind, y, t, rtol, atol, max_steps, p, codes, out, stats)
+        _dop853.dop853_batch(model, y, t, rtol, atol, max_steps, out, stats)
 
 
 def _raise_on_failure(stats, t):

@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit, prange
 from scipy.integrate._ivp import dop853_coefficients as _coef
 
-from tumble.integrate._models import project, rhs
+from tumble._model import project, rhs
 
 ORDER = 8
 _STAGES = _coef.N_STAGES  # 12
@@ -46,14 +46,14 @@ def _rms(v):
 
 
 @njit(cache=True)
-def initial_step(kind, t, y, f0, p, codes, rtol, atol, span):
+def initial_step(model, b, t, y, f0, rtol, atol, span):
     """Hairer's starting step (HNW I, §II.4): based on ‖y‖, ‖f‖ and a difference estimate of ‖f'‖."""
     scale = atol + np.abs(y) * rtol
     d0, d1 = _rms(y / scale), _rms(f0 / scale)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, span)
     f1 = np.empty_like(y)
-    rhs(kind, t + h0, y + h0 * f0, p, codes, f1)
+    rhs(model, b, t + h0, y + h0 * f0, f1)
     d2 = _rms((f1 - f0) / scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, 1e-3 * h0)
@@ -63,8 +63,8 @@ def initial_step(kind, t, y, f0, p, codes, rtol, atol, span):
 
 
 @njit(cache=True)
-def dop853_path(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
-    """Advance ``y`` (in place) through ``t_out``; ``out[j]`` = state at ``t_out[j]``.
+def dop853_path(model, b, y, t_out, rtol, atol, max_steps, out, stats):
+    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[j]`` = state at ``t_out[j]``.
 
     ``stats`` = [steps, rejected steps, evaluations, status, next step size]:
     the step size is carried in and out, so a run split in chunks continues
@@ -75,11 +75,11 @@ def dop853_path(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
     y_new, tmp = np.empty(n), np.empty(n)
     out[0, :] = y
     t = t_out[0]
-    rhs(kind, t, y, p, codes, K[0])
+    rhs(model, b, t, y, K[0])
     stats[2] += 1
     h = stats[4]
     if h <= 0.0 and t_out.shape[0] > 1:
-        h = initial_step(kind, t, y, K[0], p, codes, rtol, atol, t_out[-1] - t)
+        h = initial_step(model, b, t, y, K[0], rtol, atol, t_out[-1] - t)
         stats[2] += 1
     j = 1
     rejected_last = False
@@ -94,13 +94,13 @@ def dop853_path(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
                 for r in range(s):
                     acc += A[s, r] * K[r, i]
                 tmp[i] = y[i] + step * acc
-            rhs(kind, t + C[s] * step, tmp, p, codes, K[s])
+            rhs(model, b, t + C[s] * step, tmp, K[s])
         for i in range(n):
             acc = 0.0
             for r in range(_STAGES):
                 acc += B[r] * K[r, i]
             y_new[i] = y[i] + step * acc
-        rhs(kind, t + step, y_new, p, codes, K[_STAGES])
+        rhs(model, b, t + step, y_new, K[_STAGES])
         stats[2] += _STAGES
         # Error norm (HNW I, eq. 10.17 as in scipy's DOP853).
         e5 = 0.0
@@ -124,7 +124,7 @@ def dop853_path(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
             h = max(h, h_next) if landing else h_next
             t = target if landing else t + step
             y[:] = y_new
-            project(kind, y)
+            project(model, y)
             K[0, :] = K[_STAGES]
             rejected_last = False
             if landing:
@@ -144,13 +144,10 @@ def dop853_path(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
 
 
 @njit(cache=True, parallel=True)
-def dop853_batch(kind, y, t_out, rtol, atol, max_steps, p, codes, out, stats):
-    """Integrate the bodies ``y[b]`` in parallel, each with its own step sizes.
-
-    ``p`` has one row per body, or a single row shared by all; ``stats[b]``
-    is body ``b``'s statistics row (see :func:`dop853_path`).
-    """
-    shared = p.shape[0] == 1
-    for b in prange(y.shape[0]):
+def dop853_batch(model, y, t_out, rtol, atol, max_steps, out, stats):
+    """Integrate the bodies ``y[b]`` in parallel, each with its own step sizes;
+    ``stats[b]`` is body ``b``'s statistics row (see :func:`dop853_path`)."""
+    for i in prange(y.shape[0]):
+        b = np.int64(i)  # prange indices may be unsigned
         if stats[b, 3] == OK:
-            dop853_path(kind, y[b], t_out, rtol, atol, max_steps, p[0] if shared else p[b], codes, out[:, b, :], stats[b])
+            dop853_path(model, b, y[b], t_out, rtol, atol, max_steps, out[:, b, :], stats[b])

@@ -19,14 +19,14 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from tumble.integrate._models import project, rhs
+from tumble._model import project, rhs
 
 ORDER = 4
 
 
 @njit(cache=True)
-def rk4_path(kind, y, t_out, dt, p, codes, out):
-    """Advance ``y`` (in place) through the times ``t_out``; ``out[j]`` = state at ``t_out[j]``.
+def rk4_path(model, b, y, t_out, dt, out):
+    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[j]`` = state at ``t_out[j]``.
 
     Returns the number of steps taken.
     """
@@ -41,31 +41,28 @@ def rk4_path(kind, y, t_out, dt, p, codes, out):
         h = span / m
         for s in range(m):
             t = t0 + s * h
-            rhs(kind, t, y, p, codes, k1)
+            rhs(model, b, t, y, k1)
             for i in range(n):
                 tmp[i] = y[i] + 0.5 * h * k1[i]
-            rhs(kind, t + 0.5 * h, tmp, p, codes, k2)
+            rhs(model, b, t + 0.5 * h, tmp, k2)
             for i in range(n):
                 tmp[i] = y[i] + 0.5 * h * k2[i]
-            rhs(kind, t + 0.5 * h, tmp, p, codes, k3)
+            rhs(model, b, t + 0.5 * h, tmp, k3)
             for i in range(n):
                 tmp[i] = y[i] + h * k3[i]
-            rhs(kind, t + h, tmp, p, codes, k4)
+            rhs(model, b, t + h, tmp, k4)
             for i in range(n):
                 y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            project(kind, y)
+            project(model, y)
         steps += m
         out[j, :] = y
     return steps
 
 
 @njit(cache=True, parallel=True)
-def rk4_batch(kind, y, t_out, dt, p, codes, out, stats):
-    """Integrate the bodies ``y[b]`` in parallel; ``out[:, b]`` receives body ``b``'s path.
-
-    ``p`` has one row per body, or a single row shared by all. ``stats[b, 0]``
-    receives the number of steps.
-    """
-    shared = p.shape[0] == 1
-    for b in prange(y.shape[0]):
-        stats[b, 0] += rk4_path(kind, y[b], t_out, dt, p[0] if shared else p[b], codes, out[:, b, :])
+def rk4_batch(model, y, t_out, dt, out, stats):
+    """Integrate the bodies ``y[b]`` in parallel; ``out[:, b]`` receives body ``b``'s path
+    and ``stats[b, 0]`` its number of steps."""
+    for i in prange(y.shape[0]):
+        b = np.int64(i)  # prange indices may be unsigned
+        stats[b, 0] += rk4_path(model, b, y[b], t_out, dt, out[:, b, :])

@@ -1,0 +1,156 @@
+"""The `tumble` command: run, demo racket, info, --help, --version; exit codes; nothing written on bad input."""
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import tumble
+from tumble.cli import app
+from tumble.scenario import load_scenario, run_scenario
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+SRC = Path(__file__).resolve().parents[1] / "src"
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+runner = CliRunner()
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+@pytest.mark.parametrize("command", [[], ["run"], ["demo"], ["demo", "racket"], ["info"]], ids=" ".join)
+def test_help_of_every_command(command):
+    result = invoke(*command, "--help")
+    assert result.exit_code == 0, result.output
+    assert "Usage: tumble" in result.stdout
+
+
+def test_version():
+    result = invoke("--version")
+    assert result.exit_code == 0
+    assert result.stdout.strip() == f"tumble {tumble.__version__}"
+
+
+def test_python_dash_m_tumble():
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run([sys.executable, "-m", "tumble", "--version"], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == f"tumble {tumble.__version__}"
+
+
+def test_run_writes_a_loadable_trajectory_and_a_png(tmp_path):
+    scenario = EXAMPLES / "symmetric_top.toml"
+    out, png = tmp_path / "top.nc", tmp_path / "top.png"
+    result = invoke("run", scenario, "-o", out, "--plot", png)
+    assert result.exit_code == 0, result.output
+    saved = tumble.load(out)
+    direct = run_scenario(load_scenario(scenario))  # the same computation through the library
+    np.testing.assert_array_equal(saved.t, direct.t)
+    np.testing.assert_array_equal(saved.omega, direct.omega)
+    np.testing.assert_array_equal(saved.q, direct.q)
+    assert png.read_bytes()[:8] == PNG_MAGIC
+    assert "0 to 10 s, 1001 samples" in result.stdout
+    assert f"wrote     {out}, {png}" in result.stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["top.nc", "top.png"]  # no temporary files left
+
+
+BAD_FILES = {
+    "schema": ("[body]\nmoments = [1.0, 2.0, 3.0]\n[initial]\nomega = [0, 0, 1]\n[time]\nstop = -1.0\nsamples = 5\n",
+               "bad.toml: time.stop: must be greater than start"),
+    "syntax": ("[body\n", "bad.toml: line 1, column 6: invalid TOML"),
+    "physics": ("[body]\ninertia = [[1, 0, 0], [0, 1, 0], [0, 0, 0]]\n[initial]\nomega = [0, 0, 1]\n"
+                "[time]\nstop = 1.0\nsamples = 5\n", "bad.toml: body.inertia: must be positive definite"),
+}
+
+
+@pytest.mark.parametrize("case", BAD_FILES)
+def test_run_bad_file_exits_2_and_writes_nothing(tmp_path, case):
+    text, message = BAD_FILES[case]
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    result = invoke("run", bad, "-o", tmp_path / "out.nc", "--plot", tmp_path / "out.png")
+    assert result.exit_code == 2
+    assert message in result.stderr
+    assert result.stdout == ""
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
+
+
+def test_run_missing_file_exits_2(tmp_path):
+    result = invoke("run", tmp_path / "nope.toml", "-o", tmp_path / "out.nc")
+    assert result.exit_code == 2
+    assert "nope.toml: cannot read the file" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_run_output_in_missing_directory_exits_2(tmp_path):
+    result = invoke("run", EXAMPLES / "symmetric_top.toml", "-o", tmp_path / "no" / "out.nc")
+    assert result.exit_code == 2
+    assert "--output: directory" in result.stderr and "does not exist" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_solver_failure_exits_1_and_writes_nothing(tmp_path, monkeypatch):
+    def give_up(*args, **kwargs):
+        raise tumble.SolverError("max_steps reached")
+
+    monkeypatch.setattr("tumble.scenario.simulate", give_up)
+    result = invoke("run", EXAMPLES / "symmetric_top.toml", "-o", tmp_path / "out.nc")
+    assert result.exit_code == 1
+    assert "error: max_steps reached" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_demo_racket_counts_the_flips_in_the_file(tmp_path):
+    out, png = tmp_path / "racket.nc", tmp_path / "racket.png"
+    result = invoke("demo", "racket", "-o", out, "--plot", png, "--duration", 20)
+    assert result.exit_code == 0, result.output
+    match = re.search(r"flips\s+(\d+) in 20 s, mean time between flips ([0-9.]+) s", result.stdout)
+    assert match, result.stdout
+    printed_count, printed_mean = int(match.group(1)), float(match.group(2))
+
+    # Independent count from the saved file: the intermediate principal axis of
+    # the saved inertia, and the samples where the rate about it changes sign.
+    saved = tumble.load(out)
+    _, vectors = np.linalg.eigh(saved.inertia)
+    rate = saved.omega @ vectors[:, 1]
+    changes = np.flatnonzero(np.diff(np.sign(rate)) != 0)
+    assert printed_count == changes.size
+    assert printed_count >= 5  # the T-handle turns over every ~3 s
+    # The mean interval between sign-change samples is within one sample spacing of the printed one.
+    spacing = saved.t[1] - saved.t[0]
+    assert abs(np.diff(saved.t[changes]).mean() - printed_mean) <= spacing
+    assert png.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_demo_racket_bad_duration_exits_2(tmp_path):
+    result = invoke("demo", "racket", "-o", tmp_path / "r.nc", "--plot", tmp_path / "r.png", "--duration", -1)
+    assert result.exit_code == 2
+    assert "--duration: must be a finite number > 0" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_info_prints_the_file_contents(tmp_path):
+    out = tmp_path / "box.nc"
+    assert invoke("run", EXAMPLES / "box_inertial_torque.toml", "-o", out).exit_code == 0
+    result = invoke("info", out)
+    assert result.exit_code == 0, result.output
+    moments = np.linalg.eigvalsh(tumble.load(out).inertia)
+    assert f"{moments[0]:.6g}, {moments[1]:.6g}, {moments[2]:.6g} kg m^2" in result.stdout
+    assert "0 to 20 s, 2001 samples" in result.stdout
+    assert "dop853 (rtol 1e-10, atol 1e-12)" in result.stdout
+    assert "torque = ConstantInertial([0.0, 0.002, 0.0])" in result.stdout
+
+
+def test_info_on_a_file_that_is_not_a_trajectory_exits_2(tmp_path):
+    junk = tmp_path / "junk.nc"
+    junk.write_text("not netcdf")
+    result = invoke("info", junk)
+    assert result.exit_code == 2
+    assert "junk.nc: not a readable tumble trajectory" in result.stderr
