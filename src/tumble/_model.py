@@ -1,46 +1,75 @@
 """The model protocol: what an integrator needs from the thing it integrates.
 
 A *model* is an immutable :class:`typing.NamedTuple` of NumPy arrays (its
-parameters, shared by the whole batch or one row per body). Its state is a
-flat float64 vector whose first four entries are the attitude quaternion
-(scalar first). A model type provides, through :func:`numba.extending.overload`
-of the two generic functions below, its right-hand side and its projection
-back onto the state manifold::
+parameters: one row shared by the whole batch, or one row per body). Its state
+is a flat float64 vector whose first four entries are the attitude quaternion
+(scalar first). Integrators hold states as structure-of-arrays *blocks*
+``Y[i, j]`` = component ``i`` of batch member ``b0 + j``, so that the loop
+over the lanes ``j`` compiles to SIMD instructions. A model type provides,
+through :func:`numba.extending.overload` of the three generic functions below,
+its right-hand side, its projection back onto the state manifold and its
+state size::
 
-    rhs(model, b, t, y, out)     # out = dy/dt for batch member b at (t, y)
-    project(model, y)            # e.g. normalise the quaternion y[0:4]
+    rhs(model, b0, t, Y, OUT)    # OUT[:, j] = dy/dt of batch member b0 + j at (t, Y[:, j])
+    project(model, Y)            # e.g. normalise the quaternion Y[0:4, j] of every lane
+
+where ``Y`` is a block (state × lanes) or the state vector of one body
+(``Y[i]``, batch member ``b0``); the overloads specialise on ``Y.ndim``.
+    state_size(model)            # length of the state vector, a compile-time constant
 
 The integrators call these generic functions; Numba picks the implementation
 from the model's type when it compiles the integrator, so each model gets its
 own fully inlined integrator, and the compiled code is cached on disk. (Passing
 functions as arguments instead would defeat the disk cache, and a run-time
 switch on a model code costs 2–3× in the inner loop.) Adding a model is one
-module: a NamedTuple, its two overloads, and a row in ``docs/architecture.md``.
+module: a NamedTuple, its three overloads, and a row in ``docs/architecture.md``.
 """
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
 
 
-def rhs(model, b, t, y, out):  # pragma: no cover - replaced by overloads in compiled code
-    """``out = dy/dt`` of batch member ``b`` of ``model`` at time ``t``, state ``y``."""
+def rhs(model, b0, t, Y, OUT):  # pragma: no cover - replaced by overloads in compiled code
+    """``OUT[:, j] = dy/dt`` of batch member ``b0 + j`` of ``model`` at time ``t``, state ``Y[:, j]``."""
     raise NotImplementedError(f"no compiled right-hand side for {type(model).__name__}")
 
 
-def project(model, y):  # pragma: no cover - replaced by overloads in compiled code
-    """Put the state ``y`` back onto its manifold after a step (in place)."""
+def project(model, Y):  # pragma: no cover - replaced by overloads in compiled code
+    """Put every lane ``Y[:, j]`` back onto the state manifold after a step (in place)."""
     raise NotImplementedError(f"no compiled projection for {type(model).__name__}")
+
+
+def state_size(model):  # pragma: no cover - replaced by overloads in compiled code
+    """Length of the state vector of ``model`` (a constant, so loops over it unroll)."""
+    raise NotImplementedError(f"no compiled state size for {type(model).__name__}")
+
+
+@njit(cache=True)
+def quaternion_scale(qw, qx, qy, qz):
+    """``1/|q|``: the factor that projects a quaternion back onto the unit sphere.
+
+    This is the projection every attitude model uses: the exact flow keeps
+    ``|q| = 1``; a Runge–Kutta step leaves it off by about the local error.
+    Projecting after every accepted step keeps it at 1 to rounding without
+    changing the order of the method.
+    """
+    return 1.0 / np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+
+
+@njit(cache=True)
+def normalize_quaternions(Y):
+    """Normalise the quaternion ``Y[0:4, j]`` of every lane of a block (state × lanes)."""
+    for j in range(Y.shape[1]):
+        s = quaternion_scale(Y[0, j], Y[1, j], Y[2, j], Y[3, j])
+        for i in range(4):
+            Y[i, j] *= s
 
 
 @njit(cache=True)
 def normalize_quaternion(y):
-    """Divide ``y[0:4]`` by its norm: the projection every attitude model uses.
-
-    The exact flow keeps ``|q| = 1``; a Runge–Kutta step leaves it off by about
-    the local error. Projecting after every accepted step keeps it at 1 to
-    rounding without changing the order of the method.
-    """
-    n = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3]) ** 0.5
+    """Normalise the quaternion ``y[0:4]`` of one state vector."""
+    s = quaternion_scale(y[0], y[1], y[2], y[3])
     for i in range(4):
-        y[i] /= n
+        y[i] *= s

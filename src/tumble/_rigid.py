@@ -23,6 +23,7 @@ from tumble.dynamics import euler_principal
 STATE_SIZE = 7
 
 
+
 class RigidModel(NamedTuple):
     """Compiled parameters of a batch of rigid bodies.
 
@@ -53,8 +54,8 @@ def _is_rigid(model):
     return isinstance(model, types.BaseNamedTuple) and model.instance_class is RigidModel
 
 
-@overload(_model.rhs, jit_options={"cache": True})
-def _rigid_rhs(model, b, t, y, out):
+@overload(_model.rhs, inline="always", jit_options={"cache": True})
+def _rigid_rhs(model, b0, t, Y, OUT):
     if not _is_rigid(model):
         return None
     if isinstance(model.types[2], types.NoneType):  # torque-free: no torque code at all
@@ -65,28 +66,63 @@ def _rigid_rhs(model, b, t, y, out):
     else:
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
-            p = model.params[b if model.params.shape[0] > 1 else 0]
-            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, p, model.codes)
+            row = b * (model.params.shape[0] > 1)
+            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, row, model.codes)
 
-    torque = njit(torque)
+    torque = njit(inline="always")(torque)
 
-    def impl(model, b, t, y, out):
-        m = model.moments[b if model.moments.shape[0] > 1 else 0]
-        qw, qx, qy, qz, w1, w2, w3 = y[0], y[1], y[2], y[3], y[4], y[5], y[6]
+    @njit(inline="always")  # IR-level inlining: LLVM alone leaves a call in the RK4 loop (+25 %)
+    def derivative(model, b, t, qw, qx, qy, qz, w1, w2, w3):
+        # scalar reads only: a row view would cost reference counting in the inner loop
+        m = model.moments
+        r = b * (m.shape[0] > 1)  # the shared row 0, or row b (no branch: keeps IR inlining simple)
         t1, t2, t3 = torque(model, b, t, qw, qx, qy, qz, w1, w2, w3)
         d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-        out[0], out[1], out[2], out[3] = 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3]
-        out[4], out[5], out[6] = euler_principal(m[0], m[1], m[2], w1, w2, w3, t1, t2, t3)
+        a1, a2, a3 = euler_principal(m[r, 0], m[r, 1], m[r, 2], w1, w2, w3, t1, t2, t3)
+        return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
+
+    if Y.ndim == 1:  # one body: the state vector itself
+
+        def impl(model, b0, t, Y, OUT):
+            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = derivative(
+                model, b0, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]
+            )
+
+    else:  # a block: state × lanes
+
+        def impl(model, b0, t, Y, OUT):
+            for j in range(Y.shape[1]):
+                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = derivative(
+                    model, b0 + j, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]
+                )
 
     return impl
 
 
-@overload(_model.project, jit_options={"cache": True})
-def _rigid_project(model, y):
+@overload(_model.project, inline="always", jit_options={"cache": True})
+def _rigid_project(model, Y):
     if not _is_rigid(model):
         return None
 
-    def impl(model, y):
-        _model.normalize_quaternion(y)
+    if Y.ndim == 1:
+
+        def impl(model, Y):
+            _model.normalize_quaternion(Y)
+
+    else:
+
+        def impl(model, Y):
+            _model.normalize_quaternions(Y)
+
+    return impl
+
+
+@overload(_model.state_size, jit_options={"cache": True})
+def _rigid_state_size(model):
+    if not _is_rigid(model):
+        return None
+
+    def impl(model):
+        return STATE_SIZE
 
     return impl

@@ -81,6 +81,8 @@ def simulate(
     omega0 = as_array(omega0, "omega0", tail=(3,))
     q0 = attitude.identity() if q0 is None else as_array(q0, "q0", tail=(4,))
     n = _batch_size(bodies, batch_inertia, omega0, q0)
+    if np.any(np.linalg.norm(q0, axis=-1) == 0.0):
+        raise ValidationError("q0: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
     q0 = attitude.normalize(np.broadcast_to(q0, (n or 1, 4)))
     omega0 = np.broadcast_to(omega0, (n or 1, 3))
     model = torques.as_torque_model(torque)

@@ -87,7 +87,7 @@ class TorqueModel:
             raise ValidationError("q, omega: evaluate a torque model one state at a time")
         codes, params = compile_program(self, np.eye(3), offset=0)
         with registered(self):
-            tau = evaluate(float(t), *q, *omega, params, codes)
+            tau = evaluate(float(t), *q, *omega, params[None, :], 0, codes)
         return np.array(tau)
 
 
@@ -256,11 +256,11 @@ def _call_python(slot, t, q, omega, out):
 
 
 @njit(cache=True)
-def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, p, o):
+def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o):
     """Call a PythonTorque: convert the principal-axes state to body axes and back."""
-    slot = int(p[o])
-    r = p[o + 1 : o + 10]  # R_BP, row-major
-    qb = _quat.qmul(qw, qx, qy, qz, p[o + 10], -p[o + 11], -p[o + 12], -p[o + 13])
+    slot = int(P[row, o])
+    r = P[row, o + 1 : o + 10]  # R_BP, row-major
+    qb = _quat.qmul(qw, qx, qy, qz, P[row, o + 10], -P[row, o + 11], -P[row, o + 12], -P[row, o + 13])
     q_body = np.array(qb)
     omega_body = np.array(
         (
@@ -280,53 +280,58 @@ def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, p, o):
 
 
 @njit(cache=True)
-def _tabulated(t, p, o):
-    """Interpolate a Tabulated block at ``t`` (index arithmetic only: no array views in the hot loop)."""
-    n = int(p[o])
-    t0 = o + 3  # times at p[t0 : t0 + n], values (n, 3) row-major after them
+def _tabulated(t, P, row, o):
+    """Interpolate a Tabulated block at ``t`` (scalar reads only: no array views in the hot loop)."""
+    n = int(P[row, o])
+    t0 = o + 3  # times at P[row, t0 : t0 + n], values (n, 3) row-major after them
     v0 = t0 + n
-    if t <= p[t0]:
+    if t <= P[row, t0]:
         k, f = 0, 0.0
-    elif t >= p[t0 + n - 1]:
+    elif t >= P[row, t0 + n - 1]:
         k, f = n - 1, 0.0
     else:
-        lo, hi = 0, n - 1  # invariant: p[t0 + lo] <= t < p[t0 + hi]
+        lo, hi = 0, n - 1  # invariant: times[lo] <= t < times[hi]
         while hi - lo > 1:
             mid = (lo + hi) // 2
-            if p[t0 + mid] <= t:
+            if P[row, t0 + mid] <= t:
                 lo = mid
             else:
                 hi = mid
         k = lo
-        f = 0.0 if p[o + 2] != 0.0 else (t - p[t0 + k]) / (p[t0 + k + 1] - p[t0 + k])
+        f = 0.0 if P[row, o + 2] != 0.0 else (t - P[row, t0 + k]) / (P[row, t0 + k + 1] - P[row, t0 + k])
     i = v0 + 3 * k
-    a, b, c = p[i], p[i + 1], p[i + 2]
+    a, b, c = P[row, i], P[row, i + 1], P[row, i + 2]
     if f != 0.0:
-        a += f * (p[i + 3] - a)
-        b += f * (p[i + 4] - b)
-        c += f * (p[i + 5] - c)
+        a += f * (P[row, i + 3] - a)
+        b += f * (P[row, i + 4] - b)
+        c += f * (P[row, i + 5] - c)
     return a, b, c
 
 
 @njit(cache=True)
-def evaluate(t, qw, qx, qy, qz, w1, w2, w3, p, codes):
-    """Run a torque program: the torque (N·m) in the axes the program was compiled for.
+def evaluate(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
 
-    ``q`` maps those axes to inertial axes, ``omega`` is expressed in them.
+    ``q`` (normalised here) maps those axes to inertial axes, ``omega`` is
+    expressed in them.
     """
+    # Runge–Kutta stage states are off the unit sphere by about the local error:
+    # rotate by q/|q| so that the torque does not depend on the body axes chosen.
+    s = 1.0 / np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    qw, qx, qy, qz = qw * s, qx * s, qy * s, qz * s
     t1 = t2 = t3 = 0.0
     for k in range(0, codes.shape[0], 2):
         code, o = codes[k], codes[k + 1]
         if code == _CONST_BODY:
-            a, b, c = p[o], p[o + 1], p[o + 2]
+            a, b, c = P[row, o], P[row, o + 1], P[row, o + 2]
         elif code == _CONST_INERTIAL:
-            a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, p[o], p[o + 1], p[o + 2])
+            a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o], P[row, o + 1], P[row, o + 2])
         elif code == _TABULATED:
-            a, b, c = _tabulated(t, p, o)
-            if p[o + 1] != 0.0:
+            a, b, c = _tabulated(t, P, row, o)
+            if P[row, o + 1] != 0.0:
                 a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, a, b, c)
         else:
-            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, p, o)
+            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o)
         t1 += a
         t2 += b
         t3 += c

@@ -104,10 +104,13 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
 
 
 def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, serial):
+    # One body, or a model that calls back into Python: no parallel region
+    # (its start-up costs more than a short run, and callbacks need the GIL).
+    serial = serial or y.shape[0] == 1
     if method == "rk4":
         if serial:
-            for b in range(y.shape[0]):
-                stats[b, 0] += _rk4.rk4_path(model, b, y[b], t, dt, out[:, b])
+            for k in range(-(-y.shape[0] // _rk4.LANES)):
+                _rk4.rk4_run_block(model, k, y, t, dt, out, stats)
         else:
             _rk4.rk4_batch(model, y, t, dt, out, stats)
         stats[:, 2] = 4 * stats[:, 0]

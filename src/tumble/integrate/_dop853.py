@@ -21,7 +21,7 @@ import numpy as np
 from numba import njit, prange
 from scipy.integrate._ivp import dop853_coefficients as _coef
 
-from tumble._model import project, rhs
+from tumble._model import project, rhs, state_size
 
 ORDER = 8
 _STAGES = _coef.N_STAGES  # 12
@@ -42,12 +42,12 @@ OK, STEP_TOO_SMALL, TOO_MANY_STEPS = 0, 1, 2
 
 @njit(cache=True)
 def _rms(v):
-    return math.sqrt(np.sum(v * v) / v.shape[0])
+    return math.sqrt(np.sum(v * v) / v.size)
 
 
 @njit(cache=True)
 def initial_step(model, b, t, y, f0, rtol, atol, span):
-    """Hairer's starting step (HNW I, §II.4): based on ‖y‖, ‖f‖ and a difference estimate of ‖f'‖."""
+    """Hairer's starting step (HNW I, §II.4): from ‖y‖, ‖f‖ and a difference estimate of ‖f'‖."""
     scale = atol + np.abs(y) * rtol
     d0, d1 = _rms(y / scale), _rms(f0 / scale)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
@@ -64,13 +64,13 @@ def initial_step(model, b, t, y, f0, rtol, atol, span):
 
 @njit(cache=True)
 def dop853_path(model, b, y, t_out, rtol, atol, max_steps, out, stats):
-    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[j]`` = state at ``t_out[j]``.
+    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[k]`` = state at ``t_out[k]``.
 
     ``stats`` = [steps, rejected steps, evaluations, status, next step size]:
     the step size is carried in and out, so a run split in chunks continues
     exactly as one run would (0 on entry means "choose a starting step").
     """
-    n = y.shape[0]
+    n = state_size(model)
     K = np.empty((_STAGES + 1, n))
     y_new, tmp = np.empty(n), np.empty(n)
     out[0, :] = y
@@ -81,25 +81,25 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, out, stats):
     if h <= 0.0 and t_out.shape[0] > 1:
         h = initial_step(model, b, t, y, K[0], rtol, atol, t_out[-1] - t)
         stats[2] += 1
-    j = 1
+    k = 1
     rejected_last = False
-    while j < t_out.shape[0]:
-        target = t_out[j]
+    while k < t_out.shape[0]:
+        target = t_out[k]
         # land on the output time when the proposed step reaches it or nearly (1 %)
         landing = t + 1.01 * h >= target
         step = target - t if landing else h
         for s in range(1, _STAGES):
-            for i in range(n):
-                acc = 0.0
-                for r in range(s):
-                    acc += A[s, r] * K[r, i]
-                tmp[i] = y[i] + step * acc
+            tmp[:] = y
+            for r in range(s):
+                a = step * A[s, r]
+                for i in range(n):
+                    tmp[i] += a * K[r, i]
             rhs(model, b, t + C[s] * step, tmp, K[s])
-        for i in range(n):
-            acc = 0.0
-            for r in range(_STAGES):
-                acc += B[r] * K[r, i]
-            y_new[i] = y[i] + step * acc
+        y_new[:] = y
+        for r in range(_STAGES):
+            a = step * B[r]
+            for i in range(n):
+                y_new[i] += a * K[r, i]
         rhs(model, b, t + step, y_new, K[_STAGES])
         stats[2] += _STAGES
         # Error norm (HNW I, eq. 10.17 as in scipy's DOP853).
@@ -125,21 +125,21 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, out, stats):
             t = target if landing else t + step
             y[:] = y_new
             project(model, y)
-            K[0, :] = K[_STAGES]
+            K[0] = K[_STAGES]
             rejected_last = False
             if landing:
-                out[j, :] = y
-                j += 1
+                out[k, :] = y
+                k += 1
         else:
             stats[1] += 1
             h = step * max(MIN_FACTOR, SAFETY * err**_EXPONENT)
             rejected_last = True
             if h < 10.0 * np.finfo(np.float64).eps * max(abs(t), 1.0):
                 stats[3] = STEP_TOO_SMALL
-                return
+                break
         if stats[0] >= max_steps:
             stats[3] = TOO_MANY_STEPS
-            return
+            break
     stats[4] = h
 
 

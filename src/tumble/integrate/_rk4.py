@@ -19,50 +19,73 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from tumble._model import project, rhs
+from tumble._model import project, rhs, state_size
 
 ORDER = 4
 
+#: Bodies advanced together in one structure-of-arrays block (SIMD lanes × unrolling).
+LANES = 64
+
 
 @njit(cache=True)
-def rk4_path(model, b, y, t_out, dt, out):
-    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[j]`` = state at ``t_out[j]``.
+def rk4_block(model, b0, Y, t_out, dt, out):
+    """Advance ``Y`` (in place) through ``t_out``: a block (state × lanes) of bodies ``b0, b0+1, …``,
+    or the state vector of body ``b0``.
 
-    Returns the number of steps taken.
+    ``out[k]`` receives ``Y.T`` at ``t_out[k]``. Returns the number of steps taken.
     """
-    n = y.shape[0]
-    k1, k2, k3, k4, tmp = np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    out[0, :] = y
+    k1, k2, k3, k4, tmp = np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y)
+    # flat views: each stage update is one loop over state × lanes (contiguous, vectorised)
+    y_, k1_, k2_, k3_, k4_, tmp_ = Y.ravel(), k1.ravel(), k2.ravel(), k3.ravel(), k4.ravel(), tmp.ravel()
+    # a compile-time constant for one body, so LLVM unrolls the stage loops
+    size = state_size(model) if Y.ndim == 1 else Y.size
+    out[0] = Y.T
     steps = 0
-    for j in range(1, t_out.shape[0]):
-        t0 = t_out[j - 1]
-        span = t_out[j] - t0
+    for k in range(1, t_out.shape[0]):
+        t0 = t_out[k - 1]
+        span = t_out[k] - t0
         m = max(1, int(math.ceil(span / dt - 1e-9)))
         h = span / m
         for s in range(m):
             t = t0 + s * h
-            rhs(model, b, t, y, k1)
-            for i in range(n):
-                tmp[i] = y[i] + 0.5 * h * k1[i]
-            rhs(model, b, t + 0.5 * h, tmp, k2)
-            for i in range(n):
-                tmp[i] = y[i] + 0.5 * h * k2[i]
-            rhs(model, b, t + 0.5 * h, tmp, k3)
-            for i in range(n):
-                tmp[i] = y[i] + h * k3[i]
-            rhs(model, b, t + h, tmp, k4)
-            for i in range(n):
-                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            project(model, y)
+            rhs(model, b0, t, Y, k1)
+            for i in range(size):
+                tmp_[i] = y_[i] + 0.5 * h * k1_[i]
+            rhs(model, b0, t + 0.5 * h, tmp, k2)
+            for i in range(size):
+                tmp_[i] = y_[i] + 0.5 * h * k2_[i]
+            rhs(model, b0, t + 0.5 * h, tmp, k3)
+            for i in range(size):
+                tmp_[i] = y_[i] + h * k3_[i]
+            rhs(model, b0, t + h, tmp, k4)
+            for i in range(size):
+                y_[i] += h / 6.0 * (k1_[i] + 2.0 * k2_[i] + 2.0 * k3_[i] + k4_[i])
+            project(model, Y)
         steps += m
-        out[j, :] = y
+        out[k] = Y.T
     return steps
+
+
+@njit(cache=True)
+def rk4_run_block(model, k, y, t_out, dt, out, stats):
+    """Integrate block ``k`` (bodies ``k·LANES …``) of the batch ``y`` (bodies × state, updated in place)."""
+    b0 = k * LANES
+    b1 = min(y.shape[0], b0 + LANES)
+    if b1 - b0 == 1:  # a lone body runs on its state vector (no lane loops)
+        steps = rk4_block(model, b0, y[b0], t_out, dt, out[:, b0])
+    else:
+        Y = np.ascontiguousarray(y[b0:b1].T)
+        steps = rk4_block(model, b0, Y, t_out, dt, out[:, b0:b1])
+        y[b0:b1] = Y.T
+    for b in range(b0, b1):
+        stats[b, 0] += steps
 
 
 @njit(cache=True, parallel=True)
 def rk4_batch(model, y, t_out, dt, out, stats):
-    """Integrate the bodies ``y[b]`` in parallel; ``out[:, b]`` receives body ``b``'s path
-    and ``stats[b, 0]`` its number of steps."""
-    for i in prange(y.shape[0]):
-        b = np.int64(i)  # prange indices may be unsigned
-        stats[b, 0] += rk4_path(model, b, y[b], t_out, dt, out[:, b, :])
+    """Integrate the bodies ``y[b]`` (updated in place), blocks in parallel over the cores.
+
+    ``out[:, b]`` receives body ``b``'s path and ``stats[b, 0]`` its number of steps.
+    """
+    for k in prange((y.shape[0] + LANES - 1) // LANES):
+        rk4_run_block(model, np.int64(k), y, t_out, dt, out, stats)
