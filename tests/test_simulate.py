@@ -6,7 +6,7 @@ import pytest
 import tumble
 from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError
-from tumble.integrate import SolverError
+from tumble.integrate import SolverError, _rk4
 
 EPS = np.finfo(np.float64).eps
 
@@ -71,7 +71,7 @@ def rodrigues(axis, angle):
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
-# -- 1. torque-free invariants -----------------------------------------------------------------
+# -- torque-free invariants -----------------------------------------------------------------
 
 
 @pytest.mark.parametrize("inertia", [DIAG, FULL], ids=["diagonal", "full"])
@@ -86,7 +86,7 @@ def test_torque_free_motion_conserves_energy_and_momentum(inertia):
     assert np.linalg.norm(momentum - momentum[0], axis=-1).max() / norm[0] <= TOL_CONSERVATION
 
 
-# -- 2. sphere and symmetric top against closed forms --------------------------------------------
+# -- sphere and symmetric top against closed forms --------------------------------------------
 
 
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
@@ -125,7 +125,7 @@ def test_symmetric_top_matches_the_closed_form(i3):
     assert np.abs(attitude.to_matrix(traj.q) - expected).max() <= TOL_CLOSED_FORM
 
 
-# -- 4. convergence ---------------------------------------------------------------------------
+# -- convergence ---------------------------------------------------------------------------
 
 
 def sine_torque(t, q, omega):
@@ -163,7 +163,7 @@ def test_dop853_error_follows_the_tolerance(torque):
     assert tight <= TOL_DOP853_AT_1E12
 
 
-# -- 5. frame invariance ----------------------------------------------------------------------
+# -- frame invariance ----------------------------------------------------------------------
 
 
 def rotated_runs(inertia, rotation, torque, torque_rotated, **kwargs):
@@ -219,7 +219,7 @@ def test_rk4_motion_does_not_depend_on_the_body_axes_to_rounding(kind, random_ro
     assert frame_difference(FULL, rotation, first, second) <= TOL_FRAME_RK4
 
 
-# -- 6. batches -------------------------------------------------------------------------------
+# -- batches -------------------------------------------------------------------------------
 
 
 def random_batch(n, seed=5):
@@ -256,6 +256,21 @@ def test_batch_equals_single_runs(method, torque):
         assert np.abs(state(batch)[:, k] - state(single)).max() <= TOL_BATCH
 
 
+@pytest.mark.parametrize("extra", [1, 3], ids=["lone body in the last block", "partial last block"])
+@pytest.mark.parametrize("torque", ["torque-free", "ConstantInertial + Tabulated"])
+def test_rk4_batch_across_blocks_equals_single_runs(torque, extra):
+    # rk4 advances up to LANES bodies together (structure of arrays); a batch of
+    # LANES + extra bodies has a full block and a short one (a lone body takes
+    # the one-body path).
+    n = _rk4.LANES + extra
+    inertia, omega0, q0 = random_batch(n)
+    kwargs = dict(t=np.linspace(0.0, 1.0, 3), method="rk4", dt=1e-2, torque=BATCH_TORQUES[torque])
+    batch = tumble.simulate(inertia, omega0, q0=q0, **kwargs)
+    for k in range(n):
+        single = tumble.simulate(tumble.RigidBody(inertia[k]), omega0[k], q0=q0[k], **kwargs)
+        assert np.abs(state(batch)[:, k] - state(single)).max() <= TOL_BATCH
+
+
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
 def test_batch_of_one_body_broadcasts_omega0_or_q0(method):
     n = 5
@@ -271,7 +286,7 @@ def test_batch_of_one_body_broadcasts_omega0_or_q0(method):
         assert np.abs(state(by_attitude)[:, k] - state(single)).max() <= TOL_BATCH
 
 
-# -- 7. output times --------------------------------------------------------------------------
+# -- output times --------------------------------------------------------------------------
 
 
 def spin_up(**kwargs):
@@ -332,7 +347,7 @@ def test_progress_reports_and_does_not_change_the_result(method):
     assert np.abs(state(loud) - state(quiet)).max() <= TOL_CHUNKED
 
 
-# -- 10. bad input ----------------------------------------------------------------------------
+# -- bad input ----------------------------------------------------------------------------
 
 
 @pytest.mark.parametrize(
@@ -404,7 +419,7 @@ def test_exhausted_max_steps_is_a_solver_error():
         tumble.simulate(tumble.RigidBody(DIAG), OMEGA0, t=[0.0, 100.0], max_steps=10)
 
 
-# -- 12. unit quaternion ----------------------------------------------------------------------
+# -- unit quaternion ----------------------------------------------------------------------
 
 
 @pytest.mark.parametrize("method", ["rk4", "dop853"])

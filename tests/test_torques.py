@@ -287,27 +287,44 @@ def test_tabulated_equals_the_same_interpolation_in_python(method, interpolation
     assert max_diff(compiled, python) <= tol
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="BUG: a zero-order-hold Tabulated is evaluated at the jump time itself by the last stage "
-    "of a step that lands on the jump (rk4 k4, dop853 stage 12), which sees the post-jump value: "
-    "landing on the jumps does not restore accuracy (rk4 error h*jump/6 per jump, first order)",
-)
-def test_zero_order_hold_with_steps_landing_on_the_jumps_is_exact():
-    # Spin about principal axis 3 under a piecewise-constant torque about it: ω₃ is
-    # piecewise linear, so rk4 steps that land on the jumps (the docstring's advice)
-    # should give it exactly; here every jump adds an error h Δτ / (6 I₃).
+def _spin_under_table(interpolation, dt):
+    """ω₃(t) of a body spinning about principal axis 3 under a tabulated torque about it (rk4)."""
     t_table = np.array([0.0, 1.0, 2.0, 3.0])
     tau_table = np.zeros((4, 3))
     tau_table[:, 2] = [0.5, -0.3, 0.8, 0.2]
-    t = np.linspace(0.0, 4.0, 9)  # holds the jumps; rk4 steps land on them
-    traj = tumble.simulate(tumble.RigidBody(DIAG), [0.0, 0.0, 1.0], t=t, method="rk4", dt=0.05,
-                           torque=torques.Tabulated(t_table, tau_table, interpolation="previous"))
-    # ∫₀ᵗ τ₃ ds for the zero-order hold (t_table[0] = 0 is the start of the run).
-    segment = np.clip(np.searchsorted(t_table, t, side="right") - 1, 0, 3)
-    area = np.concatenate([[0.0], np.cumsum(np.diff(t_table) * tau_table[:-1, 2])])
-    expected = 1.0 + (area[segment] + (t - t_table[segment]) * tau_table[segment, 2]) / 3.0
-    assert np.abs(traj.omega[:, 2] - expected).max() <= TOL_LINEAR_RATE
+    t = np.linspace(0.0, 4.0, 9)  # holds the sample times: rk4 steps land on them
+    traj = tumble.simulate(tumble.RigidBody(DIAG), [0.0, 0.0, 1.0], t=t, method="rk4", dt=dt,
+                           torque=torques.Tabulated(t_table, tau_table, interpolation=interpolation))
+    return t, t_table, tau_table[:, 2], traj.omega[:, 2]
+
+
+def test_linear_table_with_steps_landing_on_the_samples_is_exact():
+    # ω₃' = τ₃(t)/I₃ with τ₃ piecewise linear: ω₃ is piecewise quadratic, which RK4
+    # integrates exactly on steps that do not straddle a sample time (torques.md).
+    t, t_table, tau3, omega3 = _spin_under_table("linear", 0.05)
+    tau_t = np.interp(t, t_table, tau3)
+    seg = np.clip(np.searchsorted(t_table, t, side="right") - 1, 0, 2)
+    # ∫ of the piecewise-linear τ₃ from 0 to t (trapezoids of whole segments + the part segment)
+    whole = np.concatenate([[0.0], np.cumsum(np.diff(t_table) * (tau3[:-1] + tau3[1:]) / 2)])
+    inside = np.where(t <= t_table[-1], (t - t_table[seg]) * (np.interp(t_table[seg], t_table, tau3) + tau_t) / 2,
+                      0.0)
+    held = np.where(t > t_table[-1], (t - t_table[-1]) * tau3[-1], 0.0)
+    area = np.where(t > t_table[-1], whole[-1] + held, whole[seg] + inside)
+    assert np.abs(omega3 - (1.0 + area / 3.0)).max() <= TOL_LINEAR_RATE
+
+
+def test_zero_order_hold_costs_the_documented_first_order_error_per_jump():
+    # torques.md: a step that ends on a jump Δτ sees the new value in its last RK4
+    # stage, so ω₃ = L₃/I₃ picks up h Δτ / (6 I₃) per jump. Check the law exactly
+    # (it is what a user is told to expect) and that it halves with h.
+    for dt in (0.05, 0.025):
+        t, t_table, tau3, omega3 = _spin_under_table("previous", dt)
+        seg = np.clip(np.searchsorted(t_table, t, side="right") - 1, 0, 3)
+        area = np.concatenate([[0.0], np.cumsum(np.diff(t_table) * tau3[:-1])])
+        exact = 1.0 + (area[seg] + (t - t_table[seg]) * tau3[seg]) / 3.0
+        jumps_before = np.array([np.sum(np.diff(tau3)[t_table[1:] <= tk]) for tk in t])
+        predicted = dt * jumps_before / (6.0 * 3.0)
+        assert np.abs((omega3 - exact) - predicted).max() <= TOL_LINEAR_RATE
 
 
 def test_sum_in_simulate_equals_the_summed_callable():
