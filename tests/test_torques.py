@@ -336,3 +336,59 @@ def test_sum_in_simulate_equals_the_summed_callable():
     python = tumble.simulate(body, OMEGA0, torque=lambda t, q, w: a.torque + attitude.rotate_inverse(q, TAU),
                              **kwargs)
     assert max_diff(summed, python) <= TOL_SAME_TORQUE
+
+
+# --- Gravity and FunctionOfTime ----------------------------------------------
+
+TOL_GRAVITY = 1e-13  # a cross product and one rotation of O(10) numbers: rounding only
+
+
+def test_gravity_torque_is_r_cross_m_g_in_body_axes():
+    rng = np.random.default_rng(7)
+    mass, com, g = 1.7, np.array([0.02, -0.01, 0.12]), np.array([0.0, 0.0, -9.81])
+    model = torques.Gravity(mass, com, g)
+    for _ in range(5):
+        q = attitude.normalize(rng.standard_normal(4))
+        expected = np.cross(com, mass * attitude.rotate_inverse(q, g))
+        assert np.abs(model(0.3, q, [0.1, 0.2, 0.3]) - expected).max() <= TOL_GRAVITY
+
+
+def test_gravity_heavy_top_conserves_energy_and_vertical_momentum():
+    # A symmetric top on a pivot: E = T + m g·(R r) and L_z (inertial, along g) are conserved.
+    mass, length = 1.0, 0.1
+    com = np.array([0.0, 0.0, length])
+    inertia = np.diag([0.01, 0.01, 0.004]) + mass * (length**2) * np.diag([1.0, 1.0, 0.0])  # about the pivot
+    q0 = attitude.from_rotvec([0.3, 0.0, 0.0])
+    t = np.linspace(0.0, 5.0, 51)
+    traj = tumble.simulate(inertia, [0.0, 0.0, 60.0], q0=q0, t=t, rtol=1e-12, atol=1e-12,
+                           torque=torques.Gravity(mass, com, (0.0, 0.0, -9.81)))
+    height = attitude.rotate(traj.q, com)[:, 2]
+    energy = traj.energy + mass * 9.81 * height
+    lz = traj.momentum_inertial[:, 2]
+    assert np.abs(energy - energy[0]).max() <= 1e-10 * abs(energy[0])  # DOP853 at 1e-12 over 5 s
+    assert np.abs(lz - lz[0]).max() <= 1e-10 * abs(lz[0])
+
+
+def test_function_of_time_in_body_and_inertial_axes():
+    q = attitude.from_rotvec([0.0, np.pi / 2, 0.0])
+    body = torques.FunctionOfTime(lambda t: [t, 0.0, 0.0])
+    inertial = torques.FunctionOfTime(lambda t: [0.0, 0.0, 2.0 * t], frame="inertial")
+    assert np.abs(body(1.5, q, [0, 0, 0]) - [1.5, 0.0, 0.0]).max() == 0.0
+    assert np.abs(inertial(1.5, q, [0, 0, 0]) - attitude.rotate_inverse(q, [0.0, 0.0, 3.0])).max() <= TOL_GRAVITY
+
+
+@pytest.mark.parametrize("bad, field", [
+    (dict(mass=-1.0, com=[0, 0, 1]), "mass"),
+    (dict(mass=1.0, com=[0, 1]), "com"),
+    (dict(mass=1.0, com=[0, 0, 1], g=[0, np.nan, 0]), "g"),
+])
+def test_gravity_refuses_bad_input(bad, field):
+    with pytest.raises(tumble.ValidationError, match=field):
+        torques.Gravity(**bad)
+
+
+def test_function_of_time_refuses_bad_input():
+    with pytest.raises(tumble.ValidationError, match="function"):
+        torques.FunctionOfTime(3.0)
+    with pytest.raises(tumble.ValidationError, match="frame"):
+        torques.FunctionOfTime(np.sin, frame="lvlh")

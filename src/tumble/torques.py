@@ -14,6 +14,8 @@ Models add with ``+``. The built-in models run compiled inside the integrators
 ``ConstantInertial(τ)`` ``τ_B = R(q)ᵀ τ_N``: fixed in inertial space
 ``Tabulated(t, τ)``     samples of ``τ(t)`` (body or inertial axes), linear or
                         zero-order-hold interpolation, end values held
+``Gravity(m, r, g)``    uniform gravity on a body pivoting about a fixed point:
+                        ``τ_B = r_B × m R(q)ᵀ g_N`` (heavy top)
 =====================  ==========================================================
 
 Any Python callable ``f(t, q, omega) -> torque`` (body axes) is accepted too,
@@ -36,13 +38,16 @@ import numpy as np
 from numba import njit, objmode
 
 from tumble import _quat
-from tumble._validate import ValidationError, as_array
+from tumble._validate import ValidationError, as_array, require_positive
+from tumble.attitude import rotate_inverse
 
 __all__ = [
     "TorqueModel",
     "ConstantBody",
     "ConstantInertial",
     "Tabulated",
+    "Gravity",
+    "FunctionOfTime",
     "PythonTorque",
     "as_torque_model",
 ]
@@ -51,6 +56,7 @@ __all__ = [
 _CONST_BODY = 1
 _CONST_INERTIAL = 2
 _TABULATED = 3
+_GRAVITY = 4
 _PYTHON = 9
 
 
@@ -174,6 +180,30 @@ class Tabulated(TorqueModel):
         return f"Tabulated({self.t.size} samples, frame={self.frame!r}, interpolation={self.interpolation!r})"
 
 
+class Gravity(TorqueModel):
+    """Uniform gravity on a body that pivots about a fixed point (a heavy top).
+
+    ``τ_B = r_B × (m R(q)ᵀ g_N)``: ``mass`` (kg), ``com`` the centre of mass
+    relative to the pivot in body axes (m), ``g`` the gravitational
+    acceleration in inertial axes (m/s², default ``(0, 0, -9.80665)``).
+    Simulate such a body with its inertia *about the pivot*
+    (``RigidBody.inertia_about(pivot)``), since the pivot is the fixed point.
+    """
+
+    def __init__(self, mass, com, g=(0.0, 0.0, -9.80665)):
+        self.mass = require_positive(mass, "mass")
+        self.com = as_array(com, "com", tail=(3,))
+        self.g = as_array(g, "g", tail=(3,))
+        if self.com.ndim != 1 or self.g.ndim != 1:
+            raise ValidationError("com, g: must have shape (3,)")
+
+    def _params(self, axes):
+        return _GRAVITY, np.concatenate([axes.T @ (self.mass * self.com), self.g])
+
+    def __repr__(self):
+        return f"Gravity(mass={self.mass}, com={self.com.tolist()}, g={self.g.tolist()})"
+
+
 class PythonTorque(TorqueModel):
     """Any Python callable ``f(t, q, omega) -> torque`` (body axes, N·m).
 
@@ -197,6 +227,30 @@ class PythonTorque(TorqueModel):
 
     def __repr__(self):
         return f"PythonTorque({getattr(self.function, '__name__', self.function)!r})"
+
+
+class FunctionOfTime(PythonTorque):
+    """A torque given by a Python function of time only, ``f(t) -> (3,)`` (N·m).
+
+    ``frame="body"`` (default) or ``"inertial"`` says in which axes ``f``
+    returns it. Runs at Python speed; tabulate it (:class:`Tabulated`) for
+    compiled speed.
+    """
+
+    def __init__(self, function, *, frame: str = "body"):
+        if not callable(function):
+            raise ValidationError(f"function: must be callable f(t) -> torque, got {function!r}")
+        if frame not in ("body", "inertial"):
+            raise ValidationError(f"frame: must be 'body' or 'inertial', got {frame!r}")
+        self.time_function, self.frame = function, frame
+        if frame == "body":
+            super().__init__(lambda t, q, omega: function(t))
+        else:
+            super().__init__(lambda t, q, omega: rotate_inverse(q, np.asarray(function(t), dtype=np.float64)))
+        self.function.__name__ = getattr(function, "__name__", "f")
+
+    def __repr__(self):
+        return f"FunctionOfTime({getattr(self.time_function, '__name__', self.time_function)!r}, frame={self.frame!r})"
 
 
 def as_torque_model(torque) -> TorqueModel | None:
@@ -330,6 +384,11 @@ def evaluate(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
             a, b, c = _tabulated(t, P, row, o)
             if P[row, o + 1] != 0.0:
                 a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, a, b, c)
+        elif code == _GRAVITY:
+            # τ = (m r) × g_body with g_body = R(q)ᵀ g_N
+            gx, gy, gz = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o + 3], P[row, o + 4], P[row, o + 5])
+            rx, ry, rz = P[row, o], P[row, o + 1], P[row, o + 2]
+            a, b, c = ry * gz - rz * gy, rz * gx - rx * gz, rx * gy - ry * gx
         else:
             a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o)
         t1 += a
