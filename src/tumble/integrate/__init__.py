@@ -116,9 +116,9 @@ def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, se
         stats[:, 2] = 4 * stats[:, 0]
     elif serial:
         for b in range(y.shape[0]):
-            _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, out[:, b], stats[b])
+            _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, _dop853.tableau(), out[:, b], stats[b])
     else:
-        _dop853.dop853_batch(model, y, t, rtol, atol, max_steps, out, stats)
+        _dop853.dop853_batch(model, y, t, rtol, atol, max_steps, _dop853.tableau(), out, stats)
 
 
 def _raise_on_failure(stats, t):

@@ -16,20 +16,35 @@ accepted step.
 from __future__ import annotations
 
 import math
+from functools import cache
 
 import numpy as np
 from numba import njit, prange
-from scipy.integrate._ivp import dop853_coefficients as _coef
 
 from tumble._model import project, rhs, state_size
 
 ORDER = 8
-_STAGES = _coef.N_STAGES  # 12
-A = np.ascontiguousarray(_coef.A[:_STAGES, :_STAGES])
-B = np.ascontiguousarray(_coef.B)
-C = np.ascontiguousarray(_coef.C[:_STAGES])
-E3 = np.ascontiguousarray(_coef.E3)
-E5 = np.ascontiguousarray(_coef.E5)
+_STAGES = 12
+
+
+@cache
+def tableau():
+    """The DOP853 coefficients ``(A, B, C, E3, E5)``, read from SciPy on first use.
+
+    (Importing ``scipy.integrate`` costs half a second, so it is not done at
+    ``import tumble``.)
+    """
+    from scipy.integrate._ivp import dop853_coefficients as coef
+
+    assert coef.N_STAGES == _STAGES
+    return (
+        np.ascontiguousarray(coef.A[:_STAGES, :_STAGES]),
+        np.ascontiguousarray(coef.B),
+        np.ascontiguousarray(coef.C[:_STAGES]),
+        np.ascontiguousarray(coef.E3),
+        np.ascontiguousarray(coef.E5),
+    )
+
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -63,13 +78,15 @@ def initial_step(model, b, t, y, f0, rtol, atol, span):
 
 
 @njit(cache=True)
-def dop853_path(model, b, y, t_out, rtol, atol, max_steps, out, stats):
+def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
     """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[k]`` = state at ``t_out[k]``.
 
+    ``tab`` is :func:`tableau`.
     ``stats`` = [steps, rejected steps, evaluations, status, next step size]:
     the step size is carried in and out, so a run split in chunks continues
     exactly as one run would (0 on entry means "choose a starting step").
     """
+    A, B, C, E3, E5 = tab
     n = state_size(model)
     K = np.empty((_STAGES + 1, n))
     y_new, tmp = np.empty(n), np.empty(n)
@@ -144,10 +161,10 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, out, stats):
 
 
 @njit(cache=True, parallel=True)
-def dop853_batch(model, y, t_out, rtol, atol, max_steps, out, stats):
+def dop853_batch(model, y, t_out, rtol, atol, max_steps, tab, out, stats):
     """Integrate the bodies ``y[b]`` in parallel, each with its own step sizes;
     ``stats[b]`` is body ``b``'s statistics row (see :func:`dop853_path`)."""
     for i in prange(y.shape[0]):
         b = np.int64(i)  # prange indices may be unsigned
         if stats[b, 3] == OK:
-            dop853_path(model, b, y[b], t_out, rtol, atol, max_steps, out[:, b, :], stats[b])
+            dop853_path(model, b, y[b], t_out, rtol, atol, max_steps, tab, out[:, b, :], stats[b])

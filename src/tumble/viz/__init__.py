@@ -1,0 +1,1 @@
+"""Figures (matplotlib) that explain the motion."""
