@@ -73,7 +73,7 @@ def numpy_rk4(y, dt, steps):
 
 
 def single_body_rk4(steps):
-    model = _rigid.RigidModel(MOMENTS[None, :], np.zeros((1, 0)), None)
+    model = _rigid.build([tumble.RigidBody(np.diag(MOMENTS))], None)
     y = np.concatenate([Q0, OMEGA0])[None, :]
     t = np.array([0.0, steps * 1e-3])
     out, stats = np.empty((2, 1, 7)), np.zeros((1, 5))

@@ -18,7 +18,7 @@ from numba import njit, types
 from numba.extending import overload
 
 from tumble import _model, _quat, torques
-from tumble.dynamics import euler_principal
+from tumble.dynamics import euler_coefficients, euler_principal
 
 STATE_SIZE = 7
 
@@ -27,12 +27,13 @@ STATE_SIZE = 7
 class RigidModel(NamedTuple):
     """Compiled parameters of a batch of rigid bodies.
 
-    moments : (N or 1, 3) principal moments, kg·m² (one row shared by all bodies, or one per body)
+    coefficients : (N or 1, 6) Euler coefficients per body (``dynamics.euler_coefficients``
+                   of the principal moments): one row shared by all bodies, or one per body
     params  : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes   : int64 torque-program codes, or None for a torque-free body
     """
 
-    moments: np.ndarray
+    coefficients: np.ndarray
     params: np.ndarray
     codes: np.ndarray | None
 
@@ -44,7 +45,7 @@ def build(bodies, model) -> RigidModel:
         codes, params = torques.compile_program(model, body.axes, offset=0)
         rows.append(params)
     return RigidModel(
-        moments=np.ascontiguousarray([b.moments for b in bodies], dtype=np.float64),
+        coefficients=np.ascontiguousarray([euler_coefficients(*b.moments) for b in bodies], dtype=np.float64),
         params=np.ascontiguousarray(rows, dtype=np.float64),
         codes=None if model is None else codes,
     )
@@ -72,29 +73,40 @@ def _rigid_rhs(model, b0, t, Y, OUT):
     torque = njit(inline="always")(torque)
 
     @njit(inline="always")  # IR-level inlining: LLVM alone leaves a call in the RK4 loop (+25 %)
-    def derivative(model, b, t, qw, qx, qy, qz, w1, w2, w3):
-        # scalar reads only: a row view would cost reference counting in the inner loop
-        m = model.moments
-        r = b * (m.shape[0] > 1)  # the shared row 0, or row b (no branch: keeps IR inlining simple)
+    def derivative(model, b, r, t, qw, qx, qy, qz, w1, w2, w3):
+        # body b, coefficients in row r; scalar reads only: a row view would
+        # cost reference counting in the inner loop
+        c = model.coefficients
         t1, t2, t3 = torque(model, b, t, qw, qx, qy, qz, w1, w2, w3)
         d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-        a1, a2, a3 = euler_principal(m[r, 0], m[r, 1], m[r, 2], w1, w2, w3, t1, t2, t3)
+        a1, a2, a3 = euler_principal(
+            c[r, 0], c[r, 1], c[r, 2], c[r, 3], c[r, 4], c[r, 5], w1, w2, w3, t1, t2, t3
+        )
         return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
 
     if Y.ndim == 1:  # one body: the state vector itself
 
         def impl(model, b0, t, Y, OUT):
+            r = b0 * (model.coefficients.shape[0] > 1)
             OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = derivative(
-                model, b0, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]
+                model, b0, r, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]
             )
 
     else:  # a block: state × lanes
 
         def impl(model, b0, t, Y, OUT):
-            for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = derivative(
-                    model, b0 + j, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]
-                )
+            # one body's coefficients for all lanes, or one row per lane: two loops,
+            # so that the shared case is a broadcast the compiler can vectorise
+            if model.coefficients.shape[0] == 1:
+                for j in range(Y.shape[1]):
+                    (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = derivative(
+                        model, b0 + j, 0, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]
+                    )
+            else:
+                for j in range(Y.shape[1]):
+                    (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = derivative(
+                        model, b0 + j, b0 + j, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]
+                    )
 
     return impl
 

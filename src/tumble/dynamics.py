@@ -75,16 +75,27 @@ def omega_dot(inertia, omega, torque=None) -> np.ndarray:
 
 
 @njit(cache=True)
-def euler_principal(i1, i2, i3, w1, w2, w3, t1, t2, t3):
-    """Principal-axes Euler equations for one body: returns ``(ω̇₁, ω̇₂, ω̇₃)``.
+def euler_coefficients(i1, i2, i3):
+    """Coefficients of Euler's equations in principal axes, computed once per body.
 
-    ``ω̇₁ = (τ₁ + (I₂ − I₃) ω₂ ω₃) / I₁`` and cyclic; moments in kg·m²,
-    rates in rad/s, torques in N·m, all in principal axes.
+    Returns ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)`` with ``c₁ = (I₂ − I₃)/I₁`` and
+    cyclic, so that :func:`euler_principal` needs no division.
+    """
+    return (i2 - i3) / i1, (i3 - i1) / i2, (i1 - i2) / i3, 1.0 / i1, 1.0 / i2, 1.0 / i3
+
+
+@njit(cache=True)
+def euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3):
+    """Principal-axes Euler equations for one body: returns ``(ω̇₁, ω̇₂, ω̇₃)`` (rad/s²).
+
+    ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic, with ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``
+    from :func:`euler_coefficients`; rates in rad/s, torques in N·m, all in
+    principal axes. (Equal to ``(τ₁ + (I₂ − I₃) ω₂ ω₃)/I₁`` up to rounding.)
     """
     return (
-        (t1 + (i2 - i3) * w2 * w3) / i1,
-        (t2 + (i3 - i1) * w3 * w1) / i2,
-        (t3 + (i1 - i2) * w1 * w2) / i3,
+        c1 * w2 * w3 + t1 * r1,
+        c2 * w3 * w1 + t2 * r2,
+        c3 * w1 * w2 + t3 * r3,
     )
 
 
@@ -92,8 +103,9 @@ def euler_principal(i1, i2, i3, w1, w2, w3, t1, t2, t3):
 def _omega_dot_principal_batch(moments, omega, torque, out):
     for k in range(omega.shape[0]):
         m, w, t = moments[k], omega[k], torque[k]
+        c = euler_coefficients(m[0], m[1], m[2])
         out[k, 0], out[k, 1], out[k, 2] = euler_principal(
-            m[0], m[1], m[2], w[0], w[1], w[2], t[0], t[1], t[2]
+            c[0], c[1], c[2], c[3], c[4], c[5], w[0], w[1], w[2], t[0], t[1], t[2]
         )
 
 
