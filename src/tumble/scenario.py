@@ -396,7 +396,20 @@ class TabulatedTorque(_Table):
         return torques.Tabulated(self.times, self.values, **options)
 
 
-_Torque = Annotated[Union[ConstantBodyTorque, ConstantInertialTorque, TabulatedTorque],
+class GravityTorque(_Table):
+    """Uniform gravity on a body pivoting about a fixed point, as :class:`tumble.torques.Gravity`:
+    ``mass`` (kg), ``com`` (m, centre of mass relative to the pivot, body axes), ``g`` (m/s², inertial)."""
+
+    kind: Literal["gravity"]
+    mass: _Positive
+    com: _Vector
+    g: _Vector | None = None
+
+    def build(self) -> torques.TorqueModel:
+        return torques.Gravity(self.mass, self.com, *([] if self.g is None else [self.g]))
+
+
+_Torque = Annotated[Union[ConstantBodyTorque, ConstantInertialTorque, TabulatedTorque, GravityTorque],
                     Field(discriminator="kind")]
 
 

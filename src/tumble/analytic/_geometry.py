@@ -37,12 +37,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tumble._validate import ValidationError, require_positive
+from tumble._validate import ValidationError, as_array, require_positive
+from tumble.analytic._free import free_parameters
 from tumble.attitude import rotate
 from tumble.body import RigidBody
 from tumble.trajectory import Trajectory
 
-__all__ = ["Polhode", "Herpolhode", "polhode", "polhode_family", "separatrix", "herpolhode"]
+__all__ = ["Polhode", "Herpolhode", "polhode", "polhode_through", "polhode_family", "separatrix", "herpolhode"]
 
 # 2T I₁ ≤ L² ≤ 2T I₃ is accepted up to this relative excess (rounding of T and
 # |L| computed from a rate along the first or third principal axis).
@@ -120,18 +121,47 @@ def _circled_axis(moments: np.ndarray, energy: float, l2: float) -> int:
     return 2 if l2 >= 2.0 * energy * moments[1] and moments[1] < moments[2] else 0
 
 
-def _curve(moments, energy, l2, c, sign, theta) -> np.ndarray:
-    """Polhode points (len(theta), 3) circling axis ``c`` on side ``sign``, at Jacobi amplitudes ``theta``."""
+def _ellipse(moments, energy, l2, c):
+    """Axes ``j, k`` after ``c`` (cyclic), semi-axes ``(A_j, A_k)`` and the direction of the motion in ``θ``.
+
+    ``A_i² = (L² − 2T I_c) / (I_i (I_i − I_c))``; ``direction = sign(I_c − I_j)``
+    because ``I_k ω̇_k = (I_c − I_j) ω_c ω_j``: with ``ω_k = s·direction·A_k sin θ``,
+    ``θ`` grows along the motion.
+    """
     j, k = (c + 1) % 3, (c + 2) % 3
     others = moments[[j, k]]
-    amplitude = np.sqrt(np.maximum((l2 - 2.0 * energy * moments[c]) / (others * (others - moments[c])), 0.0))
-    direction = np.sign(moments[c] - moments[j])  # I_k ω̇_k = (I_c − I_j) ω_c ω_j: θ grows along the motion
+    semi_axes = np.sqrt(np.maximum((l2 - 2.0 * energy * moments[c]) / (others * (others - moments[c])), 0.0))
+    return j, k, semi_axes, np.sign(moments[c] - moments[j])
+
+
+def _curve(moments, energy, l2, c, sign, theta) -> np.ndarray:
+    """Polhode points (len(theta), 3) circling axis ``c`` on side ``sign``, at Jacobi amplitudes ``theta``."""
+    j, k, (a_j, a_k), direction = _ellipse(moments, energy, l2, c)
     points = np.empty((theta.size, 3))
-    points[:, j] = amplitude[0] * np.cos(theta)
-    points[:, k] = sign * direction * amplitude[1] * np.sin(theta)
+    points[:, j] = a_j * np.cos(theta)
+    points[:, k] = sign * direction * a_k * np.sin(theta)
     rest = 2.0 * energy - moments[j] * points[:, j] ** 2 - moments[k] * points[:, k] ** 2
     points[:, c] = sign * np.sqrt(np.maximum(rest, 0.0) / moments[c])
     return points
+
+
+def _amplitude(moments: np.ndarray, c: int, sign: int, omega_p: np.ndarray) -> float:
+    """The angle ``θ`` of :func:`_curve` at the point ``omega_p`` (principal axes) of its polhode.
+
+    ``tan θ = s·direction·(ω_k/A_k)/(ω_j/A_j)``, where the ratio
+    ``A_j/A_k = √(I_k (I_k − I_c) / (I_j (I_j − I_c)))`` does not depend on
+    ``L² − 2T I_c``: ``θ`` keeps full accuracy next to the axis.
+    """
+    j, k = (c + 1) % 3, (c + 2) % 3
+    direction = np.sign(moments[c] - moments[j])
+    scale_j = np.sqrt(abs(moments[j] * (moments[j] - moments[c])))
+    scale_k = np.sqrt(abs(moments[k] * (moments[k] - moments[c])))
+    return float(np.arctan2(sign * direction * omega_p[k] * scale_k, omega_p[j] * scale_j))
+
+
+def _circled(params) -> int:
+    """Principal axis (0-based) circled by the polhode of a motion of :func:`free_parameters`."""
+    return 0 if params.regime in ("minor", "prolate") else 2
 
 
 def _side(sign) -> int:
@@ -169,6 +199,30 @@ def polhode(body: RigidBody, energy: float, momentum: float, *, n: int = _DEFAUL
     l2 = _momentum_squared(moments, energy, momentum)
     c = _circled_axis(moments, float(energy), l2)
     return _curve(moments, float(energy), l2, c, _side(sign), _angles(_count(n, "n", 3)))
+
+
+def polhode_through(body: RigidBody, omega, *, n: int = _DEFAULT_POINTS) -> Polhode:
+    """The polhode of the torque-free motion whose body rate is ``omega`` (3,) (rad/s, body axes).
+
+    ``T``, ``|L|`` and the regime come from :func:`free_parameters`; the side
+    is the sign of the rate about the circled axis (+1 when it is 0: on the
+    separatrix). The curve starts at ``ω`` itself (``points[0]`` is ``ω`` in
+    principal axes, to rounding) and runs in the direction of the motion;
+    points in principal axes, rad/s.
+    """
+    moments = _moments(body)
+    omega = as_array(omega, "omega", tail=(3,))
+    if omega.shape != (3,):
+        raise ValidationError(f"omega: must have shape (3,), got {omega.shape}")
+    omega_p = body.axes.T @ omega
+    params = free_parameters(moments, omega_p)
+    if params.regime == "rest":
+        raise ValidationError("omega: must be non-zero (a body at rest has no polhode)")
+    l2 = _momentum_squared(moments, params.energy, params.momentum)
+    c = _circled(params)
+    sign = -1 if omega_p[c] < 0.0 else 1
+    theta = _amplitude(moments, c, sign, omega_p) + _angles(_count(n, "n", 3))
+    return Polhode(_curve(moments, params.energy, l2, c, sign, theta), params.momentum, c, sign)
 
 
 def polhode_family(body: RigidBody, energy: float, n_curves: int = 5, *, n: int = _DEFAULT_POINTS) -> list[Polhode]:

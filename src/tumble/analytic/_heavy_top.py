@@ -123,8 +123,9 @@ class HeavyTop:
     def from_simulation_state(cls, body_inertia_about_pivot, mass, com, g, omega0, q0) -> HeavyTop:
         """The top whose state is a ``tumble.simulate`` state with ``tumble.torques.Gravity(mass, com, g)``.
 
-        ``body_inertia_about_pivot`` (3, 3) kg·m² in body axes (or a
-        ``RigidBody`` whose ``inertia`` it is) must be axisymmetric about
+        ``body_inertia_about_pivot`` (3, 3) kg·m² in body axes (e.g.
+        ``RigidBody.inertia_about(pivot)``; not ``RigidBody.inertia``, which is
+        about the centre of mass) must be axisymmetric about
         ``com`` (m, body axes, from the pivot to the centre of mass):
         ``I = I₁ (E − e eᵀ) + I₃ e eᵀ`` with ``e = com/|com|``, to
         :data:`SYMMETRY_RTOL`. ``g`` (m/s², inertial axes) fixes the vertical
@@ -132,8 +133,7 @@ class HeavyTop:
         are the state. The body and inertial axes may be any; θ, θ̇, φ̇ and
         ω₃ do not depend on them (φ itself does, see :func:`axis_motion`).
         """
-        inertia = as_array(getattr(body_inertia_about_pivot, "inertia", body_inertia_about_pivot),
-                           "body_inertia_about_pivot", tail=(3, 3))
+        inertia = as_array(body_inertia_about_pivot, "body_inertia_about_pivot", tail=(3, 3))
         if inertia.shape != (3, 3):
             raise ValidationError(f"body_inertia_about_pivot: must have shape (3, 3), got {inertia.shape}")
         com, g = _vector(com, "com"), _vector(g, "g")
@@ -561,17 +561,18 @@ def measure_nutation(trajectory: Trajectory, *, com, g) -> NutationMeasurement:
     """Turning points of ``u = cos θ`` along a simulated top, refined between samples.
 
     Each interior local extremum of the samples is refined by the parabola
-    through it and its two neighbours (vertex time and value); φ is read at
-    the refined times by the same three-point interpolation. ``u`` is even
+    through it and its two neighbours (vertex time and value). ``u`` is even
     about a turning point, so the vertex value is off by O(λ⁴h⁴ (u₂ − u₁)) for
     a sample spacing ``h`` (``λ`` of :attr:`HeavyTop.rate`): sample a few
-    hundred times per nutation period or more.
+    hundred times per nutation period or more. φ is read at the refined
+    times by cubic Hermite interpolation of the sampled φ and φ̇.
     """
     motion = axis_motion(trajectory, com=com, g=g)
-    u = motion.u
-    t_max, u_max, phi_max = _turning_points(motion.t, u, motion.phi, sign=1.0)
-    t_min, u_min, _ = _turning_points(motion.t, u, motion.phi, sign=-1.0)
+    t, u = motion.t, motion.u
+    t_max, u_max = _turning_points(t, u, sign=1.0)
+    t_min, u_min = _turning_points(t, u, sign=-1.0)
     if t_max.size >= 2:
+        phi_max = _hermite(t, motion.phi, motion.phi_dot, t_max[[0, -1]])
         period = float((t_max[-1] - t_max[0]) / (t_max.size - 1))
         mean_rate = float((phi_max[-1] - phi_max[0]) / (t_max[-1] - t_max[0]))
     else:
@@ -637,19 +638,26 @@ def _angle_from_poles(north, south):
     return 2.0 * np.arctan2(np.sqrt(np.maximum(north, 0.0)), np.sqrt(np.maximum(south, 0.0)))
 
 
-def _turning_points(t, y, z, *, sign: float):
-    """Refined local maxima of ``sign·y`` (times, values of y, values of z there), by three-point parabolas."""
+def _turning_points(t, y, *, sign: float):
+    """Local maxima of ``sign·y`` at interior samples, refined to the vertex of the parabola through three samples.
+
+    Newton form ``p(t) = y₀ + d₀₁(t − t₀) + c(t − t₀)(t − t₁)``; ``p'(t*) = 0``.
+    Returns the vertex times and values.
+    """
     s = sign * y
     k = 1 + np.flatnonzero((s[1:-1] >= s[:-2]) & (s[1:-1] > s[2:]))
     t0, t1, t2 = t[k - 1], t[k], t[k + 1]
     y0, y1, y2 = y[k - 1], y[k], y[k + 1]
     d01, d12 = (y1 - y0) / (t1 - t0), (y2 - y1) / (t2 - t1)
-    curvature = (d12 - d01) / (t2 - t0)
-    t_star = 0.5 * (t0 + t1) - d01 / (2.0 * curvature)
-    return t_star, _quadratic(t0, t1, t2, y0, y1, y2, t_star), _quadratic(t0, t1, t2, z[k - 1], z[k], z[k + 1], t_star)
+    c = (d12 - d01) / (t2 - t0)
+    t_star = 0.5 * (t0 + t1) - d01 / (2.0 * c)
+    return t_star, y0 + d01 * (t_star - t0) + c * (t_star - t0) * (t_star - t1)
 
 
-def _quadratic(t0, t1, t2, y0, y1, y2, t):
-    """Newton form of the parabola through three points, evaluated at ``t``."""
-    d01, d12 = (y1 - y0) / (t1 - t0), (y2 - y1) / (t2 - t1)
-    return y0 + d01 * (t - t0) + (d12 - d01) / (t2 - t0) * (t - t0) * (t - t1)
+def _hermite(t, y, y_dot, at):
+    """Cubic Hermite interpolation of samples ``y`` with derivatives ``y_dot`` at the times ``at``."""
+    k = np.clip(np.searchsorted(t, at) - 1, 0, t.size - 2)
+    h = t[k + 1] - t[k]
+    s = (at - t[k]) / h
+    h00, h10, h01, h11 = (1 + 2 * s) * (1 - s) ** 2, s * (1 - s) ** 2, s * s * (3 - 2 * s), s * s * (s - 1)
+    return h00 * y[k] + h10 * h * y_dot[k] + h01 * y[k + 1] + h11 * h * y_dot[k + 1]

@@ -33,11 +33,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tumble._validate import ValidationError, as_array
+from scipy.special import elliprf
+
+from tumble._validate import ValidationError, as_array, require_positive
 from tumble.analytic._free import free_parameters
+from tumble.analytic._geometry import _amplitude, _circled
 from tumble.body import RigidBody
 
-__all__ = ["StabilityReport", "stability", "classify_axes", "growth_rate", "flip_interval", "polhode_period"]
+__all__ = [
+    "StabilityReport",
+    "stability",
+    "classify_axes",
+    "growth_rate",
+    "flip_interval",
+    "polhode_period",
+    "flip_times",
+]
 
 STABLE, UNSTABLE, NEUTRAL = "stable", "unstable", "neutral"
 
@@ -137,8 +148,10 @@ def growth_rate(body: RigidBody, spin: float) -> float:
     like ``e^{σt}`` while they stay small. 0 for a symmetric body.
     """
     i1, i2, i3 = _body(body).moments
-    spin = float(as_array(spin, "spin"))
-    return abs(spin) * float(np.sqrt(max((i3 - i2) * (i2 - i1), 0.0) / (i1 * i3)))
+    spin = as_array(spin, "spin")
+    if spin.ndim != 0:
+        raise ValidationError(f"spin: must be a number (rad/s), got shape {spin.shape}")
+    return abs(float(spin)) * float(np.sqrt(max((i3 - i2) * (i2 - i1), 0.0) / (i1 * i3)))
 
 
 def flip_interval(body: RigidBody, omega) -> float:
@@ -174,16 +187,57 @@ def stability(body: RigidBody, omega) -> StabilityReport:
     omega_p = _omega_principal(body, omega)
     params = free_parameters(body.moments, omega_p)
     quarter = float(params.quarter_period)
+    classes = classify_axes(body)
     return StabilityReport(
         moments=body.moments,
         axes=body.axes,
         symmetry=body.symmetry(),
-        axis_stability=classify_axes(body),
+        axis_stability=classes,
         omega_principal=omega_p,
         energy=float(params.energy),
         momentum=float(params.momentum),
         regime=str(params.regime),
-        growth_rate=growth_rate(body, params.momentum / body.moments[1]),
+        growth_rate=growth_rate(body, params.momentum / body.moments[1]) if classes[1] == UNSTABLE else 0.0,
         flip_interval=2.0 * quarter,
         polhode_period=4.0 * quarter,
     )
+
+
+def flip_times(body: RigidBody, omega0, t_end: float) -> np.ndarray:
+    """Times (s) in ``(0, t_end]`` at which the intermediate-axis rate ``ω₂`` changes sign, exactly.
+
+    ``omega0`` (3,) is the body rate at ``t = 0`` (rad/s, body axes) of the
+    torque-free motion. Along the polhode the Jacobi amplitude ``φ = am(u)``,
+    ``u = λt + u₀``, advances as ``dφ/dt = λ √(1 − m sin²φ)``, and ``ω₂ ∝ sn u``
+    vanishes at ``φ = jπ`` (``u = 2jK``). The initial phase is
+    ``u₀ = F(φ₀|m)``, with ``φ₀`` from the rates at ``t = 0`` (the angle of
+    :func:`tumble.analytic._geometry.polhode_through`, shifted by ``π/2`` in
+    the minor regime) and the incomplete integral
+    ``F(φ|m) = sin φ R_F(cos²φ, m1 + m cos²φ, 1)`` (DLMF 19.25.5, Carlson's
+    ``R_F`` of :func:`scipy.special.elliprf`, free of cancellation as
+    ``m1 → 0``). The flips are then ``t₁ + 2jK/λ``, ``j = 0, 1, …``;
+    ``m``, ``m1``, ``λ`` and ``K/λ`` come from :func:`free_parameters`.
+    Empty when ``ω₂`` never changes sign (a sphere, a steady rotation, the
+    separatrix after its one flip). ``analysis.flip_times`` measures the
+    same events on a sampled trajectory.
+    """
+    body = _body(body)
+    t_end = require_positive(t_end, "t_end")
+    moments = body.moments
+    omega_p = _omega_principal(body, omega0)
+    params = free_parameters(moments, omega_p)
+    c = _circled(params)
+    j, k = (c + 1) % 3, (c + 2) % 3
+    if params.regime in ("sphere", "rest") or (omega_p[j] == 0.0 and omega_p[k] == 0.0):
+        return np.empty(0)  # ω constant, or a steady rotation about the circled axis: ω₂ ≡ 0
+    sign = -1 if omega_p[c] < 0.0 else 1
+    phi = _amplitude(moments, c, sign, omega_p) - (0.5 * np.pi if c == 0 else 0.0)
+    phi -= np.pi * np.round(phi / np.pi)  # into [−π/2, π/2]: same ω₂ zeros, phase shifted by 2K
+    cos = np.cos(phi)
+    u0 = np.sin(phi) * elliprf(cos * cos, params.m1 + params.m * cos * cos, 1.0)
+    half = 2.0 * params.quarter_period  # 2K/λ, s
+    first = (-u0 / params.lam) if phi < 0.0 else half - u0 / params.lam
+    if not np.isfinite(first) or first > t_end:
+        return np.empty(0)
+    count = 1 if not np.isfinite(half) else int(np.floor((t_end - first) / half)) + 1
+    return first + half * np.arange(count)
