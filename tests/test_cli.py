@@ -1,4 +1,4 @@
-"""The `tumble` command: run, demo racket, info, --help, --version; exit codes; nothing written on bad input."""
+"""The `tumble` command: run, demos, info, --help, --version; exit codes; nothing written on bad input."""
 
 import os
 import re
@@ -25,7 +25,11 @@ def invoke(*args):
     return runner.invoke(app, [str(a) for a in args])
 
 
-@pytest.mark.parametrize("command", [[], ["run"], ["demo"], ["demo", "racket"], ["info"]], ids=" ".join)
+@pytest.mark.parametrize(
+    "command",
+    [[], ["run"], ["demo"], ["demo", "racket"], ["demo", "polhode"], ["demo", "top"], ["info"]],
+    ids=" ".join,
+)
 def test_help_of_every_command(command):
     result = invoke(*command, "--help")
     assert result.exit_code == 0, result.output
@@ -127,6 +131,57 @@ def test_demo_racket_counts_the_flips_in_the_file(tmp_path):
     spacing = saved.t[1] - saved.t[0]
     assert abs(np.diff(saved.t[changes]).mean() - printed_mean) <= spacing
     assert png.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_demo_racket_prints_the_predicted_flip_interval(tmp_path):
+    result = invoke("demo", "racket", "-o", tmp_path / "r.nc", "--plot", tmp_path / "r.png", "--duration", 10)
+    assert result.exit_code == 0, result.output
+    simulated = float(re.search(r"mean time between flips ([0-9.]+) s", result.stdout).group(1))
+    predicted = float(re.search(r"predicted time between flips 2K/lambda = ([0-9.]+) s", result.stdout).group(1))
+    # Measured 6e-8 apart (printed to 6 digits); 1e-3 is the agreement the demo promises.
+    assert predicted == pytest.approx(simulated, rel=1e-3)
+    assert predicted == pytest.approx(2.98632, rel=1e-5)  # 2K/λ of the default T-handle motion
+
+
+def test_demo_polhode_writes_the_figure(tmp_path):
+    from tumble.analytic._stability import stability
+
+    png = tmp_path / "polhode.png"
+    result = invoke("demo", "polhode", "-o", png)
+    assert result.exit_code == 0, result.output
+    assert png.read_bytes()[:8] == PNG_MAGIC
+    assert [p.name for p in tmp_path.iterdir()] == ["polhode.png"]  # no temporary files left
+    handle = tumble.RigidBody.t_handle()
+    report = stability(handle, handle.axes @ np.array([1.0, 10.0, 1.0]))
+    assert "axes      1: stable, 2: unstable, 3: stable" in result.stdout
+    assert f"flips every 2K/lambda = {report.flip_interval:.6g} s" in result.stdout
+    assert f"wrote     {png}" in result.stdout
+
+
+def test_demo_polhode_output_in_missing_directory_exits_2(tmp_path):
+    result = invoke("demo", "polhode", "-o", tmp_path / "no" / "polhode.png")
+    assert result.exit_code == 2
+    assert "--output: directory" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_demo_top_writes_the_trajectory_and_the_figure(tmp_path):
+    pytest.importorskip("tumble.viz.top")  # written alongside; skipped only while the module is missing
+    result = invoke("demo", "top", "-o", tmp_path, "--duration", 0.5)
+    assert result.exit_code == 0, result.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["top.nc", "top.png"]
+    assert (tmp_path / "top.png").read_bytes()[:8] == PNG_MAGIC
+    assert len(tumble.load(tmp_path / "top.nc")) > 1
+    exact, simulated = map(float, re.search(r"period\s+([0-9.]+) s \(exact\), ([0-9.]+) s \(simulated\)",
+                                            result.stdout).groups())
+    assert simulated == pytest.approx(exact, rel=1e-5)  # printed to 6 digits
+
+
+def test_demo_top_missing_directory_exits_2(tmp_path):
+    result = invoke("demo", "top", "-o", tmp_path / "nope")
+    assert result.exit_code == 2
+    assert "--output:" in result.stderr and "is not an existing directory" in result.stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_demo_racket_bad_duration_exits_2(tmp_path):

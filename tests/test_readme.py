@@ -25,3 +25,13 @@ def test_ten_line_example_runs_and_conserves(tmp_path, monkeypatch):
     assert np.abs(traj.momentum_norm_drift).max() <= DRIFT_CLAIM
     assert (tmp_path / "box.nc").stat().st_size > 0
     assert (tmp_path / "box.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_exact_motion_example_runs_and_prints_the_flip_interval(capsys):
+    code = _python_block("## Exact motion, stability and the heavy top")
+    namespace: dict = {}
+    exec(compile(code, str(README), "exec"), namespace)
+    printed = capsys.readouterr().out
+    assert "2.98632" in f"{namespace['tumble'].analytic.flip_interval(namespace['body'], namespace['omega0']):.6g}"
+    assert printed  # the example prints its results
+    assert namespace["exact"].method == "exact"

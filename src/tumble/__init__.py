@@ -20,8 +20,22 @@ from tumble.trajectory import Trajectory, load
 
 __version__ = "0.1.0"
 
+# Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
+# `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
+_LAZY = ("analytic", "viz", "scenario", "analysis")
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        return importlib.import_module(f"tumble.{name}")
+    raise AttributeError(f"module 'tumble' has no attribute {name!r}")
+
 __all__ = [
     "RigidBody",
+    "analysis",
+    "analytic",
     "SolverError",
     "Trajectory",
     "ValidationError",
@@ -29,6 +43,8 @@ __all__ = [
     "dynamics",
     "integrate",
     "load",
+    "scenario",
     "simulate",
     "torques",
+    "viz",
 ]

@@ -12,17 +12,30 @@ state size::
 
     rhs(model, b0, t, Y, OUT)    # OUT[:, j] = dy/dt of batch member b0 + j at (t, Y[:, j])
     project(model, Y)            # e.g. normalise the quaternion Y[0:4, j] of every lane
+    state_size(model)            # length of the state vector, a compile-time constant
 
 where ``Y`` is a block (state × lanes) or the state vector of one body
 (``Y[i]``, batch member ``b0``); the overloads specialise on ``Y.ndim``.
-    state_size(model)            # length of the state vector, a compile-time constant
+
+Two more functions serve the geometric integrators (:mod:`tumble.integrate`);
+a model provides those that apply to it::
+
+    body_rate(model, Y, j)       # (ω₁, ω₂, ω₃) of lane j (rad/s, body axes of the quaternion):
+                                 # q̇ = ½ q ⊗ [0, ω]; the Lie-group method (cf4) needs it
+    inverse_moments(model, b)    # (1/I₁, 1/I₂, 1/I₃) of batch member b, principal axes (1/(kg·m²)),
+                                 # for a torque-free rigid body whose state is [q, ω]; the
+                                 # splitting methods need it
+
+A model also tells Python code whether it has an external torque: the
+attribute ``torque_free`` (True when it has none) is read by
+:func:`tumble.integrate.solve`, which refuses a free-body-only method otherwise.
 
 The integrators call these generic functions; Numba picks the implementation
 from the model's type when it compiles the integrator, so each model gets its
 own fully inlined integrator, and the compiled code is cached on disk. (Passing
 functions as arguments instead would defeat the disk cache, and a run-time
 switch on a model code costs 2–3× in the inner loop.) Adding a model is one
-module: a NamedTuple, its three overloads, and a row in ``docs/architecture.md``.
+module: a NamedTuple, its overloads, and a row in ``docs/architecture.md``.
 """
 
 from __future__ import annotations
@@ -44,6 +57,24 @@ def project(model, Y):  # pragma: no cover - replaced by overloads in compiled c
 def state_size(model):  # pragma: no cover - replaced by overloads in compiled code
     """Length of the state vector of ``model`` (a constant, so loops over it unroll)."""
     raise NotImplementedError(f"no compiled state size for {type(model).__name__}")
+
+
+def body_rate(model, Y, j):  # pragma: no cover - replaced by overloads in compiled code
+    """Body angular velocity ``(ω₁, ω₂, ω₃)`` (rad/s) of lane ``j`` of the block ``Y`` (or of the state vector ``Y``).
+
+    It is the rate in the attitude kinematics ``q̇ = ½ q ⊗ [0, ω]`` of the
+    quaternion ``Y[0:4]``, in the body axes that quaternion maps to inertial.
+    """
+    raise NotImplementedError(f"no compiled body rate for {type(model).__name__}")
+
+
+def inverse_moments(model, b):  # pragma: no cover - replaced by overloads in compiled code
+    """``(1/I₁, 1/I₂, 1/I₃)`` (1/(kg·m²)) of batch member ``b`` of a torque-free rigid-body model.
+
+    Only models whose state is ``[q, ω]`` with ``ω`` in principal axes and
+    whose motion is torque-free provide it: the splitting methods rely on both.
+    """
+    raise NotImplementedError(f"{type(model).__name__} is not a torque-free rigid body")
 
 
 @njit(cache=True)

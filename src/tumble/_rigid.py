@@ -31,11 +31,18 @@ class RigidModel(NamedTuple):
                    of the principal moments): one row shared by all bodies, or one per body
     params  : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes   : int64 torque-program codes, or None for a torque-free body
+    moments : (N or 1, 3) principal moments, kg·m² (for the exact flow, ``method="exact"``)
     """
 
     coefficients: np.ndarray
     params: np.ndarray
     codes: np.ndarray | None
+    moments: np.ndarray
+
+    @property
+    def torque_free(self) -> bool:
+        """True when the bodies have no torque program (the free-rigid-body methods apply)."""
+        return self.codes is None
 
 
 def build(bodies, model) -> RigidModel:
@@ -48,6 +55,7 @@ def build(bodies, model) -> RigidModel:
         coefficients=np.ascontiguousarray([euler_coefficients(*b.moments) for b in bodies], dtype=np.float64),
         params=np.ascontiguousarray(rows, dtype=np.float64),
         codes=None if model is None else codes,
+        moments=np.ascontiguousarray([b.moments for b in bodies], dtype=np.float64),
     )
 
 
@@ -136,5 +144,27 @@ def _rigid_state_size(model):
 
     def impl(model):
         return STATE_SIZE
+
+    return impl
+
+
+@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+def _rigid_body_rate(model, Y, j):
+    if not _is_rigid(model):
+        return None
+    if Y.ndim == 1:
+        return lambda model, Y, j: (Y[4], Y[5], Y[6])
+    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
+
+
+@overload(_model.inverse_moments, inline="always", jit_options={"cache": True})
+def _rigid_inverse_moments(model, b):
+    if not _is_rigid(model) or not isinstance(model.types[2], types.NoneType):
+        return None  # with a torque program, the body is not free: no splitting
+
+    def impl(model, b):
+        r = b * (model.coefficients.shape[0] > 1)
+        c = model.coefficients
+        return c[r, 3], c[r, 4], c[r, 5]
 
     return impl

@@ -2,6 +2,8 @@
 
     tumble run SCENARIO.toml -o out.nc [--plot out.png] [--quiet]
     tumble demo racket [-o racket.nc] [--plot racket.png] [--duration 20]
+    tumble demo polhode [-o polhode.png]
+    tumble demo top [-o DIRECTORY] [--duration 1.5]
     tumble info out.nc
     tumble --version
 
@@ -27,6 +29,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 import tumble
 from tumble._validate import ValidationError, require_positive
 from tumble.analysis import flip_times, intermediate_rate
+from tumble.analytic._stability import flip_interval, stability
 from tumble.body import RigidBody
 from tumble.integrate import SolverError
 from tumble.scenario import load_scenario
@@ -57,6 +60,10 @@ _RACKET_SPIN = 10.0
 _RACKET_PERTURBATION = 1e-3
 _RACKET_SAMPLES_PER_SECOND = 200
 _RACKET_TOLERANCE = 1e-12
+# Polhode demo: the same T-handle, 10 rad/s about the intermediate axis and
+# 1 rad/s about each of the others (principal axes): a motion just inside the
+# "major" regime, so that its polhode stands apart from the separatrix.
+_POLHODE_OMEGA = (1.0, 10.0, 1.0)
 
 _stderr = Console(stderr=True)
 
@@ -117,23 +124,91 @@ def racket(
 
     The default RigidBody.t_handle() starts at 10 rad/s about its intermediate principal axis
     with 1e-3 rad/s about the other two, integrated by dop853 at rtol = atol = 1e-12. A flip
-    is a sign change of the intermediate-axis rate; the command prints their number and the
-    mean time between them.
+    is a sign change of the intermediate-axis rate; the command prints their number, the
+    mean time between them, and the time between flips predicted by the exact (elliptic)
+    solution, 2K(m)/lambda.
     """
     with _exit_codes():
         require_positive(duration, "--duration")
         _check_outputs(output, plot)
         body = RigidBody.t_handle()
-        omega_principal = np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
+        omega0 = body.axes @ np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
         n = int(np.ceil(duration * _RACKET_SAMPLES_PER_SECOND))
         with _progress_bar("simulating", enabled=not quiet) as progress:
-            traj = simulate(body, body.axes @ omega_principal, t=np.linspace(0.0, duration, n + 1),
+            traj = simulate(body, omega0, t=np.linspace(0.0, duration, n + 1),
                             method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE, progress=progress)
         flips = flip_times(traj, body)
         _save(traj, output, _racket_figure(traj, body, flips), plot)
-    mean = f", mean time between flips {np.diff(flips).mean():.4g} s" if flips.size > 1 else ""
+    mean = f", mean time between flips {np.diff(flips).mean():.6g} s" if flips.size > 1 else ""
     _print_rows([*_summary(traj), ("flips", f"{flips.size} in {duration:g} s{mean}"),
+                 ("predicted", f"time between flips 2K/lambda = {flip_interval(body, omega0):.6g} s (exact solution)"),
                  ("wrote", _written(output, plot))])
+
+
+@demo_app.command("polhode")
+def polhode(
+    output: Annotated[Path, typer.Option("-o", "--output", help="PNG figure to write.")] = Path("polhode.png"),
+) -> None:
+    """Poinsot's construction: polhodes on the energy ellipsoid and the herpolhode of a T-handle.
+
+    RigidBody.t_handle() spinning at 10 rad/s about its intermediate principal axis and 1 rad/s
+    about each of the other two. The figure (tumble.viz.polhode.polhode_figure) shows the energy
+    ellipsoid with a family of polhodes, the separatrix and this motion's polhode, and the
+    herpolhode on the invariable plane; the command prints the stability of the axes and the
+    predicted times.
+    """
+    from tumble.viz.polhode import polhode_figure
+
+    with _exit_codes():
+        _check_outputs(output, None)
+        body = RigidBody.t_handle()
+        omega0 = body.axes @ np.array(_POLHODE_OMEGA)
+        report = stability(body, omega0)
+        figure = polhode_figure(body, omega0)
+        write_atomic(output, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+    moments = ", ".join(f"{m:.4g}" for m in report.moments)
+    _print_rows([
+        ("body", f"T-handle, principal moments {moments} kg m^2"),
+        ("axes", ", ".join(f"{i + 1}: {kind}" for i, kind in enumerate(report.axis_stability))),
+        ("omega", "[" + ", ".join(f"{w:g}" for w in _POLHODE_OMEGA) + f"] rad/s (principal axes), "
+                  f"regime {report.regime!r}"),
+        ("timing", f"flips every 2K/lambda = {report.flip_interval:.6g} s, "
+                   f"polhode period 4K/lambda = {report.polhode_period:.6g} s"),
+        ("wrote", str(output)),
+    ])
+
+
+@demo_app.command("top")
+def top(
+    output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write top.nc and top.png in.")]
+    = Path("."),
+    duration: Annotated[float, typer.Option("--duration", help="Simulated time, s.")] = 1.5,
+) -> None:
+    """Heavy symmetric top: simulation (gravity torque on a pivot) against the exact theory.
+
+    Runs tumble.viz.top.demo_top: a spinning top released at 60 deg from the vertical nutates
+    between two angles while it precesses. Writes top.nc and top.png in the directory and prints
+    the nutation bounds, the nutation period and the mean precession rate, exact and measured.
+    """
+    from tumble.viz.top import demo_top
+
+    with _exit_codes():
+        require_positive(duration, "--duration")
+        if not output.is_dir():
+            raise ValidationError(f"--output: {str(output)!r} is not an existing directory")
+        summary = demo_top(output, duration=duration)
+    _print_rows([
+        ("nutation", f"theta from {summary['theta_min_deg']:.6g} to {summary['theta_max_deg']:.6g} deg (exact), "
+                     f"{summary['theta_min_deg_measured']:.6g} to {summary['theta_max_deg_measured']:.6g} deg "
+                     "(simulated)"),
+        ("period", f"{summary['nutation_period_s']:.6g} s (exact), "
+                   f"{summary['nutation_period_s_measured']:.6g} s (simulated)"),
+        ("rate", f"mean precession rate {summary['mean_precession_rate']:.6g} rad/s (exact), "
+                 f"{summary['mean_precession_rate_measured']:.6g} rad/s (simulated)"),
+        ("spin", f"{summary['spin']:.6g} rad/s (critical spin {summary['critical_spin']:.6g} rad/s: "
+                 "the upright top is stable above it)"),
+        ("wrote", f"{summary['nc']}, {summary['png']}"),
+    ])
 
 
 @app.command()

@@ -57,9 +57,11 @@ def simulate(
     q0 : (4,) or (N, 4) array_like, optional
         Initial attitude, unit quaternion ``[w, x, y, z]`` mapping body →
         inertial axes (normalised here; default: identity).
-    method : {"dop853", "rk4"}
-        Adaptive 8th-order Dormand–Prince (``rtol``, ``atol``) or classical
-        Runge–Kutta with fixed step ``dt`` (s). See :mod:`tumble.integrate`.
+    method : {"dop853", "rk4", "cf4", "splitting2", "splitting4", "exact"}
+        Adaptive 8th-order Dormand–Prince (``rtol``, ``atol``); classical
+        Runge–Kutta, the Lie-group method or the Lie–Poisson splittings with
+        fixed step ``dt`` (s); or the closed-form torque-free motion (no step).
+        See :mod:`tumble.integrate` and ``docs/integrators.md``.
     torque : TorqueModel, callable ``f(t, q, omega) -> (3,)``, or None
         External torque in body axes (N·m); see :mod:`tumble.torques`. Python
         callables run at Python speed and on one core.
@@ -75,7 +77,7 @@ def simulate(
         energy, angular momentum and their drifts.
     """
     method = str(method)
-    m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+    m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque)
     times = _output_times(t)
     bodies, batch_inertia = _bodies(body)
     omega0 = as_array(omega0, "omega0", tail=(3,))
@@ -108,7 +110,10 @@ def simulate(
     if n is None:
         q, omega = q[:, 0], omega[:, 0]
     info = {"torque": repr(model) if model is not None else "none", **stats}
-    info.update({"dt": float(dt)} if not m.adaptive else {"rtol": float(rtol), "atol": float(atol)})
+    if m.adaptive:
+        info.update(rtol=float(rtol), atol=float(atol))
+    elif m.stepper:
+        info.update(dt=float(dt))
     return Trajectory(t=times, q=q, omega=omega, inertia=batch_inertia, method=method, info=info)
 
 

@@ -13,17 +13,19 @@ a closed curve, the *polhode* (Landau & Lifshitz, *Mechanics*, §37; Goldstein,
 for ``L² < 2T I₂`` the axis of smallest moment (``"minor"``); ``L² = 2T I₂``
 is the *separatrix*, two ellipses crossing at the intermediate axis.
 
-Subtracting ``2T I_c`` times the first equation from ``2T`` times the second
-leaves, for the circled axis ``c`` and the other two ``j, k``,
-``Σᵢ Iᵢ (Iᵢ − I_c) ωᵢ² = L² − 2T I_c``: an ellipse in ``(ω_j, ω_k)``, which
+Subtracting ``Iᵢ`` times the first equation from the second gives
+``Σⱼ Iⱼ (Iⱼ − Iᵢ) ωⱼ² = Δᵢ``, ``Δᵢ = L² − 2T Iᵢ``. For the circled axis ``c``
+and the other two ``j, k`` (cyclic) it is an ellipse in ``(ω_j, ω_k)``, which
 parametrises the polhode exactly,
 
-    ω_j = A_j cos θ,   ω_k = ± A_k sin θ,   A_i² = (L² − 2T I_c) / (I_i (I_i − I_c)),
-    ω_c = s √((2T − I_j ω_j² − I_k ω_k²) / I_c),
+    ω_j = A_j cos θ,   ω_k = ± A_k sin θ,   A_i² = Δ_c / (I_i (I_i − I_c)),
+    I_c |I_c − I₂| ω_c² = |Δ₂| + I_o |I_o − I₂| ω_o²     (o: the axis other than c and 2),
 
-with ``s = ±1`` the side of the polhode (the sign of ``ω_c``); ``θ`` is the
-Jacobi amplitude of the elliptic solution, and the sign of ``ω_k`` is chosen so
-that ``θ`` increases along the motion.
+with ``ω_c`` of sign ``s = ±1``, the side of the polhode; the last line is
+the equation ``i = 2``, a sum of non-negative terms, so ``ω_c`` keeps its
+accuracy up to the separatrix. ``θ`` is the Jacobi amplitude of the elliptic
+solution (up to a quarter turn), and the sign of ``ω_k`` is chosen so that
+``θ`` increases along the motion.
 
 Poinsot: the energy ellipsoid, fixed to the body, rolls without slipping on
 the *invariable plane*, perpendicular to the inertial angular momentum ``L_I``
@@ -53,7 +55,7 @@ _DEFAULT_POINTS = 361
 
 @dataclass(frozen=True, eq=False)
 class Polhode:
-    """One polhode of a family: its points and the motion it belongs to.
+    """A polhode: its points and the motion it belongs to (:func:`polhode_through`, :func:`polhode_family`).
 
     ``points`` (n, 3): body rates in principal axes (rad/s), a closed curve
     (first point = last) in the direction of the motion; ``momentum``: ``|L|``
@@ -103,8 +105,18 @@ def _moments(body: RigidBody) -> np.ndarray:
     return moments
 
 
-def _momentum_squared(moments: np.ndarray, energy: float, momentum: float) -> float:
-    """``L²`` checked against ``2T I₁ ≤ L² ≤ 2T I₃`` (to ``_LEVEL_RTOL``) and clipped into it."""
+def _omega_principal(body: RigidBody, omega) -> np.ndarray:
+    """``ω_P = R_BPᵀ ω_B`` (rad/s) for one non-zero body rate ``omega`` of shape (3,) in body axes."""
+    omega = as_array(omega, "omega", tail=(3,))
+    if omega.shape != (3,):
+        raise ValidationError(f"omega: must have shape (3,), got {omega.shape}")
+    if not omega.any():
+        raise ValidationError("omega: must be non-zero (a body at rest does not move)")
+    return body.axes.T @ omega
+
+
+def _levels(moments: np.ndarray, energy: float, momentum: float) -> np.ndarray:
+    """``Δᵢ = L² − 2T Iᵢ`` (3,), with ``2T I₁ ≤ L² ≤ 2T I₃`` checked (to ``_LEVEL_RTOL``) and ``L²`` clipped into it."""
     energy = require_positive(energy, "energy")
     l2 = require_positive(momentum, "momentum") ** 2
     low, high = 2.0 * energy * moments[0], 2.0 * energy * moments[2]
@@ -113,42 +125,48 @@ def _momentum_squared(moments: np.ndarray, energy: float, momentum: float) -> fl
             f"momentum: |L|^2 = {l2:.6g} must lie between 2 T I1 = {low:.6g} and 2 T I3 = {high:.6g} "
             f"(T = {energy:.6g} J)"
         )
-    return min(max(l2, low), high)
+    return min(max(l2, low), high) - 2.0 * energy * moments
 
 
-def _circled_axis(moments: np.ndarray, energy: float, l2: float) -> int:
-    """Index of the principal axis the polhode circles: 2 when ``L² ≥ 2T I₂`` (and ``I₂ < I₃``), else 0."""
-    return 2 if l2 >= 2.0 * energy * moments[1] and moments[1] < moments[2] else 0
+def _levels_of_rates(moments: np.ndarray, omega_p: np.ndarray) -> np.ndarray:
+    """``Δᵢ = L² − 2T Iᵢ = Σⱼ Iⱼ (Iⱼ − Iᵢ) ωⱼ²`` (3,) from rates in principal axes: Δ₁ ≥ 0 ≥ Δ₃ without cancellation."""
+    terms = moments * omega_p**2
+    return (moments[None, :] - moments[:, None]) @ terms
 
 
-def _ellipse(moments, energy, l2, c):
-    """Axes ``j, k`` after ``c`` (cyclic), semi-axes ``(A_j, A_k)`` and the direction of the motion in ``θ``.
+def _circled_axis(moments: np.ndarray, levels: np.ndarray) -> int:
+    """Index of the principal axis the polhode circles: 2 when ``Δ₂ ≥ 0`` (and ``I₂ < I₃``), else 0."""
+    return 2 if levels[1] >= 0.0 and moments[1] < moments[2] else 0
 
-    ``A_i² = (L² − 2T I_c) / (I_i (I_i − I_c))``; ``direction = sign(I_c − I_j)``
-    because ``I_k ω̇_k = (I_c − I_j) ω_c ω_j``: with ``ω_k = s·direction·A_k sin θ``,
-    ``θ`` grows along the motion.
+
+def _curve(moments, levels, c, sign, theta) -> np.ndarray:
+    """Polhode points (len(theta), 3) circling axis ``c`` on side ``sign``, at the angles ``theta``.
+
+    ``levels`` are the ``Δᵢ = L² − 2T Iᵢ``. With ``j, k`` the axes after ``c``
+    (cyclic): ``ω_j = A_j cos θ``, ``ω_k = s·d·A_k sin θ``,
+    ``A_i² = Δ_c / (I_i (I_i − I_c))``, and ``d = sign(I_c − I_j)`` because
+    ``I_k ω̇_k = (I_c − I_j) ω_c ω_j``: ``θ`` grows along the motion. The
+    circled rate follows from ``Σᵢ Iᵢ (Iᵢ − I₂) ωᵢ² = Δ₂`` as a sum of
+    non-negative terms, ``I_c |I_c − I₂| ω_c² = |Δ₂| + I_o |I_o − I₂| ω_o²``
+    (``o`` the axis other than ``c`` and the intermediate one), exact to
+    rounding up to the separatrix. Indices here are 0-based.
     """
     j, k = (c + 1) % 3, (c + 2) % 3
     others = moments[[j, k]]
-    semi_axes = np.sqrt(np.maximum((l2 - 2.0 * energy * moments[c]) / (others * (others - moments[c])), 0.0))
-    return j, k, semi_axes, np.sign(moments[c] - moments[j])
-
-
-def _curve(moments, energy, l2, c, sign, theta) -> np.ndarray:
-    """Polhode points (len(theta), 3) circling axis ``c`` on side ``sign``, at Jacobi amplitudes ``theta``."""
-    j, k, (a_j, a_k), direction = _ellipse(moments, energy, l2, c)
+    a_j, a_k = np.sqrt(np.maximum(levels[c] / (others * (others - moments[c])), 0.0))
     points = np.empty((theta.size, 3))
     points[:, j] = a_j * np.cos(theta)
-    points[:, k] = sign * direction * a_k * np.sin(theta)
-    rest = 2.0 * energy - moments[j] * points[:, j] ** 2 - moments[k] * points[:, k] ** 2
-    points[:, c] = sign * np.sqrt(np.maximum(rest, 0.0) / moments[c])
+    points[:, k] = sign * np.sign(moments[c] - moments[j]) * a_k * np.sin(theta)
+    o = 2 - c
+    numerator = abs(levels[1]) + moments[o] * abs(moments[o] - moments[1]) * points[:, o] ** 2
+    points[:, c] = sign * np.sqrt(numerator / (moments[c] * abs(moments[c] - moments[1])))
     return points
 
 
 def _amplitude(moments: np.ndarray, c: int, sign: int, omega_p: np.ndarray) -> float:
     """The angle ``θ`` of :func:`_curve` at the point ``omega_p`` (principal axes) of its polhode.
 
-    ``tan θ = s·direction·(ω_k/A_k)/(ω_j/A_j)``, where the ratio
+    ``tan θ = s·d·(ω_k/A_k)/(ω_j/A_j)``, where the ratio
     ``A_j/A_k = √(I_k (I_k − I_c) / (I_j (I_j − I_c)))`` does not depend on
     ``L² − 2T I_c``: ``θ`` keeps full accuracy next to the axis.
     """
@@ -196,9 +214,8 @@ def polhode(body: RigidBody, energy: float, momentum: float, *, n: int = _DEFAUL
     module docstring. A spherical body has none (refused).
     """
     moments = _moments(body)
-    l2 = _momentum_squared(moments, energy, momentum)
-    c = _circled_axis(moments, float(energy), l2)
-    return _curve(moments, float(energy), l2, c, _side(sign), _angles(_count(n, "n", 3)))
+    levels = _levels(moments, energy, momentum)
+    return _curve(moments, levels, _circled_axis(moments, levels), _side(sign), _angles(_count(n, "n", 3)))
 
 
 def polhode_through(body: RigidBody, omega, *, n: int = _DEFAULT_POINTS) -> Polhode:
@@ -208,21 +225,20 @@ def polhode_through(body: RigidBody, omega, *, n: int = _DEFAULT_POINTS) -> Polh
     is the sign of the rate about the circled axis (+1 when it is 0: on the
     separatrix). The curve starts at ``ω`` itself (``points[0]`` is ``ω`` in
     principal axes, to rounding) and runs in the direction of the motion;
-    points in principal axes, rad/s.
+    points in principal axes, rad/s. A steady rotation (``ω × Iω = 0``
+    exactly: ``ω`` along a principal axis, or in the plane of two equal
+    moments) has a polhode of one point: ``n`` copies of ``ω``.
     """
     moments = _moments(body)
-    omega = as_array(omega, "omega", tail=(3,))
-    if omega.shape != (3,):
-        raise ValidationError(f"omega: must have shape (3,), got {omega.shape}")
-    omega_p = body.axes.T @ omega
+    omega_p = _omega_principal(body, omega)
     params = free_parameters(moments, omega_p)
-    if params.regime == "rest":
-        raise ValidationError("omega: must be non-zero (a body at rest has no polhode)")
-    l2 = _momentum_squared(moments, params.energy, params.momentum)
     c = _circled(params)
     sign = -1 if omega_p[c] < 0.0 else 1
     theta = _amplitude(moments, c, sign, omega_p) + _angles(_count(n, "n", 3))
-    return Polhode(_curve(moments, params.energy, l2, c, sign, theta), params.momentum, c, sign)
+    if not np.cross(omega_p, moments * omega_p).any():
+        return Polhode(np.tile(omega_p, (theta.size, 1)), params.momentum, c, sign)
+    points = _curve(moments, _levels_of_rates(moments, omega_p), c, sign, theta)
+    return Polhode(points, params.momentum, c, sign)
 
 
 def polhode_family(body: RigidBody, energy: float, n_curves: int = 5, *, n: int = _DEFAULT_POINTS) -> list[Polhode]:
@@ -246,7 +262,8 @@ def polhode_family(body: RigidBody, energy: float, n_curves: int = 5, *, n: int 
             continue  # a symmetric top: polhodes circle only the symmetry axis
         axis_l2 = 2.0 * energy * moments[c]
         for l2 in axis_l2 + (separatrix_l2 - axis_l2) * fractions**2:
-            curves += [Polhode(_curve(moments, energy, l2, c, s, theta), float(np.sqrt(l2)), c, s) for s in (1, -1)]
+            levels = l2 - 2.0 * energy * moments
+            curves += [Polhode(_curve(moments, levels, c, s, theta), float(np.sqrt(l2)), c, s) for s in (1, -1)]
     return sorted(curves, key=lambda p: (p.momentum, -p.sign))
 
 
@@ -271,7 +288,7 @@ def separatrix(body: RigidBody, energy: float, *, n: int = _DEFAULT_POINTS) -> n
     i1, i2, i3 = moments
     if i1 == i2 or i2 == i3:
         c = 2 if i1 == i2 else 0
-        return _curve(moments, energy, 2.0 * energy * i2, c, 1, theta)[None]
+        return _curve(moments, 2.0 * energy * (i2 - moments), c, 1, theta)[None]
     u1 = np.sqrt((i3 - i2) / (i1 * (i3 - i1)))
     u3 = np.sqrt((i2 - i1) / (i3 * (i3 - i1)))
     scale = np.sqrt(2.0 * energy)
@@ -281,7 +298,8 @@ def separatrix(body: RigidBody, energy: float, *, n: int = _DEFAULT_POINTS) -> n
 
 
 def _plane_basis(normal: np.ndarray) -> np.ndarray:
-    """Orthonormal (2, 3) in-plane axes for ``normal``: the inertial axis least aligned with it, projected; then ``n × a``."""
+    """Orthonormal in-plane axes (2, 3) for ``normal``: ``a``, the inertial axis least aligned with it
+    made orthogonal to it, then ``normal × a``."""
     axis = np.eye(3)[np.argmin(np.abs(normal))]
     a = axis - (axis @ normal) * normal
     a /= np.linalg.norm(a)

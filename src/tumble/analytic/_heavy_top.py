@@ -25,7 +25,7 @@ Lagrangian ``L = ½I₁(θ̇² + φ̇² sin²θ) + ½I₃ω₃² − m g l cos �
     E = ½I₁(θ̇² + φ̇² sin²θ) + ½I₃ω₃² + m g l cos θ,   E' = E − ½I₃ω₃²
     α = 2E'/I₁,   β = 2 m g l / I₁                          (rad²/s²)
 
-With ``u = cos θ`` the motion in θ separates (Goldstein eq. 5.68):
+With ``u = cos θ`` the motion in θ separates (Goldstein §5.7):
 
     u̇² = f(u) = (α − β u)(1 − u²) − (b − a u)² = β (u − u₁)(u − u₂)(u − u₃),
 
@@ -69,8 +69,8 @@ SYMMETRY_RTOL = 1e-9
 class HeavyTop:
     """A heavy symmetric top on a fixed pivot and its initial state; the exact motion.
 
-    Parameters (SI; see the module docstring for the Euler angles)
-    ----------
+    Parameters (SI units; the Euler angles are those of the module docstring):
+
     I1, I3 : float
         Transverse and axial moments of inertia *about the pivot*, kg·m².
     mass : float
@@ -221,9 +221,9 @@ class HeavyTop:
     # -- θ motion -------------------------------------------------------------
 
     def effective_potential(self, theta) -> np.ndarray:
-        """``V_eff(θ) = (p_φ − p_ψ cos θ)² / (2 I₁ sin²θ) + m g l cos θ``, J; ``E' = ½I₁θ̇² + V_eff(θ)``.
+        """``V_eff(θ) = (p_φ − p_ψ cos θ)² / (2 I₁ sin²θ) + m g l cos θ``, J: ``E' = ½I₁θ̇² + V_eff(θ)``.
 
-        Infinite at θ = 0 or π unless ``p_φ = ±p_ψ`` there (Goldstein eq. 5.62).
+        Infinite at θ = 0 and π (returned as ``inf`` there), where the axis reaches a pole only if ``p_φ = ±p_ψ``.
         """
         theta = as_array(theta, "theta")
         num = (self.p_phi - self.p_psi * np.cos(theta)) ** 2
@@ -232,7 +232,7 @@ class HeavyTop:
         return centrifugal + self.weight_torque * np.cos(theta)
 
     def f(self, u) -> np.ndarray:
-        """``f(u) = (α − β u)(1 − u²) − (b − a u)² = u̇²``, rad²/s², with ``u = cos θ`` (Goldstein eq. 5.68)."""
+        """``f(u) = (α − β u)(1 − u²) − (b − a u)² = u̇²``, rad²/s², ``u = cos θ`` (Goldstein §5.7)."""
         u = as_array(u, "u")
         return (self.alpha - self.beta * u) * (1.0 - u * u) - (self.b - self.a * u) ** 2
 
@@ -342,7 +342,7 @@ class HeavyTop:
 
     @property
     def fast_precession_rate(self) -> float:
-        """``Ω_fast = I₃ ω₃ / (I₁ cos θ₀)``, rad/s: the fast-top limit of the fast steady-precession root at θ₀.
+        """``Ω_fast = I₃ ω₃ / (I₁ cos θ₀)``, rad/s: fast-top limit of the fast steady precession at θ₀.
 
         The nutation frequency ``2π/T`` of a fast top tends to ``I₃ ω₃ / I₁ = a``.
         ``±inf`` at θ₀ = π/2.
@@ -354,7 +354,7 @@ class HeavyTop:
         """Exact steady-precession rates at angle θ (rad), shape (…, 2) ``[slow, fast]``, rad/s.
 
         Roots of ``I₁ cos θ φ̇² − I₃ ω₃ φ̇ + m g l = 0`` (θ̇ = θ̈ = 0, Goldstein
-        eq. 5.76), computed without cancellation: ``q = ½(I₃ω₃ + sgn(ω₃) √D)``,
+        §5.7), computed without cancellation: ``q = ½(I₃ω₃ + sgn(ω₃) √D)``,
         ``D = I₃²ω₃² − 4 I₁ m g l cos θ``, slow ``= m g l / q``, fast
         ``= q / (I₁ cos θ)`` (``±inf`` at θ = π/2). ``nan`` where ``D < 0``: no
         steady precession at that angle with this spin.
@@ -363,10 +363,8 @@ class HeavyTop:
         disc = self.p_psi**2 - 4.0 * self.I1 * self.weight_torque * cos
         root = np.sqrt(np.where(disc >= 0.0, disc, np.nan))
         q = 0.5 * (self.p_psi + math.copysign(1.0, self.p_psi) * root)
-        den = self.I1 * cos
-        with np.errstate(divide="ignore"):
-            fast = np.where(den != 0.0, q / np.where(den != 0.0, den, 1.0), np.copysign(np.inf, q))
-        return np.stack([self.weight_torque / q, fast], axis=-1)
+        with np.errstate(divide="ignore", invalid="ignore"):  # θ = π/2: fast = ±inf; no spin: q may be 0
+            return np.stack([self.weight_torque / q, q / (self.I1 * cos)], axis=-1)
 
     # -- sleeping top -----------------------------------------------------------
 
@@ -447,12 +445,12 @@ class HeavyTop:
 
     @cached_property
     def _tau0(self) -> float:
-        """Phase ``τ₀``: ``sn²(τ₀) = (u₀ − u₁)/(u₂ − u₁)``, ``τ₀ = ±F(arcsin √·| m)``, sign of ``u̇₀ = −θ̇₀ sin θ₀``."""
+        """Phase: ``sn²(τ₀) = (u₀ − u₁)/(u₂ − u₁)``, ``τ₀ = ±F(arcsin √· | m)`` signed as ``u̇₀ = −θ̇₀ sin θ₀``."""
         x1, x2, _ = self._x
         if x2 == x1:
             return 0.0
-        s = math.sqrt(min(max(-x1 / (x2 - x1), 0.0), 1.0))
-        tau0 = float(elliprf(1.0 - s * s, 1.0 - self.modulus * s * s, 1.0)) * s  # F(arcsin s | m)
+        s2, c2 = min(max(-x1 / (x2 - x1), 0.0), 1.0), min(max(x2 / (x2 - x1), 0.0), 1.0)  # sin², cos² of am τ₀
+        tau0 = math.sqrt(s2) * float(elliprf(c2, 1.0 - self.modulus * s2, 1.0))  # F(arcsin √s2 | m)
         return -tau0 if self.theta_dot0 > 0.0 else tau0
 
     def _tau(self, t) -> np.ndarray:
@@ -463,7 +461,8 @@ class HeavyTop:
         """``(1 − u(t), 1 + u(t))`` without cancellation near either pole."""
         tau = self._tau(t)
         x1, x2, _ = self._x
-        sn2 = _sn2(tau, self.modulus)
+        _, sn, _ = _reduced_jacobi(tau, self.modulus)
+        sn2 = sn * sn
         return self._d_north - x1 - (x2 - x1) * sn2, self._d_south + x1 + (x2 - x1) * sn2
 
     def _pi_terms(self) -> list[tuple[float, float]]:
@@ -477,16 +476,14 @@ class HeavyTop:
         return [(half / at_u1, at_u2 / at_u1) for half, at_u1, at_u2 in pairs if half != 0.0]
 
     def _pi_integral(self, n_c: float, tau: np.ndarray) -> np.ndarray:
-        """``∫₀^τ dτ'/(1 − n sn²τ') = Π(n; am τ | m)``, with ``n_c = 1 − n``, continued past ``am τ = ±π/2``.
+        """``∫₀^τ dτ'/(1 − n sn²τ') = Π(n; am τ | m)``, ``n_c = 1 − n``, continued past ``am τ = ±π/2``.
 
         ``Π(n; jπ + φ) = 2jΠ(n) + Π(n; φ)`` with ``|φ| ≤ π/2``, and
         ``Π(n; φ) = s R_F(c², 1 − m s², 1) + (n/3) s³ R_J(c², 1 − m s², 1, c² + n_c s²)``,
-        ``s = sin φ``, ``c = cos φ`` (DLMF 19.25.5, 19.25.14).
+        ``s = sin φ = sn``, ``c = cos φ = cn`` (DLMF §19.25(i)).
         """
         m = self.modulus
-        k = float(ellipk(m))
-        j = np.round(tau / (2.0 * k))
-        s, c, _, _ = ellipj(tau - 2.0 * k * j, m)
+        j, s, c = _reduced_jacobi(tau, m)
         c2, s2, n = c * c, s * s, 1.0 - n_c
         delta2 = 1.0 - m * s2
         partial = s * elliprf(c2, delta2, 1.0) + (n / 3.0) * s * s2 * elliprj(c2, delta2, 1.0, c2 + n_c * s2)
@@ -592,7 +589,7 @@ def _vector(value, name: str) -> np.ndarray:
 
 
 def _axis_state(q, omega, axis_body: np.ndarray, up: np.ndarray) -> dict:
-    """θ, θ̇, φ̇, ω₃ and ``e_N`` of the body axis ``axis_body`` (unit) for states ``q``, ``omega`` (…, 4), (…, 3)."""
+    """θ, θ̇, φ̇, ω₃ and ``e_N`` of the unit body axis ``axis_body`` for states ``q`` (…, 4), ``omega`` (…, 3)."""
     e = attitude.rotate(q, axis_body)
     e_dot = np.cross(attitude.rotate(q, omega), e)
     horizontal = np.cross(up, e)                      # ẑ × e, |ẑ × e| = sin θ
@@ -619,17 +616,21 @@ def _bracketed_root(g, end: float, inner: float) -> float:
     return brentq(g, lo, hi, xtol=np.finfo(float).tiny, rtol=4.0 * np.finfo(float).eps)
 
 
-def _sn2(tau: np.ndarray, m: float) -> np.ndarray:
-    """``sn²(τ | m)``, reducing τ modulo the period 2K first."""
+def _reduced_jacobi(tau: np.ndarray, m: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(j, sn τ_r, cn τ_r)`` with ``τ = 2Kj + τ_r``, ``|τ_r| ≤ K`` (``sn²`` has period 2K; ``am τ = jπ + am τ_r``).
+
+    For ``m = 1`` (``K = ∞``): ``j = 0``, ``sn = tanh``, ``cn = sech``.
+    """
     k = float(ellipk(m))
-    if not math.isfinite(k):  # m = 1: sn = tanh, no period
-        return np.tanh(tau) ** 2
-    sn, _, _, _ = ellipj(tau - 2.0 * k * np.round(tau / (2.0 * k)), m)
-    return sn * sn
+    if not math.isfinite(k):
+        return np.zeros_like(tau), np.tanh(tau), 1.0 / np.cosh(tau)
+    j = np.round(tau / (2.0 * k))
+    sn, cn, _, _ = ellipj(tau - 2.0 * k * j, m)
+    return j, sn, cn
 
 
 def _complete_pi(n_c: float, m: float) -> float:
-    """Complete ``Π(n | m) = R_F(0, 1 − m, 1) + (n/3) R_J(0, 1 − m, 1, 1 − n)``, ``n_c = 1 − n`` (DLMF 19.25.2)."""
+    """``Π(n | m) = R_F(0, 1 − m, 1) + (n/3) R_J(0, 1 − m, 1, 1 − n)``, ``n_c = 1 − n`` (DLMF §19.25(i))."""
     return float(elliprf(0.0, 1.0 - m, 1.0) + (1.0 - n_c) / 3.0 * elliprj(0.0, 1.0 - m, 1.0, n_c))
 
 

@@ -37,7 +37,7 @@ from scipy.special import elliprf
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.analytic._free import free_parameters
-from tumble.analytic._geometry import _amplitude, _circled
+from tumble.analytic._geometry import _amplitude, _circled, _omega_principal
 from tumble.body import RigidBody
 
 __all__ = [
@@ -94,7 +94,7 @@ class StabilityReport:
     polhode_period: float
 
     def __str__(self) -> str:
-        lines = [f"principal axes of a {self.symmetry} body (moments ascending):"]
+        lines = [f"principal axes ({self.symmetry} body, moments ascending):"]
         for i, (moment, kind) in enumerate(zip(self.moments, self.axis_stability)):
             role = f" ({_ROLES[i]})" if self.symmetry == "asymmetric" else ""
             lines.append(f"  axis {i + 1}: I = {moment:.6g} kg m^2, {kind}{role}")
@@ -115,16 +115,6 @@ def _body(body) -> RigidBody:
     if not isinstance(body, RigidBody):
         raise ValidationError(f"body: must be a RigidBody, got {type(body).__name__}")
     return body
-
-
-def _omega_principal(body: RigidBody, omega) -> np.ndarray:
-    """``ω_P = R_BPᵀ ω_B`` (rad/s) for one rate of shape (3,)."""
-    omega = as_array(omega, "omega", tail=(3,))
-    if omega.shape != (3,):
-        raise ValidationError(f"omega: must have shape (3,), got {omega.shape}")
-    if not omega.any():
-        raise ValidationError("omega: must be non-zero (a body at rest has no motion to classify)")
-    return body.axes.T @ omega
 
 
 def classify_axes(body: RigidBody) -> tuple[str, str, str]:

@@ -1,14 +1,24 @@
 """Integrators: one engine for every model, compiled, batched over bodies.
 
-=========  =====  ============================================================
-method     order  notes
-=========  =====  ============================================================
-``rk4``    4      fixed step ``dt``, lands on every output time
-``dop853`` 8      adaptive (``rtol``, ``atol``), Dormand–Prince 8(5,3)
-=========  =====  ============================================================
+==============  =====  =======================================================
+method          order  notes
+==============  =====  =======================================================
+``rk4``         4      fixed step ``dt``; any torque
+``dop853``      8      adaptive (``rtol``, ``atol``), Dormand–Prince 8(5,3); any torque
+``cf4``         4      fixed step; commutator-free Lie-group method: ``|q| = 1``
+                       without projection; any torque
+``splitting2``  2      fixed step; Lie–Poisson splitting into exact rotations
+                       (Strang): ``|L|``, ``L_N`` and ``|q|`` kept to rounding,
+                       energy error bounded; torque-free bodies only
+``splitting4``  4      the same, composed to order 4 (Blanes–Moan S₆)
+``exact``       —      the closed-form free motion (Jacobi elliptic functions),
+                       no steps: exact to rounding at any time; torque-free only
+==============  =====  =======================================================
 
-Both normalise the attitude quaternion after every step (projection onto
-``|q| = 1``), return states exactly at the requested output times, and run a
+``rk4`` and ``dop853`` normalise the attitude quaternion after every step
+(projection onto ``|q| = 1``); the geometric methods move it by exact
+rotations only. Every method returns states exactly at the requested output
+times (the fixed-step ones land on them, see :mod:`._fixed`), and runs a
 batch of bodies in parallel over the cores (``numba.prange``) unless the
 model calls back into Python.
 
@@ -23,7 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble._validate import ValidationError, require_positive
-from tumble.integrate import _dop853, _rk4
+from tumble import _free_flow
+from tumble.integrate import _dop853, _fixed, _liegroup, _rk4, _splitting
 
 __all__ = ["METHODS", "Method", "SolverError", "solve"]
 
@@ -34,25 +45,54 @@ class SolverError(RuntimeError):
 
 @dataclass(frozen=True)
 class Method:
-    """An integration method: its name, order, and whether it adapts its step."""
+    """An integration method: its name, order, step policy, what it keeps and which torques it takes.
+
+    conserves : what the method keeps exactly, up to rounding (in words)
+    torque    : False for a method that integrates torque-free bodies only
+    stepper   : False for a closed form that needs no step (``"exact"``)
+    """
 
     name: str
     order: int
     adaptive: bool
     description: str
+    conserves: str = "|q| = 1 by projection"
+    torque: bool = True
+    stepper: bool = True
 
+
+_FREE_INVARIANTS = "|L|, L_N and |q| = 1 (exact rotations; energy error bounded, symplectic)"
 
 METHODS = {
     "rk4": Method("rk4", _rk4.ORDER, False, "classical Runge–Kutta, fixed step dt"),
     "dop853": Method("dop853", _dop853.ORDER, True, "Dormand–Prince 8(5,3), adaptive rtol/atol"),
+    "cf4": Method("cf4", _liegroup.ORDER, False,
+                  "commutator-free Lie-group method CF4 (Celledoni–Marthinsen–Owren 2003), fixed step dt",
+                  conserves="|q| = 1 without projection (exact rotations)"),
+    "splitting2": Method("splitting2", _splitting.ORDERS["splitting2"], False,
+                         "Lie–Poisson splitting of the free body into exact rotations, Strang, fixed step dt",
+                         conserves=_FREE_INVARIANTS, torque=False),
+    "splitting4": Method("splitting4", _splitting.ORDERS["splitting4"], False,
+                         "Lie–Poisson splitting of the free body into exact rotations, Blanes–Moan S6, "
+                         "fixed step dt", conserves=_FREE_INVARIANTS, torque=False),
+    "exact": Method("exact", 0, False, "closed-form torque-free motion (tumble.analytic.torque_free), no steps",
+                    conserves="T, |L|, L_N and |q| = 1 to rounding (the exact flow)", torque=False, stepper=False),
+}
+
+# Fixed-step methods: (compiled scheme, right-hand-side evaluations per step).
+_SCHEMES = {
+    "rk4": (_rk4.SCHEME, 4),
+    "cf4": (_liegroup.SCHEME, 4),
+    "splitting2": (_splitting.STRANG, 0),
+    "splitting4": (_splitting.BLANES_MOAN, 0),
 }
 
 # Output samples per chunk when progress is reported.
 _CHUNKS = 100
 
 
-def check_options(method: str, *, dt, rtol, atol, max_steps) -> Method:
-    """Validate the solver options; returns the :class:`Method`."""
+def check_options(method: str, *, dt, rtol, atol, max_steps, torque=None) -> Method:
+    """Validate the solver options for a run under ``torque`` (a torque model, or None); returns the :class:`Method`."""
     if method not in METHODS:
         raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
     m = METHODS[method]
@@ -63,11 +103,19 @@ def check_options(method: str, *, dt, rtol, atol, max_steps) -> Method:
             raise ValidationError(f"rtol: must be >= 1e-15 (float64 cannot do better), got {rtol}")
         if int(max_steps) < 1:
             raise ValidationError(f"max_steps: must be >= 1, got {max_steps}")
-    else:
+    elif m.stepper:
         if dt is None:
             raise ValidationError(f"dt: method {method!r} has a fixed step: give dt > 0 (s)")
         require_positive(dt, "dt")
+    if torque is not None and not m.torque:
+        _refuse_torque(method, f"torque={torque!r} given")
     return m
+
+
+def _refuse_torque(method, what):
+    others = ", ".join(repr(name) for name, m in METHODS.items() if m.torque)
+    raise ValidationError(f"torque: method {method!r} integrates torque-free bodies only (its steps are exact "
+                          f"rotations of the free rigid body), but {what}; use one of {others}")
 
 
 def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
@@ -80,13 +128,15 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
     calls back into Python). ``progress(done, total)`` is called after each
     chunk of output samples.
     """
-    check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+    m = check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+    if not m.torque and not getattr(model, "torque_free", False):
+        _refuse_torque(method, f"this {type(model).__name__} has a torque")
     y = np.array(y0, dtype=np.float64, order="C")
     n_out = t.shape[0]
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     stats = np.zeros((y.shape[0], 5))
     bounds = [0, n_out - 1]
-    if progress is not None and n_out > 2:
+    if progress is not None and n_out > 2 and m.stepper:
         bounds = np.unique(np.linspace(0, n_out - 1, min(_CHUNKS, n_out - 1) + 1).astype(int)).tolist()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
@@ -107,13 +157,16 @@ def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, se
     # One body, or a model that calls back into Python: no parallel region
     # (its start-up costs more than a short run, and callbacks need the GIL).
     serial = serial or y.shape[0] == 1
-    if method == "rk4":
+    if method == "exact":
+        _free_flow.exact_batch(model.moments, y, t, out)
+    elif method in _SCHEMES:
+        scheme, evaluations = _SCHEMES[method]
         if serial:
-            for k in range(-(-y.shape[0] // _rk4.LANES)):
-                _rk4.rk4_run_block(model, k, y, t, dt, out, stats)
+            for k in range(-(-y.shape[0] // _fixed.LANES)):
+                _fixed.run_block(scheme, model, k, y, t, dt, out, stats)
         else:
-            _rk4.rk4_batch(model, y, t, dt, out, stats)
-        stats[:, 2] = 4 * stats[:, 0]
+            _fixed.run_batch(scheme, model, y, t, dt, out, stats)
+        stats[:, 2] = evaluations * stats[:, 0]
     elif serial:
         for b in range(y.shape[0]):
             _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, _dop853.tableau(), out[:, b], stats[b])

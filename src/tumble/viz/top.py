@@ -30,7 +30,7 @@ __all__ = ["DEMO_TOP", "demo_top", "top_figure"]
 #: (about 1.6 × the critical spin of the sleeping top, 76.7 rad/s) and
 #: released at θ = 60° with φ̇ = −3 rad/s against its mean precession
 #: (+4.12 rad/s): the axis nutates between 60° and 79.2° every 0.166 s and
-#: draws a loop at each θ minimum, about 11 per precession revolution (1.52 s).
+#: draws a loop at each θ minimum, about 9 per precession revolution (1.52 s).
 DEMO_TOP = HeavyTop(I1=1.5e-3, I3=5e-4, mass=0.5, length=0.05, g=9.81,
                     theta0=math.radians(60.0), theta_dot0=0.0, phi_dot0=-3.0, spin=120.0)
 _DEMO_TOLERANCE = 1e-12          # dop853 rtol = atol

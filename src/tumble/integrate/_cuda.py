@@ -1,0 +1,242 @@
+"""Classical RK4 for a batch of rigid bodies on an NVIDIA GPU (``numba.cuda``): one thread per body.
+
+This is :mod:`tumble.integrate._rk4` applied to the :class:`tumble._rigid.RigidModel`,
+run as a CUDA kernel. Each thread keeps one body's state in registers,
+``y = [q_w, q_x, q_y, q_z, ω₁, ω₂, ω₃]`` (attitude of the principal axes P,
+P → inertial; body rate in P, rad/s), and advances it with the same
+arithmetic, step rule and landing as the CPU kernel:
+
+* between output times ``t_{k-1}`` and ``t_k`` it takes ``m = ⌈(t_k − t_{k-1})/dt⌉``
+  equal steps ``h = (t_k − t_{k-1})/m ≤ dt``, so it lands on every ``t_k``
+  (:func:`tumble.integrate._fixed.landing_steps`, the CPU's own rule);
+* the right-hand side is Euler's equations in principal axes with the
+  precomputed coefficients of :func:`tumble.dynamics.euler_coefficients`
+  (``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic, :func:`tumble.dynamics.euler_principal`)
+  and ``q̇ = ½ q ⊗ [0, ω]`` (:func:`tumble._quat.qmul`);
+* the quaternion is normalised after every step, ``q ← q/|q|``.
+
+The scalar kernels are the project's own ``njit`` functions (``qmul``,
+``qrotate_inv``, ``euler_principal``): ``numba.cuda`` compiles an ``@njit``
+function called from a kernel again, as a device function. The functions
+here that read arrays are :func:`~numba.extending.register_jitable` (plain
+Python until compiled), so that Numba's CUDA simulator can run them on its
+stand-in device arrays. The torques are the compiled torque programs of
+:mod:`tumble.torques` (``ConstantBody``, ``ConstantInertial``, ``Tabulated``,
+``Gravity``); a Python torque function cannot run on a GPU and is refused.
+
+Arithmetic is float64 throughout. NVVM fuses ``a·b + c`` into fused
+multiply–adds (its default), so on a GPU the results differ from the CPU's in
+the last bits of each step; under Numba's CUDA simulator
+(``NUMBA_ENABLE_CUDASIM=1``, how the tests run without a GPU) they are
+bitwise equal.
+
+Launch: :data:`THREADS_PER_BLOCK` threads per block, ``⌈N/128⌉`` blocks. Import
+this module only when a GPU run is asked for: it imports ``numba.cuda``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import cuda, njit, types
+from numba.extending import overload, register_jitable
+
+from tumble import _quat, torques
+from tumble._validate import ValidationError
+from tumble.dynamics import euler_principal
+from tumble.integrate._fixed import landing_steps
+
+#: Threads per block, a multiple of the warp (32). The kernel uses no shared
+#: memory, so what limits the warps resident on a multiprocessor is registers:
+#: on sm_90, 70 per thread torque-free and 156 with a torque program (ptxas),
+#: room for 28 and 12 of its 64 warps; 128 does not lower that. Not tuned on a GPU.
+THREADS_PER_BLOCK = 128
+
+# The same source as tumble.torques._tabulated, compiled inline: a plain
+# Python function, so that the CUDA simulator can run it on its device arrays.
+_tabulated = register_jitable(torques._tabulated.py_func)
+
+
+def cuda_available() -> bool:
+    """True when ``numba.cuda`` finds a usable GPU (or runs its simulator)."""
+    return cuda.is_available()
+
+
+@register_jitable
+def _quaternion_scale(qw, qx, qy, qz):
+    """``1/|q|``, as :func:`tumble._model.quaternion_scale` (``math.sqrt``: CUDA kernels have no ``np.sqrt``)."""
+    return 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+
+
+@register_jitable
+def _program_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    """The torque (N·m, principal axes) of a program of compiled terms: :func:`tumble.torques.evaluate`
+    without its Python callbacks, which cannot run on a GPU (:func:`solve_cuda` refuses them).
+
+    The same operations in the same order as ``evaluate``, so that the two
+    agree bit for bit (tested): ``q`` is first normalised, then the terms are
+    added in program order.
+    """
+    s = _quaternion_scale(qw, qx, qy, qz)
+    qw, qx, qy, qz = qw * s, qx * s, qy * s, qz * s
+    t1 = t2 = t3 = 0.0
+    for k in range(0, codes.shape[0], 2):
+        code, o = codes[k], codes[k + 1]
+        if code == torques._CONST_BODY:
+            a, b, c = P[row, o], P[row, o + 1], P[row, o + 2]
+        elif code == torques._CONST_INERTIAL:
+            a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o], P[row, o + 1], P[row, o + 2])
+        elif code == torques._TABULATED:
+            a, b, c = _tabulated(t, P, row, o)
+            if P[row, o + 1] != 0.0:
+                a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, a, b, c)
+        else:  # torques._GRAVITY: τ = (m r) × R(q)ᵀ g_N
+            gx, gy, gz = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o + 3], P[row, o + 4], P[row, o + 5])
+            rx, ry, rz = P[row, o], P[row, o + 1], P[row, o + 2]
+            a, b, c = ry * gz - rz * gy, rz * gx - rx * gz, rx * gy - ry * gx
+        t1 += a
+        t2 += b
+        t3 += c
+    return t1, t2, t3
+
+
+def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    """The torque (N·m, principal axes) of the program ``codes``, or zero for ``codes = ()``.
+
+    Compiled code picks the implementation from the type of ``codes`` (the
+    overload below), so that a torque-free kernel holds no torque code at all:
+    on sm_90 it needs 70 registers per thread instead of 156, over twice the
+    resident warps. The CUDA simulator runs this Python body.
+    """
+    if len(codes) == 0:
+        return 0.0, 0.0, 0.0
+    return _program_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
+
+
+@overload(_torque)
+def _torque_by_type(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    if isinstance(codes, types.BaseTuple):  # torque-free
+
+        def impl(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+            return 0.0, 0.0, 0.0
+
+        return impl
+    return _program_torque
+
+
+@register_jitable
+def _derivative(c, P, row, codes, t, y):
+    """``dy/dt`` of one body: ``½ q ⊗ [0, ω]`` and Euler's equations with coefficients ``c``."""
+    qw, qx, qy, qz, w1, w2, w3 = y
+    t1, t2, t3 = _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
+    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
+    a1, a2, a3 = euler_principal(c[0], c[1], c[2], c[3], c[4], c[5], w1, w2, w3, t1, t2, t3)
+    return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
+
+
+@register_jitable
+def _axpy(y, a, k):
+    """``y + a k`` for 7-tuples."""
+    return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3],
+            y[4] + a * k[4], y[5] + a * k[5], y[6] + a * k[6])
+
+
+@register_jitable
+def _rk4_step(c, P, row, codes, t, h, y):
+    """One RK4 step of length ``h`` from ``(t, y)``, then ``q ← q/|q|``."""
+    k1 = _derivative(c, P, row, codes, t, y)
+    k2 = _derivative(c, P, row, codes, t + 0.5 * h, _axpy(y, 0.5 * h, k1))
+    k3 = _derivative(c, P, row, codes, t + 0.5 * h, _axpy(y, 0.5 * h, k2))
+    k4 = _derivative(c, P, row, codes, t + h, _axpy(y, h, k3))
+    slope = (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0], k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1],
+             k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2], k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3],
+             k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4], k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5],
+             k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6])
+    qw, qx, qy, qz, w1, w2, w3 = _axpy(y, h / 6.0, slope)
+    s = _quaternion_scale(qw, qx, qy, qz)
+    return qw * s, qx * s, qy * s, qz * s, w1, w2, w3
+
+
+@njit(cache=True)
+def _landing(t_out, dt):
+    """``(m, h)``: the number ``m[k]`` and length ``h[k]`` (s) of the steps from ``t_out[k]`` to ``t_out[k+1]``.
+
+    The CPU's rule, :func:`tumble.integrate._fixed.landing_steps`, evaluated
+    once on the host (the built-in ``numba.cuda`` of Numba 0.68 cannot compile
+    its ``max`` for the device).
+    """
+    m = np.empty(t_out.shape[0] - 1, dtype=np.int64)
+    h = np.empty(t_out.shape[0] - 1)
+    for k in range(m.shape[0]):
+        m[k], h[k] = landing_steps(t_out[k + 1] - t_out[k], dt)
+    return m, h
+
+
+@cuda.jit(cache=True)
+def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
+    """Thread ``b`` integrates body ``b`` from ``y0[b]`` through ``t_out``, ``m[k]`` steps of ``h[k]``
+    from ``t_out[k]`` to ``t_out[k+1]``; ``out[k, b]`` receives its state at ``t_out[k]``."""
+    b = cuda.grid(1)
+    if b >= y0.shape[0]:
+        return
+    r = b if coefficients.shape[0] > 1 else 0
+    c = (coefficients[r, 0], coefficients[r, 1], coefficients[r, 2],
+         coefficients[r, 3], coefficients[r, 4], coefficients[r, 5])
+    row = b if P.shape[0] > 1 else 0
+    y = (y0[b, 0], y0[b, 1], y0[b, 2], y0[b, 3], y0[b, 4], y0[b, 5], y0[b, 6])
+    out[0, b, 0], out[0, b, 1], out[0, b, 2], out[0, b, 3], out[0, b, 4], out[0, b, 5], out[0, b, 6] = y
+    for k in range(1, t_out.shape[0]):
+        for s in range(m[k - 1]):
+            y = _rk4_step(c, P, row, codes, t_out[k - 1] + s * h[k - 1], h[k - 1], y)
+        out[k, b, 0], out[k, b, 1], out[k, b, 2], out[k, b, 3], out[k, b, 4], out[k, b, 5], out[k, b, 6] = y
+
+
+def solve_cuda(coefficients, params, codes, y0, t_out, dt) -> tuple[np.ndarray, dict]:
+    """Integrate a batch of rigid bodies with RK4 on the GPU.
+
+    Returns ``(states, stats)`` as :func:`tumble.integrate.solve` does: the
+    states (len(t_out), N, 7) at the output times and the statistics summed
+    over the batch (``n_steps``, ``n_rejected`` = 0, ``n_rhs`` = 4 ``n_steps``).
+
+    The arguments are the fields of a :class:`tumble._rigid.RigidModel`
+    (:func:`tumble._rigid.build`) and the initial states:
+
+    coefficients : (N or 1, 6) Euler coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``,
+                   one row per body or one shared
+    params : (N or 1, n_p) torque-program parameters in each body's principal axes
+    codes : int64 torque-program codes, or None for torque-free bodies
+    y0 : (N, 7) initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s)
+    t_out : (n,) output times (s), strictly increasing; ``t_out[0]`` is the start
+    dt : the longest step (s)
+
+    The states equal those of ``tumble.integrate.solve(model, y0, t_out, method="rk4", dt=dt)``
+    to the rounding of fused multiply–adds (bitwise under the CUDA simulator).
+    Raises :class:`~tumble._validate.ValidationError` for a Python torque
+    function, and when no GPU is found.
+    """
+    if codes is not None and np.any(np.asarray(codes)[0::2] == torques._PYTHON):
+        raise ValidationError(
+            "torque: a Python function cannot run on the GPU (device='cuda'); use the compiled models "
+            "(ConstantBody, ConstantInertial, Tabulated, Gravity) or device='cpu'"
+        )
+    if not cuda_available():
+        raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
+    y0 = np.ascontiguousarray(y0, dtype=np.float64)
+    t_out = np.ascontiguousarray(t_out, dtype=np.float64)
+    m, h = _landing(t_out, float(dt))
+    # torque-free: an empty tuple, and the kernel compiles without torque code (see _torque)
+    program = () if codes is None else cuda.to_device(np.ascontiguousarray(codes, dtype=np.int64))
+    out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
+    _rk4_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
+        cuda.to_device(np.ascontiguousarray(coefficients, dtype=np.float64)),
+        cuda.to_device(np.ascontiguousarray(params, dtype=np.float64)),
+        program,
+        cuda.to_device(y0),
+        cuda.to_device(t_out),
+        cuda.to_device(m),
+        cuda.to_device(h),
+        out,
+    )
+    n_steps = y0.shape[0] * int(m.sum())
+    return out.copy_to_host(), {"n_steps": n_steps, "n_rejected": 0, "n_rhs": 4 * n_steps}

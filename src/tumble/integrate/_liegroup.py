@@ -1,0 +1,172 @@
+"""Commutator-free Lie-group method of order 4 (CF4): the attitude moves by exact rotations.
+
+The attitude kinematics ``q̇ = ½ q ⊗ [0, ω]`` is an equation on the unit
+quaternions; a Runge–Kutta step leaves the sphere and must be projected back.
+A Lie-group method instead advances ``q`` only by products with quaternion
+exponentials, so ``|q| = 1`` holds to rounding without projection, and the
+rest of the state moves by the Euclidean method underneath.
+
+CF4 of E. Celledoni, A. Marthinsen & B. Owren, "Commutator-free Lie group
+methods", *Future Generation Computer Systems* 19 (2003) 341-352, written for
+the right action ``q ⊗ exp`` of body rates (``qexp(r)`` is the unit quaternion
+of the rotation vector ``r``; ``ωₛ`` is the body rate of stage ``s``, read
+from the model with :func:`tumble._model.body_rate`)::
+
+    Q₁ = q                                   ω₁ = ω(t,       Q₁, x₁)
+    Q₂ = q ⊗ qexp(h ω₁/2)                    ω₂ = ω(t + h/2, Q₂, x₂)
+    Q₃ = q ⊗ qexp(h ω₂/2)                    ω₃ = ω(t + h/2, Q₃, x₃)
+    Q₄ = Q₂ ⊗ qexp(h (ω₃ − ω₁/2))            ω₄ = ω(t + h,   Q₄, x₄)
+    q ← q ⊗ qexp(h (3ω₁ + 2ω₂ + 2ω₃ − ω₄)/12) ⊗ qexp(h (−ω₁ + 2ω₂ + 2ω₃ + 3ω₄)/12)
+
+The rest of the state ``x`` (the body rate, and whatever a model adds) takes
+the stages and weights of classical RK4 (``x₂ = x + h k₁/2``, …,
+``x ← x + h (k₁ + 2k₂ + 2k₃ + k₄)/6``), which is what CF4 reduces to on a
+vector space; the method is of order 4 for any torque model.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, types
+from numba.extending import overload
+
+from tumble import _quat
+from tumble._model import body_rate, rhs
+from tumble.integrate import _fixed
+
+ORDER = 4
+
+# Exponent weights of the two final exponentials (applied first: W1).
+_W1 = (3.0 / 12.0, 2.0 / 12.0, 2.0 / 12.0, -1.0 / 12.0)
+_W2 = (-1.0 / 12.0, 2.0 / 12.0, 2.0 / 12.0, 3.0 / 12.0)
+
+
+class CF4(NamedTuple):
+    """The commutator-free Lie-group method of order 4 (no parameters)."""
+
+
+SCHEME = CF4()
+
+
+@njit(cache=True, inline="always")
+def rotate_right(qw, qx, qy, qz, rx, ry, rz):
+    """``q ⊗ qexp(r)``: ``q`` followed by the rotation of rotation vector ``r`` (rad, body axes)."""
+    ew, ex, ey, ez = _quat.qexp(rx, ry, rz)
+    return times_unit(qw, qx, qy, qz, ew, ex, ey, ez)
+
+
+@njit(cache=True, inline="always")
+def times_unit(qw, qx, qy, qz, ew, ex, ey, ez):
+    """``q ⊗ e`` for a unit quaternion ``e`` (an exponential of :func:`tumble._quat.qexp`), keeping ``|q|``.
+
+    Computed as ``q + q ⊗ (e − 1)`` with the scalar part of ``e − 1`` formed
+    as ``−|e_v|²/(1 + e_w)`` rather than ``e_w − 1``: for the small rotations
+    of a time step, ``e_w`` rounds to a value next to 1 whose error repeats
+    from step to step, and the plain product would let ``|q|`` drift linearly
+    (measured 4e-11 after 2e6 rotations of ~1e-4 rad); this way only the
+    rounding errors of the small increment and of the final sums remain, and
+    they average out (``|q| − 1`` grows like √steps × 1e-16).
+    """
+    # e_w ≥ 0 for rotations up to π; beyond, e_w − 1 has no cancellation
+    gw = -(ex * ex + ey * ey + ez * ez) / (1.0 + ew) if ew > 0.0 else ew - 1.0
+    dw, dx, dy, dz = _quat.qmul(qw, qx, qy, qz, gw, ex, ey, ez)
+    return qw + dw, qx + dx, qy + dy, qz + dz
+
+
+def _is_cf4(scheme):
+    return isinstance(scheme, types.BaseNamedTuple) and scheme.instance_class is CF4
+
+
+@overload(_fixed.workspace, jit_options={"cache": True})
+def _cf4_workspace(scheme, model, Y):
+    if not _is_cf4(scheme):
+        return None
+
+    def impl(scheme, model, Y):
+        lanes = Y.size // Y.shape[0]  # 1 for one body's state vector
+        n = Y.shape[0]
+        # derivatives k₁…k₄ and the stage state (state × lanes), stage rates ω₁…ω₄, Q₂
+        return (np.empty((4, n, lanes)), np.empty((n, lanes)), np.empty((4, 3, lanes)), np.empty((4, lanes)))
+
+    return impl
+
+
+@overload(_fixed.advance, jit_options={"cache": True})
+def _cf4_advance(scheme, model, b0, t0, h, m, Y, work):
+    if not _is_cf4(scheme):
+        return None
+
+    def impl(scheme, model, b0, t0, h, m, Y, work):
+        K, S, W, Q2 = work
+        # one body's state vector runs as a block of one lane
+        y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))
+        for s in range(m):
+            _cf4_step(model, b0, t0 + s * h, h, y, K, S, W, Q2)
+
+    return impl
+
+
+@njit(cache=True)
+def _stage(model, b0, t, S, K, W, s):
+    """Evaluate stage ``s`` at the stage state ``S``: ``K[s] = f(t, S)`` and ``W[s] = ω(S)``."""
+    rhs(model, b0, t, S, K[s])
+    for j in range(S.shape[1]):
+        W[s, 0, j], W[s, 1, j], W[s, 2, j] = body_rate(model, S, j)
+
+
+@njit(cache=True)
+def _euclidean(Y, K, s, c, S):
+    """``S[4:] = Y[4:] + c K[s][4:]``: the Runge–Kutta stage of the state after the quaternion."""
+    for i in range(4, Y.shape[0]):
+        for j in range(Y.shape[1]):
+            S[i, j] = Y[i, j] + c * K[s, i, j]
+
+
+# error_model="numpy": IEEE division without Python's zero check (2x in the
+# rotation loops of the splitting methods); no divisor here can be zero.
+@njit(cache=True, error_model="numpy")
+def _cf4_step(model, b0, t, h, Y, K, S, W, Q2):
+    """One CF4 step of ``h`` (s) from ``t`` for the block ``Y`` (state × lanes), in place."""
+    lanes = Y.shape[1]
+    _stage(model, b0, t, Y, K, W, 0)
+    for j in range(lanes):
+        q = rotate_right(Y[0, j], Y[1, j], Y[2, j], Y[3, j], 0.5 * h * W[0, 0, j], 0.5 * h * W[0, 1, j],
+                         0.5 * h * W[0, 2, j])
+        S[0, j], S[1, j], S[2, j], S[3, j] = q
+        Q2[0, j], Q2[1, j], Q2[2, j], Q2[3, j] = q
+    _euclidean(Y, K, 0, 0.5 * h, S)
+    _stage(model, b0, t + 0.5 * h, S, K, W, 1)
+    for j in range(lanes):
+        S[0, j], S[1, j], S[2, j], S[3, j] = rotate_right(
+            Y[0, j], Y[1, j], Y[2, j], Y[3, j], 0.5 * h * W[1, 0, j], 0.5 * h * W[1, 1, j], 0.5 * h * W[1, 2, j]
+        )
+    _euclidean(Y, K, 1, 0.5 * h, S)
+    _stage(model, b0, t + 0.5 * h, S, K, W, 2)
+    for j in range(lanes):
+        S[0, j], S[1, j], S[2, j], S[3, j] = rotate_right(
+            Q2[0, j], Q2[1, j], Q2[2, j], Q2[3, j], h * (W[2, 0, j] - 0.5 * W[0, 0, j]),
+            h * (W[2, 1, j] - 0.5 * W[0, 1, j]), h * (W[2, 2, j] - 0.5 * W[0, 2, j])
+        )
+    _euclidean(Y, K, 2, h, S)
+    _stage(model, b0, t + h, S, K, W, 3)
+    for j in range(lanes):
+        r1 = _combine(W, _W1, h, j)
+        r2 = _combine(W, _W2, h, j)
+        q = rotate_right(Y[0, j], Y[1, j], Y[2, j], Y[3, j], r1[0], r1[1], r1[2])
+        Y[0, j], Y[1, j], Y[2, j], Y[3, j] = rotate_right(q[0], q[1], q[2], q[3], r2[0], r2[1], r2[2])
+    for i in range(4, Y.shape[0]):
+        for j in range(lanes):
+            Y[i, j] += h / 6.0 * (K[0, i, j] + 2.0 * K[1, i, j] + 2.0 * K[2, i, j] + K[3, i, j])
+
+
+@njit(cache=True, inline="always")
+def _combine(W, weights, h, j):
+    """The rotation vector ``h Σₛ weights[s] ωₛ`` of lane ``j`` (rad)."""
+    a, b, c, d = weights
+    return (
+        h * (a * W[0, 0, j] + b * W[1, 0, j] + c * W[2, 0, j] + d * W[3, 0, j]),
+        h * (a * W[0, 1, j] + b * W[1, 1, j] + c * W[2, 1, j] + d * W[3, 1, j]),
+        h * (a * W[0, 2, j] + b * W[1, 2, j] + c * W[2, 2, j] + d * W[3, 2, j]),
+    )
