@@ -191,3 +191,31 @@ def test_gpu_equals_cpu():
     cpu, _ = integrate.solve(model, y0, T_OUT, method="rk4", dt=DT)
     gpu, _ = _cuda.solve_cuda(model.coefficients, model.params, model.codes, y0, T_OUT, DT)
     np.testing.assert_allclose(gpu, cpu, rtol=0, atol=TOL_GPU)
+
+
+def test_simulate_refuses_bad_device_settings():
+    body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+    with pytest.raises(tumble.ValidationError, match="device"):
+        tumble.simulate(body, [0.1, 1.0, 0.1], t=[0.0, 1.0], method="rk4", dt=0.1, device="tpu")
+    with pytest.raises(tumble.ValidationError, match="device: 'cuda' runs method='rk4'"):
+        tumble.simulate(body, [0.1, 1.0, 0.1], t=[0.0, 1.0], device="cuda")
+
+
+def test_simulate_device_cuda_equals_cpu_under_the_simulator(tmp_path):
+    # End to end through simulate(): body axes in and out, a torque, a batch of 3.
+    script = (
+        "import numpy as np, tumble\n"
+        "body = tumble.RigidBody(np.array([[2.0, 0.1, 0.0], [0.1, 3.0, 0.2], [0.0, 0.2, 4.0]]))\n"
+        "w = np.array([[0.3, 1.0, -0.2], [1.0, 0.1, 0.5], [0.0, 0.2, 2.0]])\n"
+        "tr = tumble.simulate(body, w, t=[0.0, 0.05, 0.12], method='rk4', dt=0.02, device='cuda',\n"
+        "                     torque=tumble.torques.ConstantInertial([0.0, 0.1, 0.0]))\n"
+        f"np.savez({str(tmp_path / 'gpu.npz')!r}, q=tr.q, omega=tr.omega)\n"
+    )
+    env = {**os.environ, "NUMBA_ENABLE_CUDASIM": "1"}
+    subprocess.run([sys.executable, "-c", script], check=True, env=env, timeout=600)
+    gpu = np.load(tmp_path / "gpu.npz")
+    body = tumble.RigidBody(np.array([[2.0, 0.1, 0.0], [0.1, 3.0, 0.2], [0.0, 0.2, 4.0]]))
+    w = np.array([[0.3, 1.0, -0.2], [1.0, 0.1, 0.5], [0.0, 0.2, 2.0]])
+    cpu = tumble.simulate(body, w, t=[0.0, 0.05, 0.12], method="rk4", dt=0.02,
+                          torque=tumble.torques.ConstantInertial([0.0, 0.1, 0.0]))
+    assert np.array_equal(gpu["q"], cpu.q) and np.array_equal(gpu["omega"], cpu.omega)  # bitwise (simulator)

@@ -40,6 +40,8 @@ module: a NamedTuple, its overloads, and a row in ``docs/architecture.md``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -86,7 +88,7 @@ def quaternion_scale(qw, qx, qy, qz):
     Projecting after every accepted step keeps it at 1 to rounding without
     changing the order of the method.
     """
-    return 1.0 / np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    return 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
 
 
 @njit(cache=True)

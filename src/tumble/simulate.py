@@ -39,6 +39,7 @@ def simulate(
     torque=None,
     max_steps: int = 10**9,
     progress: Callable[[int, int], None] | None = None,
+    device: str = "cpu",
 ) -> Trajectory:
     """Integrate the rotation of a rigid body (or a batch of bodies) through the times ``t``.
 
@@ -69,6 +70,10 @@ def simulate(
         Adaptive steps allowed per body before :class:`~tumble.integrate.SolverError`.
     progress : callable ``progress(done, total)``, optional
         Called as output samples are completed (the CLI draws a progress bar).
+        Not available with ``device="cuda"``.
+    device : {"cpu", "cuda"}
+        ``"cuda"`` runs ``method="rk4"`` batches on an NVIDIA GPU, one thread
+        per body (compiled torque models only; see ``docs/gpu.md``).
 
     Returns
     -------
@@ -77,6 +82,11 @@ def simulate(
         energy, angular momentum and their drifts.
     """
     method = str(method)
+    if device not in ("cpu", "cuda"):
+        raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
+    if device == "cuda" and (method != "rk4" or progress is not None):
+        raise ValidationError(f"device: 'cuda' runs method='rk4' without progress reporting, got method={method!r}"
+                              + (" and a progress callback" if progress is not None else ""))
     m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque)
     times = _output_times(t)
     bodies, batch_inertia = _bodies(body)
@@ -99,11 +109,16 @@ def simulate(
     y0[:, 4:] = np.einsum("bji,bj->bi", axes, omega0)
     rigid = _rigid.build(bodies, model)
 
-    with torques.registered(model):
-        states, stats = integrate.solve(
-            rigid, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
-            max_steps=max_steps, serial=model is not None and model.needs_python, progress=progress,
-        )
+    if device == "cuda":
+        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
+
+        states, stats = _cuda.solve_cuda(rigid.coefficients, rigid.params, rigid.codes, y0, times, dt)
+    else:
+        with torques.registered(model):
+            states, stats = integrate.solve(
+                rigid, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
+                max_steps=max_steps, serial=model is not None and model.needs_python, progress=progress,
+            )
 
     q = attitude.multiply(states[..., :4], attitude.conjugate(q_bp))
     omega = np.einsum("bij,tbj->tbi", axes, states[..., 4:])

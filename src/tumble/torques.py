@@ -32,10 +32,12 @@ principal axes, where the integrators work; :func:`evaluate` runs a program.
 from __future__ import annotations
 
 import itertools
+import math
 from contextlib import contextmanager
 
 import numpy as np
 from numba import njit, objmode
+from numba.extending import register_jitable
 
 from tumble import _quat
 from tumble._validate import ValidationError, as_array, require_positive
@@ -311,7 +313,9 @@ def _call_python(slot, t, q, omega, out):
 
 @njit(cache=True)
 def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o):
-    """Call a PythonTorque: convert the principal-axes state to body axes and back."""
+    """Call a PythonTorque: convert the principal-axes state (``q`` normalised here) to body axes and back."""
+    s = 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    qw, qx, qy, qz = qw * s, qx * s, qy * s, qz * s
     slot = int(P[row, o])
     r = P[row, o + 1 : o + 10]  # R_BP, row-major
     qb = _quat.qmul(qw, qx, qy, qz, P[row, o + 10], -P[row, o + 11], -P[row, o + 12], -P[row, o + 13])
@@ -333,7 +337,7 @@ def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o):
     )
 
 
-@njit(cache=True)
+@register_jitable
 def _tabulated(t, P, row, o):
     """Interpolate a Tabulated block at ``t`` (scalar reads only: no array views in the hot loop)."""
     n = int(P[row, o])
@@ -362,16 +366,19 @@ def _tabulated(t, P, row, o):
     return a, b, c
 
 
-@njit(cache=True)
-def evaluate(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
-    """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
+@register_jitable
+def evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    """The compiled terms of the torque program in row ``row`` of ``P`` (all but Python callbacks):
+    the torque (N·m) in the axes it was compiled for.
 
     ``q`` (normalised here) maps those axes to inertial axes, ``omega`` is
-    expressed in them.
+    expressed in them. A plain function compiled into its callers, the CPU
+    integrators (through :func:`evaluate`) and the CUDA kernel of
+    :mod:`tumble.integrate._cuda` alike.
     """
     # Runge–Kutta stage states are off the unit sphere by about the local error:
     # rotate by q/|q| so that the torque does not depend on the body axes chosen.
-    s = 1.0 / np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    s = 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
     qw, qx, qy, qz = qw * s, qx * s, qy * s, qz * s
     t1 = t2 = t3 = 0.0
     for k in range(0, codes.shape[0], 2):
@@ -389,9 +396,25 @@ def evaluate(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
             gx, gy, gz = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o + 3], P[row, o + 4], P[row, o + 5])
             rx, ry, rz = P[row, o], P[row, o + 1], P[row, o + 2]
             a, b, c = ry * gz - rz * gy, rz * gx - rx * gz, rx * gy - ry * gx
-        else:
-            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o)
+        else:  # a Python callback: see evaluate
+            continue
         t1 += a
         t2 += b
         t3 += c
+    return t1, t2, t3
+
+
+@njit(cache=True)
+def evaluate(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
+
+    The compiled terms (:func:`evaluate_compiled`), then the Python callbacks.
+    """
+    t1, t2, t3 = evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
+    for k in range(0, codes.shape[0], 2):
+        if codes[k] == _PYTHON:
+            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes[k + 1])
+            t1 += a
+            t2 += b
+            t3 += c
     return t1, t2, t3

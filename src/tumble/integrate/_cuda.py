@@ -43,6 +43,7 @@ from numba import cuda, njit, types
 from numba.extending import overload, register_jitable
 
 from tumble import _quat, torques
+from tumble._model import quaternion_scale
 from tumble._validate import ValidationError
 from tumble.dynamics import euler_principal
 from tumble.integrate._fixed import landing_steps
@@ -53,52 +54,9 @@ from tumble.integrate._fixed import landing_steps
 #: room for 28 and 12 of its 64 warps; 128 does not lower that. Not tuned on a GPU.
 THREADS_PER_BLOCK = 128
 
-# The same source as tumble.torques._tabulated, compiled inline: a plain
-# Python function, so that the CUDA simulator can run it on its device arrays.
-_tabulated = register_jitable(torques._tabulated.py_func)
-
-
 def cuda_available() -> bool:
     """True when ``numba.cuda`` finds a usable GPU (or runs its simulator)."""
     return cuda.is_available()
-
-
-@register_jitable
-def _quaternion_scale(qw, qx, qy, qz):
-    """``1/|q|``, as :func:`tumble._model.quaternion_scale` (``math.sqrt``: CUDA kernels have no ``np.sqrt``)."""
-    return 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-
-
-@register_jitable
-def _program_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
-    """The torque (N·m, principal axes) of a program of compiled terms: :func:`tumble.torques.evaluate`
-    without its Python callbacks, which cannot run on a GPU (:func:`solve_cuda` refuses them).
-
-    The same operations in the same order as ``evaluate``, so that the two
-    agree bit for bit (tested): ``q`` is first normalised, then the terms are
-    added in program order.
-    """
-    s = _quaternion_scale(qw, qx, qy, qz)
-    qw, qx, qy, qz = qw * s, qx * s, qy * s, qz * s
-    t1 = t2 = t3 = 0.0
-    for k in range(0, codes.shape[0], 2):
-        code, o = codes[k], codes[k + 1]
-        if code == torques._CONST_BODY:
-            a, b, c = P[row, o], P[row, o + 1], P[row, o + 2]
-        elif code == torques._CONST_INERTIAL:
-            a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o], P[row, o + 1], P[row, o + 2])
-        elif code == torques._TABULATED:
-            a, b, c = _tabulated(t, P, row, o)
-            if P[row, o + 1] != 0.0:
-                a, b, c = _quat.qrotate_inv(qw, qx, qy, qz, a, b, c)
-        else:  # torques._GRAVITY: τ = (m r) × R(q)ᵀ g_N
-            gx, gy, gz = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o + 3], P[row, o + 4], P[row, o + 5])
-            rx, ry, rz = P[row, o], P[row, o + 1], P[row, o + 2]
-            a, b, c = ry * gz - rz * gy, rz * gx - rx * gz, rx * gy - ry * gx
-        t1 += a
-        t2 += b
-        t3 += c
-    return t1, t2, t3
 
 
 def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
@@ -111,7 +69,7 @@ def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
     """
     if len(codes) == 0:
         return 0.0, 0.0, 0.0
-    return _program_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
+    return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
 
 
 @overload(_torque)
@@ -122,7 +80,7 @@ def _torque_by_type(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
             return 0.0, 0.0, 0.0
 
         return impl
-    return _program_torque
+    return torques.evaluate_compiled
 
 
 @register_jitable
@@ -154,7 +112,7 @@ def _rk4_step(c, P, row, codes, t, h, y):
              k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4], k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5],
              k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6])
     qw, qx, qy, qz, w1, w2, w3 = _axpy(y, h / 6.0, slope)
-    s = _quaternion_scale(qw, qx, qy, qz)
+    s = quaternion_scale(qw, qx, qy, qz)
     return qw * s, qx * s, qy * s, qz * s, w1, w2, w3
 
 
