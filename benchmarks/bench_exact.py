@@ -25,13 +25,13 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 
 import numba
 import numpy as np
 
 import tumble
+from _timing import best_of
 from tumble import attitude
 from tumble.analytic._free import torque_free
 
@@ -53,16 +53,6 @@ OTHER_BODIES = {"oblate top (1, 1, 2)": [1.0, 1.0, 2.0], "on the separatrix (3, 
 
 def body_of(case):
     return tumble.RigidBody(np.diag(OTHER_BODIES.get(case, MOMENTS)))
-
-
-def best_of(repeats, fn):
-    """Smallest wall time of ``repeats`` calls of ``fn`` (s) and its last result."""
-    best, result = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, result
 
 
 def motion_error(a, b):

@@ -18,12 +18,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import time
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
 import tumble
+from _timing import best_of
 from tumble import _rigid
 from tumble.integrate import _rk4
 
@@ -33,16 +33,6 @@ OMEGA0 = np.array([1e-3, 1.0, 1e-3])          # rad/s: near the intermediate axi
 # differences of 1e-16 grow to 1e-9 in 100 s, and no reference can tell methods apart.
 OMEGA0_ACCURACY = np.array([1.0, 0.2, 0.5])
 Q0 = np.array([1.0, 0.0, 0.0, 0.0])
-
-
-def best_of(repeats, fn):
-    """Smallest wall time of ``repeats`` calls of ``fn`` (s) and its last result."""
-    best, result = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, result
 
 
 def euler_rhs(t, y):

@@ -18,13 +18,13 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import time
 
 import numpy as np
 from numba import cuda
 from numba.core import config
 
 import tumble
+from _timing import best_of
 from tumble import _rigid, attitude, integrate
 from tumble.dynamics import euler_coefficients
 from tumble.integrate import _cuda
@@ -66,12 +66,7 @@ def kernel_seconds(coefficients, y0, t):
 
 def wall_seconds(fn, repeats=3):
     """Best wall time (s) of ``fn()`` and its last result."""
-    best, result = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, result
+    return best_of(repeats, fn)
 
 
 def main():
