@@ -24,27 +24,17 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
-import time
 
 import numpy as np
 
 import tumble
+from _timing import best_of
 from tumble import _rigid, dynamics
 from tumble.integrate import _fixed, _splitting
 
 MOMENTS = np.array([1.0, 2.0, 3.0])           # kg m², principal axes = body axes
 OMEGA0 = np.array([0.3, 1.0, -0.2])            # rad/s
 METHODS = ("rk4", "splitting2", "splitting4", "cf4")
-
-
-def best_of(repeats, fn):
-    """Smallest wall time of ``repeats`` calls of ``fn`` (s) and its last result."""
-    best, result = np.inf, None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, result
 
 
 def speed(method, n_bodies, steps_single, steps_batch):

@@ -58,11 +58,13 @@ def simulate(
     q0 : (4,) or (N, 4) array_like, optional
         Initial attitude, unit quaternion ``[w, x, y, z]`` mapping body →
         inertial axes (normalised here; default: identity).
-    method : {"dop853", "rk4", "cf4", "splitting2", "splitting4", "exact"}
-        Adaptive 8th-order Dormand–Prince (``rtol``, ``atol``); classical
-        Runge–Kutta, the Lie-group method or the Lie–Poisson splittings with
-        fixed step ``dt`` (s); or the closed-form torque-free motion (no step).
-        See :mod:`tumble.integrate` and ``docs/integrators.md``.
+    method : str, one of ``tumble.integrate.METHODS``
+        ``"dop853"``: adaptive 8th-order Dormand–Prince (``rtol``, ``atol``);
+        ``"rk4"``, ``"cf4"`` (Lie group), ``"splitting2"``/``"splitting4"``
+        (Lie–Poisson, torque-free), ``"exact_split2"``/``"exact_split4"``
+        (exact free flow + torque kicks): fixed step ``dt`` (s); ``"exact"``:
+        the closed-form torque-free motion (no step). See
+        :mod:`tumble.integrate` and ``docs/integrators.md``.
     torque : TorqueModel, callable ``f(t, q, omega) -> (3,)``, or None
         External torque in body axes (N·m); see :mod:`tumble.torques`. Python
         callables run at Python speed and on one core.

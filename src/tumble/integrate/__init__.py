@@ -1,19 +1,22 @@
 """Integrators: one engine for every model, compiled, batched over bodies.
 
-==============  =====  =======================================================
-method          order  notes
-==============  =====  =======================================================
-``rk4``         4      fixed step ``dt``; any torque
-``dop853``      8      adaptive (``rtol``, ``atol``), Dormand–Prince 8(5,3); any torque
-``cf4``         4      fixed step; commutator-free Lie-group method: ``|q| = 1``
-                       without projection; any torque
-``splitting2``  2      fixed step; Lie–Poisson splitting into exact rotations
-                       (Strang): ``|L|``, ``L_N`` and ``|q|`` kept to rounding,
-                       energy error bounded; torque-free bodies only
-``splitting4``  4      the same, composed to order 4 (Blanes–Moan S₆)
-``exact``       —      the closed-form free motion (Jacobi elliptic functions),
-                       no steps: exact to rounding at any time; torque-free only
-==============  =====  =======================================================
+================  =====  =======================================================
+method            order  notes
+================  =====  =======================================================
+``rk4``           4      fixed step ``dt``; any torque
+``dop853``        8      adaptive (``rtol``, ``atol``), Dormand–Prince 8(5,3); any torque
+``cf4``           4      fixed step; commutator-free Lie-group method: ``|q| = 1``
+                         without projection; any torque
+``splitting2``    2      fixed step; Lie–Poisson splitting into exact rotations
+                         (Strang): ``|L|``, ``L_N`` and ``|q|`` kept to rounding,
+                         energy error bounded; torque-free bodies only
+``splitting4``    4      the same, composed to order 4 (Blanes–Moan S₆)
+``exact_split2``  2      fixed step; exact free flow composed with torque kicks
+                         (Strang): symplectic for potential torques (heavy top)
+``exact_split4``  4      the same, composed to order 4 (Blanes–Moan S₆)
+``exact``         —      the closed-form free motion (Jacobi elliptic functions),
+                         no steps: exact to rounding at any time; torque-free only
+================  =====  =======================================================
 
 ``rk4`` and ``dop853`` normalise the attitude quaternion after every step
 (projection onto ``|q| = 1``); the geometric methods move it by exact
@@ -34,7 +37,7 @@ import numpy as np
 
 from tumble._validate import ValidationError, require_positive
 from tumble import _free_flow
-from tumble.integrate import _dop853, _fixed, _liegroup, _rk4, _splitting
+from tumble.integrate import _dop853, _exactsplit, _fixed, _liegroup, _rk4, _splitting
 
 __all__ = ["METHODS", "Method", "SolverError", "solve"]
 
@@ -63,6 +66,9 @@ class Method:
 
 _FREE_INVARIANTS = "|L|, L_N and |q| = 1 (exact rotations; energy error bounded, symplectic)"
 
+_SPLIT_INVARIANTS = ("symplectic for a torque from a potential (heavy top): energy error bounded, the momentum "
+                     "about g kept to rounding; torque-free: the exact motion")
+
 METHODS = {
     "rk4": Method("rk4", _rk4.ORDER, False, "classical Runge–Kutta, fixed step dt"),
     "dop853": Method("dop853", _dop853.ORDER, True, "Dormand–Prince 8(5,3), adaptive rtol/atol"),
@@ -75,6 +81,12 @@ METHODS = {
     "splitting4": Method("splitting4", _splitting.ORDERS["splitting4"], False,
                          "Lie–Poisson splitting of the free body into exact rotations, Blanes–Moan S6, "
                          "fixed step dt", conserves=_FREE_INVARIANTS, torque=False),
+    "exact_split2": Method("exact_split2", _exactsplit.ORDERS["exact_split2"], False,
+                           "exact free flow composed with torque kicks, Strang, fixed step dt",
+                           conserves=_SPLIT_INVARIANTS),
+    "exact_split4": Method("exact_split4", _exactsplit.ORDERS["exact_split4"], False,
+                           "exact free flow composed with torque kicks, Blanes–Moan S6, fixed step dt",
+                           conserves=_SPLIT_INVARIANTS),
     "exact": Method("exact", 0, False, "closed-form torque-free motion (tumble.analytic.torque_free), no steps",
                     conserves="T, |L|, L_N and |q| = 1 to rounding (the exact flow)", torque=False, stepper=False),
 }
@@ -85,6 +97,8 @@ _SCHEMES = {
     "cf4": (_liegroup.SCHEME, 4),
     "splitting2": (_splitting.STRANG, 0),
     "splitting4": (_splitting.BLANES_MOAN, 0),
+    "exact_split2": (_exactsplit.STRANG, 4),       # torque evaluations: one RK4 kick per step
+    "exact_split4": (_exactsplit.BLANES_MOAN, 24),  # six
 }
 
 # Output samples per chunk when progress is reported.

@@ -1,0 +1,174 @@
+"""Exact-flow splitting: the closed-form free motion composed with torque kicks (symplectic for potentials).
+
+The equations of a rigid body under a torque, in principal axes P,
+
+    I ω̇ + ω × (I ω) = τ(t, q, ω),      q̇ = ½ q ⊗ [0, ω],
+
+are split into the free body ``F`` (``τ = 0``; its flow is known in closed
+form, :mod:`tumble._free_flow`, and advances the time ``t``) and the kick
+``K``: ``q`` and ``t`` held fixed, ``ω̇ = I⁻¹ τ(t, q, ω)``. For a torque that
+does not depend on ``ω`` (every compiled torque of :mod:`tumble.torques`:
+constant, tabulated, gravity) the kick is exact: ``ω ← ω + c h I⁻¹ τ(t, q)``.
+A step composes them as
+
+    K(a₀h) F(b₁h) K(a₁h) … F(b_sh) K(a_sh)
+
+with the last kick of a step merged with the first of the next (the same
+``t`` and ``q``). When the torque comes from a potential ``V(q)`` (the heavy
+top :class:`tumble.torques.Gravity`, ``V = −m g·(R r)``) both parts are
+Hamiltonian flows on T*SO(3), so the step is a symplectic (Poisson) map (R. I.
+McLachlan, "Explicit Lie–Poisson integration and the Euler equations", *Phys.
+Rev. Lett.* 71 (1993) 3043; A. Dullweber, B. Leimkuhler & R. McLachlan, "Symplectic splitting methods for
+rigid body molecular dynamics", *J. Chem. Phys.* 107 (1997) 5840): the energy
+error stays bounded, and a kick by a torque that is the moment of a force
+along ``g`` leaves the inertial momentum about ``g`` unchanged, as the free
+flow does, so ``L_z`` is kept to rounding.
+
+A torque that depends on ``ω`` (a Python callback, a damper) has no exact
+kick: the kick is then one classical RK4 step of ``ω̇ = I⁻¹ τ(t, q, ω)``,
+accurate to ``O(h⁵)`` per step, so the composition keeps its order (2 or 4)
+but is no longer symplectic. For an ``ω``-independent torque the four stages
+are equal and the RK4 step is the exact kick (to rounding).
+
+Two compositions (symmetric: time-reversible where the kicks are exact):
+
+* ``STRANG`` (``exact_split2``, order 2): ``a = (½, ½)``, ``b = (1,)``; one free
+  flow and one kick (merged) per step.
+* ``BLANES_MOAN`` (``exact_split4``, order 4): the S₆ coefficients of
+  :mod:`._splitting` (S. Blanes & P. C. Moan, *J. Comput. Appl. Math.* 142
+  (2002) 313, Table 2), kicks in the role of ``A``; six free flows (two of
+  them backward in time: the exact flow allows it) and six kicks per step. At
+  equal work (free flows per second) it had a 13× smaller energy error and a
+  47× smaller error in ``ω`` than the Yoshida triple jump on the heavy top of
+  ``docs/integrators.md``.
+
+Without a torque the kicks vanish and the free flows of an output interval
+compose to one, which is applied once per interval: the method is then the
+exact motion (to rounding).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, types
+from numba.core.errors import TypingError
+from numba.extending import overload
+
+from tumble import _free_flow, torques
+from tumble._rigid import RigidModel
+from tumble.integrate import _fixed
+from tumble.integrate._splitting import BLANES_MOAN as _S6
+
+
+class ExactSplit(NamedTuple):
+    """A composition ``K(a₀h) F(b₁h) K(a₁h) … F(b_sh) K(a_sh)`` of kicks ``K`` and exact free flows ``F``.
+
+    kicks : (s+1,) step fractions of the kicks (``a[0] = a[-1]``: merged across steps)
+    flows : (s,) step fractions of the free flows (any sign)
+    """
+
+    kicks: np.ndarray
+    flows: np.ndarray
+
+
+STRANG = ExactSplit(np.array([0.5, 0.5]), np.array([1.0]))
+BLANES_MOAN = ExactSplit(_S6.a.copy(), _S6.b.copy())
+
+ORDERS = {"exact_split2": 2, "exact_split4": 4}
+
+
+def _is_exact_split(scheme):
+    return isinstance(scheme, types.BaseNamedTuple) and scheme.instance_class is ExactSplit
+
+
+def _check_rigid(model):
+    if not (isinstance(model, types.BaseNamedTuple) and model.instance_class is RigidModel):
+        raise TypingError(f"the exact-flow splitting integrates rigid bodies (RigidModel) only, got {model}")
+
+
+@overload(_fixed.workspace, jit_options={"cache": True})
+def _exact_split_workspace(scheme, model, Y):
+    if not _is_exact_split(scheme):
+        return None
+    _check_rigid(model)
+    return lambda scheme, model, Y: ()  # every lane runs on scalars
+
+
+@overload(_fixed.advance, jit_options={"cache": True})
+def _exact_split_advance(scheme, model, b0, t0, h, m, Y, work):
+    if not _is_exact_split(scheme):
+        return None
+    _check_rigid(model)
+
+    if isinstance(model.types[2], types.NoneType):  # torque-free: F(b₁h) … F(b_sh) = F(h), m times
+
+        def impl(scheme, model, b0, t0, h, m, Y, work):
+            y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))  # one body: a block of one lane
+            for j in range(y.shape[1]):
+                x = _free(model, b0 + j, m * h, _load(y, j))
+                _store(y, j, x)
+
+        return impl
+
+    def impl(scheme, model, b0, t0, h, m, Y, work):
+        y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))
+        a, b = scheme.kicks, scheme.flows
+        for j in range(y.shape[1]):
+            x = _load(y, j)
+            for s in range(m):
+                t = t0 + s * h
+                for i in range(b.shape[0]):
+                    # the last kick of the previous step merges with the first of this one
+                    fa = a[0] + a[-1] if (i == 0 and s > 0) else a[i]
+                    x = _kick(model, b0 + j, t, fa * h, x)
+                    x = _free(model, b0 + j, b[i] * h, x)
+                    t += b[i] * h
+            _store(y, j, _kick(model, b0 + j, t0 + m * h, a[-1] * h, x))
+
+    return impl
+
+
+@njit(cache=True, inline="always")
+def _load(y, j):
+    return y[0, j], y[1, j], y[2, j], y[3, j], y[4, j], y[5, j], y[6, j]
+
+
+@njit(cache=True, inline="always")
+def _store(y, j, x):
+    y[0, j], y[1, j], y[2, j], y[3, j], y[4, j], y[5, j], y[6, j] = x
+
+
+@njit(cache=True)
+def _free(model, b, tau, x):
+    """The exact torque-free motion of body ``b`` over ``tau`` (s, any sign) from ``x = [q_NP, ω_P]``."""
+    r = b * (model.moments.shape[0] > 1)
+    mo = _free_flow._setup(model.moments[r, 0], model.moments[r, 1], model.moments[r, 2],
+                           x[4], x[5], x[6], x[0], x[1], x[2], x[3])
+    w1, w2, w3, qw, qx, qy, qz = _free_flow._evaluate(mo, tau)
+    return qw, qx, qy, qz, w1, w2, w3
+
+
+@njit(cache=True, inline="always")
+def _acceleration(model, b, t, x, w1, w2, w3):
+    """``I⁻¹ τ(t, q, ω)`` (rad/s², principal axes) of body ``b`` at the attitude of ``x`` and the rate ``ω``."""
+    r = b * (model.coefficients.shape[0] > 1)
+    c = model.coefficients
+    t1, t2, t3 = torques.evaluate(t, x[0], x[1], x[2], x[3], w1, w2, w3, model.params,
+                                  b * (model.params.shape[0] > 1), model.codes)
+    return c[r, 3] * t1, c[r, 4] * t2, c[r, 5] * t3
+
+
+@njit(cache=True)
+def _kick(model, b, t, tau, x):
+    """The kick ``ω̇ = I⁻¹ τ(t, q, ω)`` over ``tau`` (s) at fixed ``t`` and ``q``: one RK4 step of it,
+    which for a torque independent of ``ω`` is the exact ``ω + tau I⁻¹ τ(t, q)`` (to rounding)."""
+    w1, w2, w3 = x[4], x[5], x[6]
+    k1 = _acceleration(model, b, t, x, w1, w2, w3)
+    k2 = _acceleration(model, b, t, x, w1 + 0.5 * tau * k1[0], w2 + 0.5 * tau * k1[1], w3 + 0.5 * tau * k1[2])
+    k3 = _acceleration(model, b, t, x, w1 + 0.5 * tau * k2[0], w2 + 0.5 * tau * k2[1], w3 + 0.5 * tau * k2[2])
+    k4 = _acceleration(model, b, t, x, w1 + tau * k3[0], w2 + tau * k3[1], w3 + tau * k3[2])
+    d = tau / 6.0
+    return (x[0], x[1], x[2], x[3], w1 + d * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
+            w2 + d * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]), w3 + d * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]))
