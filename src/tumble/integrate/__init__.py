@@ -172,7 +172,11 @@ def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, se
     # (its start-up costs more than a short run, and callbacks need the GIL).
     serial = serial or y.shape[0] == 1
     if method == "exact":
-        _free_flow.exact_batch(model.moments, y, t, out)
+        tasks = y.shape[0] * -(-t.shape[0] // _free_flow._CHUNK)
+        if tasks == 1:  # a short run of one body: no parallel region (its start-up dominates)
+            _free_flow.exact_task(model.moments, y, t, out, 0)
+        else:
+            _free_flow.exact_batch(model.moments, y, t, out)
     elif method in _SCHEMES:
         scheme, evaluations = _SCHEMES[method]
         if serial:
