@@ -14,3 +14,20 @@ def random_rotation():
         return q if np.linalg.det(q) > 0.0 else -q
 
     return make
+
+
+@pytest.fixture
+def random_batch():
+    """``random_batch(n, seed=5)``: n bodies — inertia (n, 3, 3) with moments in [1, 1.9]
+    (the triangle inequality holds), ω0 (n, 3), unit q0 (n, 4)."""
+
+    def make(n, seed=5):
+        rng = np.random.default_rng(seed)
+        inertia = []
+        for _ in range(n):
+            r, _ = np.linalg.qr(rng.standard_normal((3, 3)))
+            inertia.append(r @ np.diag(rng.uniform(1.0, 1.9, 3)) @ r.T)
+        q0 = rng.standard_normal((n, 4))
+        return np.array(inertia), rng.standard_normal((n, 3)), q0 / np.linalg.norm(q0, axis=-1, keepdims=True)
+
+    return make

@@ -237,21 +237,10 @@ def test_cf4_keeps_the_unit_quaternion_without_projection(torque):
 # -- batches -------------------------------------------------------------------------------
 
 
-def random_batch(n, seed=5):
-    """n bodies: inertia (n, 3, 3) with moments in [1, 1.9] (triangle inequality holds), ω0, unit q0."""
-    rng = np.random.default_rng(seed)
-    inertia = []
-    for _ in range(n):
-        r, _ = np.linalg.qr(rng.standard_normal((3, 3)))
-        inertia.append(r @ np.diag(rng.uniform(1.0, 1.9, 3)) @ r.T)
-    q0 = rng.standard_normal((n, 4))
-    return np.array(inertia), rng.standard_normal((n, 3)), q0 / np.linalg.norm(q0, axis=-1, keepdims=True)
-
-
 @pytest.mark.parametrize("method, torque", [("splitting2", "none"), ("splitting4", "none"), ("cf4", "none"),
                                             ("cf4", "ConstantInertial")])
 @pytest.mark.parametrize("shared", [False, True], ids=["a body per member", "one body"])
-def test_batch_across_blocks_equals_single_runs(method, torque, shared):
+def test_batch_across_blocks_equals_single_runs(method, torque, shared, random_batch):
     # LANES + 3 bodies: a full block and a short one, in parallel.
     n = _fixed.LANES + 3
     inertia, omega0, q0 = random_batch(n)

@@ -222,17 +222,6 @@ def test_rk4_motion_does_not_depend_on_the_body_axes_to_rounding(kind, random_ro
 # -- batches -------------------------------------------------------------------------------
 
 
-def random_batch(n, seed=5):
-    """n bodies: inertia (n, 3, 3) with moments in [1, 1.9] (triangle inequality holds), ω0, unit q0."""
-    rng = np.random.default_rng(seed)
-    inertia = []
-    for _ in range(n):
-        r, _ = np.linalg.qr(rng.standard_normal((3, 3)))
-        inertia.append(r @ np.diag(rng.uniform(1.0, 1.9, 3)) @ r.T)
-    q0 = rng.standard_normal((n, 4))
-    return np.array(inertia), rng.standard_normal((n, 3)), q0 / np.linalg.norm(q0, axis=-1, keepdims=True)
-
-
 BATCH_TORQUES = {
     "torque-free": None,
     "ConstantBody": torques.ConstantBody(TAU),
@@ -244,7 +233,7 @@ BATCH_TORQUES = {
 
 @pytest.mark.parametrize("torque", BATCH_TORQUES)
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
-def test_batch_equals_single_runs(method, torque):
+def test_batch_equals_single_runs(method, torque, random_batch):
     n = 5
     inertia, omega0, q0 = random_batch(n)
     torque = BATCH_TORQUES[torque]
@@ -258,7 +247,7 @@ def test_batch_equals_single_runs(method, torque):
 
 @pytest.mark.parametrize("extra", [1, 3], ids=["lone body in the last block", "partial last block"])
 @pytest.mark.parametrize("torque", ["torque-free", "ConstantInertial + Tabulated"])
-def test_rk4_batch_across_blocks_equals_single_runs(torque, extra):
+def test_rk4_batch_across_blocks_equals_single_runs(torque, extra, random_batch):
     # rk4 advances up to LANES bodies together (structure of arrays); a batch of
     # LANES + extra bodies has a full block and a short one (a lone body takes
     # the one-body path).
@@ -272,7 +261,7 @@ def test_rk4_batch_across_blocks_equals_single_runs(torque, extra):
 
 
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
-def test_batch_of_one_body_broadcasts_omega0_or_q0(method):
+def test_batch_of_one_body_broadcasts_omega0_or_q0(method, random_batch):
     n = 5
     _, omega0, q0 = random_batch(n)
     kwargs = dict(t=np.linspace(0.0, 3.0, 4), method=method, dt=1e-2, torque=torques.ConstantInertial(TAU))
