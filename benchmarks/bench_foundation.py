@@ -25,7 +25,7 @@ from scipy.integrate import solve_ivp
 import tumble
 from _timing import best_of
 from tumble import _rigid
-from tumble.integrate import _rk4
+from tumble.integrate import _fixed, _rk4
 
 MOMENTS = np.array([1.0, 2.0, 3.0])          # kg m², principal axes = body axes
 OMEGA0 = np.array([1e-3, 1.0, 1e-3])          # rad/s: near the intermediate axis (flips)
@@ -67,11 +67,11 @@ def single_body_rk4(steps):
     y = np.concatenate([Q0, OMEGA0])[None, :]
     t = np.array([0.0, steps * 1e-3])
     out, stats = np.empty((2, 1, 7)), np.zeros((1, 5))
-    _rk4.rk4_run_block(model, 0, y.copy(), t, 1e-3, out, stats)  # compile / load from cache
+    _fixed.run_block(_rk4.SCHEME, model, 0, y.copy(), t, 1e-3, out, stats)  # compile / load from cache
 
     def run():
         stats[:] = 0.0
-        _rk4.rk4_run_block(model, 0, y.copy(), t, 1e-3, out, stats)
+        _fixed.run_block(_rk4.SCHEME, model, 0, y.copy(), t, 1e-3, out, stats)
         return stats[0, 0]
 
     seconds, n = best_of(5, run)

@@ -6,7 +6,7 @@ import pytest
 import tumble
 from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError
-from tumble.integrate import SolverError, _rk4
+from tumble.integrate import SolverError, _fixed
 
 EPS = np.finfo(np.float64).eps
 
@@ -251,7 +251,7 @@ def test_rk4_batch_across_blocks_equals_single_runs(torque, extra, random_batch)
     # rk4 advances up to LANES bodies together (structure of arrays); a batch of
     # LANES + extra bodies has a full block and a short one (a lone body takes
     # the one-body path).
-    n = _rk4.LANES + extra
+    n = _fixed.LANES + extra
     inertia, omega0, q0 = random_batch(n)
     kwargs = dict(t=np.linspace(0.0, 1.0, 3), method="rk4", dt=1e-2, torque=BATCH_TORQUES[torque])
     batch = tumble.simulate(inertia, omega0, q0=q0, **kwargs)

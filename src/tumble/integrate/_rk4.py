@@ -21,7 +21,6 @@ from numba.extending import overload
 
 from tumble._model import project, rhs, state_size
 from tumble.integrate import _fixed
-from tumble.integrate._fixed import LANES  # noqa: F401  (block size; tests size batches by it)
 
 ORDER = 4
 
@@ -73,8 +72,3 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
             project(model, Y)
 
     return impl
-
-
-def rk4_run_block(model, k, y, t_out, dt, out, stats):
-    """Integrate block ``k`` of the batch ``y`` with RK4 (see :func:`tumble.integrate._fixed.run_block`)."""
-    _fixed.run_block(SCHEME, model, k, y, t_out, dt, out, stats)
