@@ -315,3 +315,15 @@ def test_heavy_top_example_conserves_total_energy_and_vertical_momentum():
     assert repr(problem.torque).startswith("Gravity(")
     assert np.abs(energy - energy[0]).max() <= 1e-10 * abs(energy[0])
     assert np.abs(lz - lz[0]).max() <= 1e-10 * abs(lz[0])
+
+
+def test_exact_method_takes_no_solver_options(tmp_path):
+    # method = "exact" is the closed form: a file without options runs and equals
+    # tumble.analytic.torque_free bitwise; a dt (or rtol) is refused, naming the key.
+    traj = run_scenario(load_scenario(write(tmp_path, BASE + '\n[solver]\nmethod = "exact"\n')))
+    exact = tumble.analytic.torque_free(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), [0.001, 1.0, 0.001],
+                                        t=traj.t)
+    assert traj.method == "exact" and np.array_equal(traj.omega, exact.omega)
+    for option in ("dt = 0.01", "rtol = 1e-9"):
+        with pytest.raises(ScenarioError, match=r"solver\.(dt|rtol): not used by method 'exact'"):
+            load_scenario(write(tmp_path, BASE + f'\n[solver]\nmethod = "exact"\n{option}\n'))

@@ -347,10 +347,12 @@ class Solver(_Table):
         method = integrate.METHODS.get(info.data.get("method"))
         if method is None:  # the method itself is invalid: reported there
             return value
-        if info.field_name == "dt" and not method.adaptive and value is None:
+        fixed_step = method.stepper and not method.adaptive
+        if info.field_name == "dt" and fixed_step and value is None:
             raise ValueError(f"required by method {method.name!r} (fixed step, s)")
-        if value is not None and (info.field_name == "dt") == method.adaptive:
-            uses = "rtol and atol" if method.adaptive else "dt"
+        used = fixed_step if info.field_name == "dt" else method.adaptive
+        if value is not None and not used:
+            uses = "rtol and atol" if method.adaptive else "dt" if fixed_step else "no solver options"
             raise ValueError(f"not used by method {method.name!r}, which takes {uses}")
         return value
 
