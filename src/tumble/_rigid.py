@@ -47,16 +47,25 @@ class RigidModel(NamedTuple):
 
 def build(bodies, model) -> RigidModel:
     """The :class:`RigidModel` of a list of RigidBody (one, or one per batch member) under a torque model."""
-    rows, codes = [], None
-    for body in bodies:
-        codes, params = torques.compile_program(model, body.axes, offset=0)
-        rows.append(params)
-    return RigidModel(
-        coefficients=np.ascontiguousarray([euler_coefficients(*b.moments) for b in bodies], dtype=np.float64),
-        params=np.ascontiguousarray(rows, dtype=np.float64),
-        codes=None if model is None else codes,
-        moments=np.ascontiguousarray([b.moments for b in bodies], dtype=np.float64),
-    )
+    return from_principal(np.stack([b.moments for b in bodies]), np.stack([b.axes for b in bodies]), model)
+
+
+def from_principal(moments, axes, model) -> RigidModel:
+    """The :class:`RigidModel` of bodies given by principal moments (B, 3) and axes R_BP (B, 3, 3).
+
+    ``B`` is 1 (one body shared by the batch) or the batch size. Without a
+    torque no per-body work is done beyond the Euler coefficients, so a batch
+    of a million bodies with dispersed inertia is set up in milliseconds.
+    """
+    moments = np.ascontiguousarray(moments, dtype=np.float64)
+    coefficients = np.stack(euler_coefficients(moments[:, 0], moments[:, 1], moments[:, 2]), axis=-1)
+    if model is None:
+        codes, params = None, np.zeros((1, 0))
+    else:
+        programs = [torques.compile_program(model, a, offset=0) for a in axes]
+        codes, params = programs[0][0], np.stack([p for _, p in programs])
+    return RigidModel(coefficients=np.ascontiguousarray(coefficients), params=np.ascontiguousarray(params),
+                      codes=codes, moments=moments)
 
 
 def _is_rigid(model):

@@ -81,44 +81,62 @@ def _axisymmetric(axial: float, transverse: float, axis: str) -> np.ndarray:
 
 
 def _check_inertia(value, name: str, *, definite: bool, check_triangle: bool):
-    """Validate an inertia tensor; return it symmetrized, its moments (ascending) and axes.
+    """Validate an inertia tensor of shape (3, 3); return it symmetrized, its moments (ascending) and axes.
 
-    Rules: shape (3, 3); finite; symmetric to ``_SYMMETRY_RTOL`` relative to
-    the largest |entry| (then symmetrized exactly, ``(I + Iᵀ)/2``); positive
-    definite (``definite``) or semi-definite (parts: a thin rod, a point
-    mass); with ``check_triangle``, ``I₁ + I₂ ≥ I₃ (1 − _TRIANGLE_RTOL)``.
-    The axes are made deterministic: each eigenvector's largest-magnitude
-    component is positive, then the third is flipped if needed for det +1.
+    The rules are those of :func:`principal_axes`.
     """
-    inertia = _as_shape(value, name, (3, 3))
-    scale = np.abs(inertia).max()
-    asym = np.abs(inertia - inertia.T).max()
-    if asym > _SYMMETRY_RTOL * scale:
+    return principal_axes(_as_shape(value, name, (3, 3)), name, definite=definite, check_triangle=check_triangle)
+
+
+def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, check_triangle: bool = True):
+    """Validate inertia tensors (…, 3, 3) (kg·m², body axes); return them symmetrized, moments, axes.
+
+    Rules: finite; symmetric to ``_SYMMETRY_RTOL`` relative to the largest
+    |entry| (then symmetrized exactly, ``(I + Iᵀ)/2``); positive definite
+    (``definite``) or semi-definite (parts: a thin rod, a point mass); with
+    ``check_triangle``, ``I₁ + I₂ ≥ I₃ (1 − _TRIANGLE_RTOL)``. A broken rule
+    raises :class:`ValidationError` naming ``name`` (and the batch index).
+    ``moments`` (…, 3) ascend; ``axes`` (…, 3, 3) = R_BP, columns the principal
+    axes in body axes, made deterministic: each eigenvector's largest-magnitude
+    component is positive, then the third is flipped if needed for det +1.
+    Batched, so that a batch of N bodies is validated in one call.
+    """
+    inertia = as_array(inertia, name, tail=(3, 3))
+
+    def where(bad):
+        k = np.argwhere(bad)[0] if inertia.ndim > 2 else ()
+        return name + "".join(f"[{int(i)}]" for i in k), tuple(int(i) for i in k)
+
+    scale = np.abs(inertia).max(axis=(-2, -1))
+    asym = np.abs(inertia - np.swapaxes(inertia, -1, -2)).max(axis=(-2, -1))
+    bad = asym > _SYMMETRY_RTOL * scale
+    if bad.any():
+        field, k = where(bad)
         raise ValidationError(
-            f"{name}: must be symmetric (max |I - I^T| = {asym:.3g} > "
-            f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale:.3g})"
+            f"{field}: must be symmetric (max |I - I^T| = {asym[k]:.3g} > "
+            f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale[k]:.3g})"
         )
-    inertia = 0.5 * (inertia + inertia.T)
+    inertia = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
     moments, axes = np.linalg.eigh(inertia)
-    if definite and not moments[0] > _DEFINITE_RTOL * moments[2]:
+    m1, m2, m3 = moments[..., 0], moments[..., 1], moments[..., 2]
+    bad = ~(m1 > _DEFINITE_RTOL * m3) if definite else m1 < -_DEFINITE_RTOL * m3
+    if bad.any():
+        field, k = where(bad)
+        rule = (f"must be positive definite (principal moments {moments[k].tolist()} kg m^2; "
+                f"the smallest must exceed {_DEFINITE_RTOL:g} x the largest)") if definite else (
+                f"must be positive semi-definite (principal moments {moments[k].tolist()} kg m^2)")
+        raise ValidationError(f"{field}: {rule}")
+    bad = m1 + m2 < m3 * (1.0 - _TRIANGLE_RTOL)
+    if check_triangle and bad.any():
+        field, k = where(bad)
         raise ValidationError(
-            f"{name}: must be positive definite (principal moments {moments.tolist()} kg m^2; "
-            f"the smallest must exceed {_DEFINITE_RTOL:g} x the largest)"
+            f"{field}: principal moments break the triangle inequality "
+            f"I1 + I2 >= I3 (1 - {_TRIANGLE_RTOL:g}): {m1[k]:.6g} + {m2[k]:.6g} "
+            f"< {m3[k]:.6g}; pass check_triangle=False to accept such data"
         )
-    if not definite and moments[0] < -_DEFINITE_RTOL * moments[2]:
-        raise ValidationError(
-            f"{name}: must be positive semi-definite (principal moments {moments.tolist()} kg m^2)"
-        )
-    if check_triangle and moments[0] + moments[1] < moments[2] * (1.0 - _TRIANGLE_RTOL):
-        raise ValidationError(
-            f"{name}: principal moments break the triangle inequality "
-            f"I1 + I2 >= I3 (1 - {_TRIANGLE_RTOL:g}): {moments[0]:.6g} + {moments[1]:.6g} "
-            f"< {moments[2]:.6g}; pass check_triangle=False to accept such data"
-        )
-    largest = np.abs(axes).argmax(axis=0)
-    axes = axes * np.sign(axes[largest, np.arange(3)])
-    if np.linalg.det(axes) < 0.0:
-        axes[:, 2] = -axes[:, 2]
+    largest = np.abs(axes).argmax(axis=-2)[..., None, :]
+    axes = axes * np.sign(np.take_along_axis(axes, largest, axis=-2))
+    axes[..., :, 2] *= np.sign(np.linalg.det(axes))[..., None]
     return inertia, moments, axes
 
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 
 from tumble import _quat
 from tumble._validate import as_array
@@ -74,12 +75,13 @@ def omega_dot(inertia, omega, torque=None) -> np.ndarray:
     return np.linalg.solve(inertia, rhs[..., None])[..., 0]
 
 
-@njit(cache=True)
+@register_jitable
 def euler_coefficients(i1, i2, i3):
     """Coefficients of Euler's equations in principal axes, computed once per body.
 
     Returns ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)`` with ``c₁ = (I₂ − I₃)/I₁`` and
-    cyclic, so that :func:`euler_principal` needs no division.
+    cyclic, so that :func:`euler_principal` needs no division. Plain Python
+    too (it works on arrays of moments), and compiled into callers.
     """
     return (i2 - i3) / i1, (i3 - i1) / i2, (i1 - i2) / i3, 1.0 / i1, 1.0 / i2, 1.0 / i3
 

@@ -20,7 +20,7 @@ import numpy as np
 
 from tumble import _rigid, attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
-from tumble.body import RigidBody
+from tumble.body import RigidBody, principal_axes
 from tumble.trajectory import Trajectory
 
 __all__ = ["simulate"]
@@ -91,25 +91,22 @@ def simulate(
                               + (" and a progress callback" if progress is not None else ""))
     m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque)
     times = _output_times(t)
-    bodies, batch_inertia = _bodies(body)
+    moments, axes, batch_inertia = _bodies(body)
     omega0 = as_array(omega0, "omega0", tail=(3,))
     q0 = attitude.identity() if q0 is None else as_array(q0, "q0", tail=(4,))
-    n = _batch_size(bodies, batch_inertia, omega0, q0)
+    n = _batch_size(batch_inertia, omega0, q0)
     if np.any(np.linalg.norm(q0, axis=-1) == 0.0):
         raise ValidationError("q0: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
     q0 = attitude.normalize(np.broadcast_to(q0, (n or 1, 4)))
     omega0 = np.broadcast_to(omega0, (n or 1, 3))
     model = torques.as_torque_model(torque)
 
-    # Into principal axes, one set of axes per distinct body.
-    axes = np.stack([b.axes for b in bodies])                      # R_BP, (B, 3, 3)
+    # Into principal axes, one set of axes per distinct body: R_BP (B, 3, 3), B = 1 or N.
     q_bp = attitude.from_matrix(axes)                              # (B, 4)
-    if len(bodies) == 1:
-        axes, q_bp = axes[:1], q_bp[:1]
     y0 = np.empty((n or 1, _rigid.STATE_SIZE))
     y0[:, :4] = attitude.multiply(q0, q_bp)
     y0[:, 4:] = np.einsum("bji,bj->bi", axes, omega0)
-    rigid = _rigid.build(bodies, model)
+    rigid = _rigid.from_principal(moments, axes, model)
 
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
@@ -147,21 +144,27 @@ def _output_times(t) -> np.ndarray:
     return times
 
 
-def _bodies(body) -> tuple[list[RigidBody], np.ndarray]:
-    """The distinct bodies (one, or one per batch member) and the inertia array to report."""
+def _bodies(body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Principal moments (B, 3), axes R_BP (B, 3, 3) and the inertia to report, B = 1 or one per member.
+
+    An (N, 3, 3) inertia array is validated in one vectorised call
+    (:func:`tumble.body.principal_axes`), with the rules of :class:`RigidBody`.
+    """
     if isinstance(body, RigidBody):
-        return [body], np.array(body.inertia)
+        return body.moments[None], body.axes[None], np.array(body.inertia)
     if isinstance(body, Sequence) and body and all(isinstance(b, RigidBody) for b in body):
-        return list(body), np.stack([b.inertia for b in body])
+        return (np.stack([b.moments for b in body]), np.stack([b.axes for b in body]),
+                np.stack([b.inertia for b in body]))
     inertia = as_array(body, "inertia", tail=(3, 3))
-    if inertia.ndim == 2:
-        return [RigidBody(inertia)], inertia
-    if inertia.ndim != 3:
+    if inertia.ndim not in (2, 3):
         raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
-    return [RigidBody(i) for i in inertia], inertia
+    inertia, moments, axes = principal_axes(inertia, "inertia")
+    if inertia.ndim == 2:
+        return moments[None], axes[None], inertia
+    return moments, axes, inertia
 
 
-def _batch_size(bodies, inertia, omega0, q0) -> int | None:
+def _batch_size(inertia, omega0, q0) -> int | None:
     """N for a batch, None for a single body; refuses inconsistent batch sizes."""
     sizes = {}
     for name, arr, single_ndim in (("omega0", omega0, 1), ("q0", q0, 1), ("body", inertia, 2)):
