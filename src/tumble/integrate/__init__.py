@@ -128,8 +128,8 @@ def check_options(method: str, *, dt, rtol, atol, max_steps, torque=None) -> Met
 
 def _refuse_torque(method, what):
     others = ", ".join(repr(name) for name, m in METHODS.items() if m.torque)
-    raise ValidationError(f"torque: method {method!r} integrates torque-free bodies only (its steps are exact "
-                          f"rotations of the free rigid body), but {what}; use one of {others}")
+    raise ValidationError(f"torque: method {method!r} integrates torque-free bodies only (it is built from the "
+                          f"exact motion of the free rigid body), but {what}; use one of {others}")
 
 
 def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
