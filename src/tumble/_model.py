@@ -42,8 +42,15 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import njit
+from numba import njit, types
+
+
+def is_type(numba_type, cls) -> bool:
+    """True when ``numba_type`` (seen by an overload) is the Numba type of a ``cls`` NamedTuple.
+
+    Models and schemes select their overloads with it.
+    """
+    return isinstance(numba_type, types.BaseNamedTuple) and numba_type.instance_class is cls
 
 
 def rhs(model, b0, t, Y, OUT):  # pragma: no cover - replaced by overloads in compiled code

@@ -69,7 +69,7 @@ def from_principal(moments, axes, model) -> RigidModel:
 
 
 def _is_rigid(model):
-    return isinstance(model, types.BaseNamedTuple) and model.instance_class is RigidModel
+    return _model.is_type(model, RigidModel)
 
 
 @overload(_model.rhs, inline="always", jit_options={"cache": True})

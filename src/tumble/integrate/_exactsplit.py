@@ -56,7 +56,7 @@ from numba import njit, types
 from numba.core.errors import TypingError
 from numba.extending import overload
 
-from tumble import _free_flow, torques
+from tumble import _free_flow, _model, torques
 from tumble._rigid import RigidModel
 from tumble.integrate import _fixed
 from tumble.integrate._splitting import BLANES_MOAN as _S6
@@ -80,11 +80,11 @@ ORDERS = {"exact_split2": 2, "exact_split4": 4}
 
 
 def _is_exact_split(scheme):
-    return isinstance(scheme, types.BaseNamedTuple) and scheme.instance_class is ExactSplit
+    return _model.is_type(scheme, ExactSplit)
 
 
 def _check_rigid(model):
-    if not (isinstance(model, types.BaseNamedTuple) and model.instance_class is RigidModel):
+    if not _model.is_type(model, RigidModel):
         raise TypingError(f"the exact-flow splitting integrates rigid bodies (RigidModel) only, got {model}")
 
 

@@ -29,10 +29,10 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.extending import overload
 
-from tumble import _quat
+from tumble import _model, _quat
 from tumble._model import body_rate, rhs
 from tumble.integrate import _fixed
 
@@ -76,7 +76,7 @@ def times_unit(qw, qx, qy, qz, ew, ex, ey, ez):
 
 
 def _is_cf4(scheme):
-    return isinstance(scheme, types.BaseNamedTuple) and scheme.instance_class is CF4
+    return _model.is_type(scheme, CF4)
 
 
 @overload(_fixed.workspace, jit_options={"cache": True})

@@ -16,9 +16,9 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import types
 from numba.extending import overload
 
+from tumble import _model
 from tumble._model import project, rhs, state_size
 from tumble.integrate import _fixed
 
@@ -33,7 +33,7 @@ SCHEME = RK4()
 
 
 def _is_rk4(scheme):
-    return isinstance(scheme, types.BaseNamedTuple) and scheme.instance_class is RK4
+    return _model.is_type(scheme, RK4)
 
 
 @overload(_fixed.workspace, jit_options={"cache": True})

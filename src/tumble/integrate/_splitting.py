@@ -49,10 +49,10 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.extending import overload
 
-from tumble import _quat
+from tumble import _model, _quat
 from tumble._model import inverse_moments
 from tumble.integrate import _fixed
 from tumble.integrate._liegroup import rotate_right, times_unit
@@ -89,7 +89,7 @@ ORDERS = {"splitting2": 2, "splitting4": 4}
 
 
 def _is_splitting(scheme):
-    return isinstance(scheme, types.BaseNamedTuple) and scheme.instance_class is Splitting
+    return _model.is_type(scheme, Splitting)
 
 
 @overload(_fixed.workspace, jit_options={"cache": True})
