@@ -11,7 +11,7 @@ import pytest
 import xarray as xr
 
 from tumble._validate import ValidationError
-from tumble.trajectory import CONVENTIONS, Trajectory, load, write_atomic
+from tumble.trajectory import CONVENTIONS, Extra, Trajectory, load, write_atomic
 
 EPS = np.finfo(np.float64).eps
 # Hand values below are exact binary fractions, and the quaternions used are
@@ -260,6 +260,50 @@ def test_save_load_round_trip_is_bitwise(tmp_path, make):
     assert back.info == traj.info
     assert {k: type(v) for k, v in back.info.items()} == {k: type(v) for k, v in traj.info.items()}
     assert os.listdir(tmp_path) == ["run.nc"]
+
+
+def _with_extras(traj):
+    """``traj`` with a wheel-speed extra (n, [N,] 4) and a scalar extra (n, [N])."""
+    lead = traj.q.shape[:-1]
+    wheels = np.arange(np.prod(lead) * 4, dtype=float).reshape(lead + (4,)) / 7.0  # not binary fractions
+    power = np.arange(np.prod(lead), dtype=float).reshape(lead) / 3.0
+    return dataclasses.replace(traj, extras={
+        "wheel_speed": Extra(wheels, ("wheel",), "rad/s", "wheel spin rate relative to the hub"),
+        "motor_work": Extra(power, (), "J", "work done by the wheel motors"),
+    })
+
+
+@pytest.mark.parametrize("make", [lambda: _batch().body(1), _batch], ids=["single", "batch"])
+def test_extras_round_trip_bitwise_with_their_labels(tmp_path, make):
+    traj = _with_extras(make())
+    traj.save(tmp_path / "run.nc")
+    back = load(tmp_path / "run.nc")
+    assert set(back.extras) == {"wheel_speed", "motor_work"}
+    for name, extra in traj.extras.items():
+        got = back.extras[name]
+        assert (got.dims, got.units, got.description) == (extra.dims, extra.units, extra.description)
+        np.testing.assert_array_equal(_bits(got.data), _bits(extra.data), name)
+
+
+def test_extras_follow_body_selection_and_are_read_only():
+    traj = _with_extras(_batch())
+    one = traj.body(2)
+    np.testing.assert_array_equal(one.extras["wheel_speed"].data, traj.extras["wheel_speed"].data[:, 2])
+    assert one.extras["motor_work"].data.shape == (len(traj),)
+    with pytest.raises(ValueError):
+        traj.extras["wheel_speed"].data[0, 0, 0] = 1.0
+
+
+@pytest.mark.parametrize("extras, message", [
+    ({"w": np.zeros((5, 4))}, r"extras\['w'\]: must be a tumble.trajectory.Extra"),
+    ({"w": Extra(np.zeros((4, 4)), ("wheel",))}, r"extras\['w'\].data: must have shape \(5,\)"),
+    ({"w": Extra(np.zeros((5, 4)), ())}, r"extras\['w'\].data: must have shape"),
+    ({"w": Extra(np.zeros((5, 3)), ("axis",))}, r"extras\['w'\].dims: must be names other than"),
+    ({"not a name": Extra(np.zeros(5))}, r"extras: names must be identifiers"),
+])
+def test_extras_validation_names_the_entry(extras, message):
+    with pytest.raises(ValidationError, match=message):
+        _trajectory(np.zeros((5, 3)), np.tile(IDENTITY, (5, 1)), extras=extras)
 
 
 def test_save_round_trips_empty_method_and_info(tmp_path):

@@ -11,7 +11,8 @@ its right-hand side, its projection back onto the state manifold and its
 state size::
 
     rhs(model, b0, t, Y, OUT)    # OUT[:, j] = dy/dt of batch member b0 + j at (t, Y[:, j])
-    project(model, Y)            # e.g. normalise the quaternion Y[0:4, j] of every lane
+    project(model, b0, t, Y)     # after a step that ends at t: e.g. normalise the quaternion
+                                 # Y[0:4, j] of every lane; also the place of discrete updates
     state_size(model)            # length of the state vector, a compile-time constant
 
 where ``Y`` is a block (state × lanes) or the state vector of one body
@@ -58,8 +59,17 @@ def rhs(model, b0, t, Y, OUT):  # pragma: no cover - replaced by overloads in co
     raise NotImplementedError(f"no compiled right-hand side for {type(model).__name__}")
 
 
-def project(model, Y):  # pragma: no cover - replaced by overloads in compiled code
-    """Put every lane ``Y[:, j]`` back onto the state manifold after a step (in place)."""
+def project(model, b0, t, Y):  # pragma: no cover - replaced by overloads in compiled code
+    """After an accepted step that ends at time ``t`` (s): put every lane ``Y[:, j]`` (batch member
+    ``b0 + j``) back onto the state manifold, in place.
+
+    It is also where a model applies its discrete-time updates, such as a
+    controller sampled at a fixed rate whose command is held in the state
+    (zero-order hold): the fixed-step methods land on every output time and
+    call ``project`` after each step, so a model whose sample times are
+    multiples of ``dt`` sees each of them. (The adaptive ``dop853`` calls it
+    after each accepted step too, but its steps do not land on sample times.)
+    """
     raise NotImplementedError(f"no compiled projection for {type(model).__name__}")
 
 

@@ -129,18 +129,18 @@ def _rigid_rhs(model, b0, t, Y, OUT):
 
 
 @overload(_model.project, inline="always", jit_options={"cache": True})
-def _rigid_project(model, Y):
+def _rigid_project(model, b0, t, Y):
     if not _is_rigid(model):
         return None
 
     if Y.ndim == 1:
 
-        def impl(model, Y):
+        def impl(model, b0, t, Y):
             _model.normalize_quaternion(Y)
 
     else:
 
-        def impl(model, Y):
+        def impl(model, b0, t, Y):
             _model.normalize_quaternions(Y)
 
     return impl

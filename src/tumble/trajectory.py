@@ -33,7 +33,7 @@ import tempfile
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
@@ -44,13 +44,14 @@ if TYPE_CHECKING:
     import xarray
     from matplotlib.figure import Figure
 
-__all__ = ["Trajectory", "load", "write_atomic"]
+__all__ = ["Extra", "Trajectory", "load", "write_atomic"]
 
 CONVENTIONS = (
     "quaternion: Hamilton, scalar-first [w,x,y,z], body->inertial; omega in body axes; SI units"
 )
 _ENGINE = "h5netcdf"  # NetCDF-4 (HDF5) reader and writer used by save() and load()
 _INFO_PREFIX = "solver_"  # global attributes of the NetCDF file that hold Trajectory.info
+_EXTRA_ATTR = "tumble_extra"  # variable attribute that marks a Trajectory.extras entry in a dataset
 _AXES = ["x", "y", "z"]
 _COMPONENTS = ["w", "x", "y", "z"]
 # Panel (b) of plot() shows |drift| on a symlog scale, linear below this value
@@ -89,6 +90,47 @@ def _check_info(info: Any) -> dict:
     return out
 
 
+class Extra(NamedTuple):
+    """A sampled state beyond ``q`` and ``omega`` (wheel speeds, modal coordinates, ...).
+
+    data        : array of shape (n, [N,] *sizes): one row per output time (and body),
+                  then one axis per name in ``dims``
+    dims        : names of the trailing axes, e.g. ``("wheel",)``; ``()`` for a scalar
+    units       : UDUNITS-style units, e.g. ``"rad/s"``
+    description : what the quantity is, with its frame where it has one
+    """
+
+    data: np.ndarray
+    dims: tuple[str, ...] = ()
+    units: str = "1"
+    description: str = ""
+
+
+_RESERVED_DIMS = {"time", "body", "axis", "axis2", "component"}
+
+
+def _check_extras(extras: Any, lead: tuple[int, ...]) -> dict:
+    """Validate ``extras`` (name -> :class:`Extra`) against the leading shape ``(n, [N])``; copy read-only."""
+    if not isinstance(extras, Mapping):
+        raise ValidationError(f"extras: must be a dict of name -> Extra, got {type(extras).__name__}")
+    out = {}
+    for name, extra in extras.items():
+        where = f"extras[{name!r}]"
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ValidationError(f"extras: names must be identifiers, got {name!r}")
+        if not isinstance(extra, Extra):
+            raise ValidationError(f"{where}: must be a tumble.trajectory.Extra, got {type(extra).__name__}")
+        dims = tuple(extra.dims)
+        if any(not isinstance(d, str) or d in _RESERVED_DIMS for d in dims):
+            raise ValidationError(f"{where}.dims: must be names other than {sorted(_RESERVED_DIMS)}, got {dims}")
+        data = np.array(extra.data, dtype=np.float64)
+        if data.shape[:len(lead)] != lead or data.ndim != len(lead) + len(dims):
+            raise ValidationError(f"{where}.data: must have shape {lead} + one axis per dim {dims}, "
+                                  f"got {data.shape}")
+        out[name] = Extra(_readonly(data), dims, str(extra.units), str(extra.description))
+    return out
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class Trajectory:
     """Samples of the rotational state of one rigid body or a batch of bodies.
@@ -111,6 +153,11 @@ class Trajectory:
     info : dict
         Solver settings and statistics (``rtol``, ``atol``, ``dt``,
         ``n_steps``, ...); values are floats, ints or strings.
+    extras : dict of str to :class:`Extra`
+        States of models larger than a rigid body (wheel speeds, modal
+        coordinates, ...), sampled at ``t``. The invariants below
+        (``energy``, ``momentum_*``) are those of ``omega`` and ``inertia``
+        alone: a model with internal momentum reports its totals itself.
 
     The arrays are copied as float64 and stored read-only. Invalid input
     raises :class:`tumble.ValidationError` naming the field.
@@ -122,6 +169,7 @@ class Trajectory:
     inertia: np.ndarray
     method: str = ""
     info: dict = field(default_factory=dict)
+    extras: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         t = as_array(self.t, "t")
@@ -151,6 +199,7 @@ class Trajectory:
         for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
             object.__setattr__(self, name, _readonly(np.array(value, dtype=np.float64)))
         object.__setattr__(self, "info", _check_info(self.info))
+        object.__setattr__(self, "extras", _check_extras(self.extras, q.shape[:-1]))
 
     def __len__(self) -> int:
         """Number of output times ``n``."""
@@ -177,7 +226,8 @@ class Trajectory:
         if not -n_bodies <= i < n_bodies:
             raise IndexError(f"i: body {i} is out of range for a batch of {n_bodies}")
         inertia = self.inertia if self.inertia.ndim == 2 else self.inertia[i]
-        return Trajectory(self.t, self.q[:, i], self.omega[:, i], inertia, self.method, self.info)
+        extras = {name: e._replace(data=e.data[:, i]) for name, e in self.extras.items()}
+        return Trajectory(self.t, self.q[:, i], self.omega[:, i], inertia, self.method, self.info, extras)
 
     # -- invariants ------------------------------------------------------------------
 
@@ -271,6 +321,11 @@ class Trajectory:
             "momentum_inertial": variable(lead + ("axis",), self.momentum_inertial, "N m s",
                                           "angular momentum L_I = R(q) I omega", "inertial"),
         }
+        for name, extra in self.extras.items():
+            if name in data_vars:
+                raise ValidationError(f"extras[{name!r}]: the name is taken by a trajectory variable")
+            data_vars[name] = xr.Variable(lead + extra.dims, extra.data, {
+                "units": extra.units, "description": extra.description, _EXTRA_ATTR: 1})
         coords = {
             "time": ("time", self.t, {"units": "s", "description": "output time"}),
             "axis": ("axis", _AXES),
@@ -293,8 +348,8 @@ class Trajectory:
         """Rebuild a trajectory from a dataset made by :meth:`to_xarray`.
 
         Reads ``time``, ``q``, ``omega`` and ``inertia`` exactly (derived
-        variables are recomputed), ``method`` and the ``solver_*`` attributes
-        (into ``info``).
+        variables are recomputed), ``method``, the ``solver_*`` attributes
+        (into ``info``) and the extras.
         """
         missing = [name for name in ("time", "q", "omega", "inertia") if name not in ds.variables]
         if missing:
@@ -312,6 +367,12 @@ class Trajectory:
             inertia=ds["inertia"].transpose(..., "axis", "axis2").values,
             method=str(ds.attrs.get("method", "")),
             info=info,
+            extras={
+                str(name): Extra(var.values, tuple(str(d) for d in var.dims[1 + ("body" in var.dims):]),
+                                 str(var.attrs.get("units", "1")), str(var.attrs.get("description", "")))
+                for name, var in ds.data_vars.items()
+                if var.attrs.get(_EXTRA_ATTR) == 1
+            },
         )
 
     def save(self, path: str | os.PathLike) -> None:

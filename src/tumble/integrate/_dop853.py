@@ -141,7 +141,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
             h = max(h, h_next) if landing else h_next
             t = target if landing else t + step
             y[:] = y_new
-            project(model, y)
+            project(model, b, t, y)
             K[0] = K[_STAGES]
             rejected_last = False
             if landing:

@@ -69,6 +69,6 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
             rhs(model, b0, t + h, tmp, k4)
             for i in range(size):
                 y_[i] += h / 6.0 * (k1_[i] + 2.0 * k2_[i] + 2.0 * k3_[i] + k4_[i])
-            project(model, Y)
+            project(model, b0, t + h, Y)
 
     return impl
