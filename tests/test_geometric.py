@@ -24,7 +24,8 @@ ORDER_TOL = 0.15
 # Symmetric tops (I₁ = I₂ or I₂ = I₃): one of the two split flows has zero
 # rate and the other commutes with the Casimir flow, so the splitting is the
 # exact motion for any dt; 100 steps of dt = 0.5 s leave rounding (measured
-# ≤ 3.1e-15 in ω, ≤ 1e-14 in R(q)).
+# ≤ 3.1e-15 in ω, ≤ 1e-14 in R(q): |L| is held to its initial length, so the
+# phase |L| t/I₁ of the 50-rad turn does not drift).
 TOL_SYMMETRIC_TOP = 1e-13
 # Phase error at t = 20 s against dop853 at 1e-13 (a method that keeps the
 # invariants can still be late): bounds are 4 × the measured errors.
@@ -34,11 +35,16 @@ PHASE = {  # method, dt (s), torque: max |ΔR(q)| bound
     ("cf4", 0.05, "none"): 3e-7,          # measured 7.8e-8
     ("cf4", 0.05, "Gravity"): 4e-5,       # measured 9.5e-6
 }
-# |L| and L_N over 1e6 steps: each exact turn of L rounds two of its
-# components once, a random walk of ~EPS·√(turns) (2 turns per step for
-# splitting2, 12 for splitting4): measured 1.2e-13 and 2.6e-13 (|L|), 1.2e-13
-# and 2.7e-13 (L_N), 5.9e-14 and 2.7e-13 (|q| − 1, no projection) against the
-# bound EPS·√(turns) = 3.1e-13 and 7.7e-13.
+# |L| over 1e6 steps (the issue asks for 1e-13 relative). The turns' rounding
+# would random-walk |L| by ~EPS·√(turns) (measured 2.6e-13 for splitting4);
+# the splitting rescales L to its initial length after each output interval,
+# so |L| stays within a few roundings: measured 4.4e-16 (splitting2) and
+# 2.2e-16 (splitting4); bound 16 EPS = 3.6e-15.
+TOL_MOMENTUM_NORM = 16 * EPS
+# L_N and |q| − 1 (no projection): each exact turn rounds the quaternion and
+# two components of L once, a random walk of ~EPS·√(turns) (2 turns per step
+# for splitting2, 12 for splitting4): measured 7.9e-14 and 2.0e-13 (L_N),
+# 3.9e-14 and 1.4e-13 (|q| − 1) against EPS·√(turns) = 3.1e-13 and 7.7e-13.
 TURNS_PER_STEP = {"splitting2": 2, "splitting4": 12}
 # |q| − 1 without projection: the final quaternion of a step is q ⊗ e₁ (⊗ e₂),
 # each product rounding once; over 1e5 cf4 steps measured ≤ 1.3e-14 against
@@ -210,7 +216,7 @@ def test_splitting_keeps_momentum_and_bounds_the_energy_error_over_a_million_ste
     turns = TURNS_PER_STEP[method] * traj.info["n_steps"]
     norm = np.linalg.norm(dynamics.angular_momentum(DIAG, traj.omega), axis=-1)
     momentum = dynamics.angular_momentum_inertial(DIAG, traj.omega, traj.q)
-    assert np.abs(norm / norm[0] - 1.0).max() <= EPS * np.sqrt(turns)
+    assert np.abs(norm / norm[0] - 1.0).max() <= TOL_MOMENTUM_NORM
     assert np.linalg.norm(momentum - momentum[0], axis=-1).max() / norm[0] <= EPS * np.sqrt(turns)
     # no drift: the energy error oscillates (splitting2 2.9e-5, splitting4 2.1e-11 in both tenths)
     assert last <= 2.0 * first

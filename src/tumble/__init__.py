@@ -15,6 +15,7 @@ from tumble import attitude, dynamics, integrate, torques
 from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.integrate import SolverError
+from tumble.limits import RigidityWarning
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory, load
 
@@ -34,6 +35,7 @@ def __getattr__(name):
 
 __all__ = [
     "RigidBody",
+    "RigidityWarning",
     "analysis",
     "analytic",
     "SolverError",

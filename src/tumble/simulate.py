@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from tumble import _rigid, attitude, integrate, torques
+from tumble import _rigid, attitude, integrate, limits, torques
 from tumble._validate import ValidationError, as_array
 from tumble.body import RigidBody, principal_axes
 from tumble.trajectory import Trajectory
@@ -91,7 +91,7 @@ def simulate(
                               + (" and a progress callback" if progress is not None else ""))
     m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque)
     times = _output_times(t)
-    moments, axes, batch_inertia = _bodies(body)
+    moments, axes, batch_inertia, mass = _bodies(body)
     omega0 = as_array(omega0, "omega0", tail=(3,))
     q0 = attitude.identity() if q0 is None else as_array(q0, "q0", tail=(4,))
     n = _batch_size(batch_inertia, omega0, q0)
@@ -107,6 +107,7 @@ def simulate(
     y0[:, :4] = attitude.multiply(q0, q_bp)
     y0[:, 4:] = np.einsum("bji,bj->bi", axes, omega0)
     rigid = _rigid.from_principal(moments, axes, model)
+    limits.check_rigid_motion(moments, y0[:, 4:], mass, stacklevel=3)
 
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
@@ -119,6 +120,8 @@ def simulate(
                 max_steps=max_steps, serial=model is not None and model.needs_python, progress=progress,
             )
 
+    if model is not None:  # a torque may have spun the body up: check where it ended
+        limits.check_rigid_motion(moments, states[-1, :, 4:], mass, stacklevel=3)
     q = attitude.multiply(states[..., :4], attitude.conjugate(q_bp))
     omega = np.einsum("bij,tbj->tbi", axes, states[..., 4:])
     if n is None:
@@ -144,24 +147,26 @@ def _output_times(t) -> np.ndarray:
     return times
 
 
-def _bodies(body) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Principal moments (B, 3), axes R_BP (B, 3, 3) and the inertia to report, B = 1 or one per member.
+def _bodies(body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | float | None]:
+    """Principal moments (B, 3), axes R_BP (B, 3, 3), the inertia to report and the mass (kg, or None
+    when unknown), B = 1 or one per member.
 
     An (N, 3, 3) inertia array is validated in one vectorised call
     (:func:`tumble.body.principal_axes`), with the rules of :class:`RigidBody`.
     """
     if isinstance(body, RigidBody):
-        return body.moments[None], body.axes[None], np.array(body.inertia)
+        return body.moments[None], body.axes[None], np.array(body.inertia), body.mass
     if isinstance(body, Sequence) and body and all(isinstance(b, RigidBody) for b in body):
+        masses = [b.mass for b in body]
         return (np.stack([b.moments for b in body]), np.stack([b.axes for b in body]),
-                np.stack([b.inertia for b in body]))
+                np.stack([b.inertia for b in body]), None if None in masses else np.array(masses))
     inertia = as_array(body, "inertia", tail=(3, 3))
     if inertia.ndim not in (2, 3):
         raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
     inertia, moments, axes = principal_axes(inertia, "inertia")
     if inertia.ndim == 2:
-        return moments[None], axes[None], inertia
-    return moments, axes, inertia
+        return moments[None], axes[None], inertia, None
+    return moments, axes, inertia, None
 
 
 def _batch_size(inertia, omega0, q0) -> int | None:

@@ -42,6 +42,14 @@ Casimir on the middle axis keeps the rates of ``A`` and ``B`` the smallest.
 
 The state stays ``[q, ω]``: ``L = I ω`` is formed at the start of each output
 interval and ``ω = L/I`` at its end.
+
+Rounding: every turn rounds the two components of ``L`` it moves, so ``|L|``
+would random-walk by about ``ε √(turns)`` (2.6e-13 after 1e6 steps of
+``splitting4``, 12e6 turns). At the end of each output interval ``L`` is
+therefore rescaled to its length at the start of the run (kept in the
+workspace), a correction of a few ulps along ``L`` that leaves its direction,
+the attitude and the order of the method untouched: ``|L|`` then stays within
+a few roundings of its initial value however long the run.
 """
 
 from __future__ import annotations
@@ -96,8 +104,9 @@ def _is_splitting(scheme):
 def _splitting_workspace(scheme, model, Y):
     if not _is_splitting(scheme):
         return None
-    # the rates of A, B and C of each lane (1/(kg·m²))
-    return lambda scheme, model, Y: (np.empty((3, Y.size // Y.shape[0])),)
+    # the rates of A, B and C of each lane (1/(kg·m²)), and |L|² at the start of the run
+    # (negative: not yet known; set by the first advance)
+    return lambda scheme, model, Y: (np.full((4, Y.size // Y.shape[0]), -1.0),)
 
 
 # error_model="numpy": IEEE division without Python's zero check, which measured
@@ -116,6 +125,8 @@ def _splitting_advance(scheme, model, b0, t0, h, m, Y, work):
             r = inverse_moments(model, b0 + j)
             rates[0, j], rates[1, j], rates[2, j] = r[ia] - r[c], r[ib] - r[c], r[c]
             y[4, j], y[5, j], y[6, j] = y[4, j] / r[0], y[5, j] / r[1], y[6, j] / r[2]  # L = I ω
+            if rates[3, j] < 0.0:
+                rates[3, j] = y[4, j] * y[4, j] + y[5, j] * y[5, j] + y[6, j] * y[6, j]
         # one turn of every lane at a time: the turns of different bodies are
         # independent and overlap in the processor (2x faster than all turns
         # of a step per lane)
@@ -132,8 +143,11 @@ def _splitting_advance(scheme, model, b0, t0, h, m, Y, work):
             y[0, j], y[1, j], y[2, j], y[3, j] = rotate_right(
                 y[0, j], y[1, j], y[2, j], y[3, j], tau * y[4, j], tau * y[5, j], tau * y[6, j]
             )
+            # |L| back to its length at the start of the run (the turns' rounding, see above)
+            norm2 = y[4, j] * y[4, j] + y[5, j] * y[5, j] + y[6, j] * y[6, j]
+            k = np.sqrt(rates[3, j] / norm2) if norm2 > 0.0 else 1.0
             r = inverse_moments(model, b0 + j)
-            y[4, j], y[5, j], y[6, j] = y[4, j] * r[0], y[5, j] * r[1], y[6, j] * r[2]  # ω = L/I
+            y[4, j], y[5, j], y[6, j] = k * y[4, j] * r[0], k * y[5, j] * r[1], k * y[6, j] * r[2]  # ω = L/I
 
     return impl
 
