@@ -339,3 +339,7 @@ def _written(output: Path, plot: Path | None) -> str:
 def _print_rows(rows: list[tuple[str, str]]) -> None:
     for label, value in rows:
         typer.echo(f"{label:<10}{value}")
+
+
+# The extension packages' demos (tumble demo diver, ...): registered on demo_app.
+from tumble import _demos  # noqa: E402,F401  (imported for its registrations)

@@ -1,0 +1,140 @@
+"""A hub with flexible appendages as a model for the integrators (see :mod:`tumble._model`).
+
+State ``y = [q_w, q_x, q_y, q_z, ω₁, ω₂, ω₃, η₁ … η_m, η̇₁ … η̇_m]``: the
+attitude of the body axes B (body → inertial), the body rate (rad/s, body
+axes) and the modal coordinates and their rates (kg^½·m, kg^½·m/s). The
+right-hand side solves the hybrid-coordinate equations (see
+:mod:`tumble.flexible` for their derivation)::
+
+    I ω̇ + Σₖ δₖ η̈ₖ + ω × h = τ,           h = I ω + Σₖ δₖ η̇ₖ
+    η̈ₖ + 2ζₖΩₖ η̇ₖ + Ωₖ² ηₖ + δₖ · ω̇ = 0
+
+for the accelerations by eliminating ``η̈`` (a Schur complement)::
+
+    fₖ = −2ζₖΩₖ η̇ₖ − Ωₖ² ηₖ
+    ω̇ = (I − Σ δₖδₖᵀ)⁻¹ (τ − ω × h − Σₖ δₖ fₖ),     η̈ₖ = fₖ − δₖ · ω̇
+
+``τ`` is the torque program evaluated in body axes.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+from numba.extending import overload
+
+from tumble import _model, _quat, torques
+
+
+class FlexibleModel(NamedTuple):
+    """Compiled parameters of a hub with ``m`` modal appendages (shared by a batch).
+
+    inertia       : (3, 3) inertia of the undeformed spacecraft, kg·m², body axes
+    inverse_hub   : (3, 3) ``(I − Σ δₖδₖᵀ)⁻¹``, 1/(kg·m²)
+    participation : (m, 3) rotational participation vectors ``δₖ``, kg^½·m, body axes
+    damping       : (m,) ``2ζₖΩₖ``, 1/s
+    stiffness     : (m,) ``Ωₖ²``, 1/s²
+    params, codes : the torque program in body axes (``codes`` may be empty)
+    """
+
+    inertia: np.ndarray
+    inverse_hub: np.ndarray
+    participation: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    params: np.ndarray
+    codes: np.ndarray
+
+    @property
+    def torque_free(self) -> bool:
+        """Always False: the free-rigid-body methods do not apply to a flexible body."""
+        return False
+
+
+@njit(cache=True, inline="always")
+def cross(a1, a2, a3, b1, b2, b3):
+    """``a × b`` of two 3-vectors given by components."""
+    return a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1
+
+
+@njit(cache=True, inline="always")
+def matvec(M, x1, x2, x3):
+    """``M x`` for a (3, 3) array ``M`` and a 3-vector given by components."""
+    return (
+        M[0, 0] * x1 + M[0, 1] * x2 + M[0, 2] * x3,
+        M[1, 0] * x1 + M[1, 1] * x2 + M[1, 2] * x3,
+        M[2, 0] * x1 + M[2, 1] * x2 + M[2, 2] * x3,
+    )
+
+
+@njit(cache=True)
+def derivative(model, t, y, out):
+    """``out = dy/dt`` of one state vector ``y`` (see the module docstring)."""
+    m = model.stiffness.shape[0]
+    D = model.participation
+    qw, qx, qy, qz, w1, w2, w3 = y[0], y[1], y[2], y[3], y[4], y[5], y[6]
+    r1, r2, r3 = torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, 0, model.codes)
+    h1, h2, h3 = matvec(model.inertia, w1, w2, w3)
+    for k in range(m):
+        rate = y[7 + m + k]
+        f = -model.damping[k] * rate - model.stiffness[k] * y[7 + k]
+        out[7 + m + k] = f  # the modal force, completed below
+        h1 += D[k, 0] * rate
+        h2 += D[k, 1] * rate
+        h3 += D[k, 2] * rate
+        r1 -= D[k, 0] * f
+        r2 -= D[k, 1] * f
+        r3 -= D[k, 2] * f
+    c1, c2, c3 = cross(w1, w2, w3, h1, h2, h3)
+    a1, a2, a3 = matvec(model.inverse_hub, r1 - c1, r2 - c2, r3 - c3)
+    for k in range(m):
+        out[7 + k] = y[7 + m + k]
+        out[7 + m + k] -= D[k, 0] * a1 + D[k, 1] * a2 + D[k, 2] * a3
+    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
+    out[0], out[1], out[2], out[3] = 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3]
+    out[4], out[5], out[6] = a1, a2, a3
+
+
+def _is_flexible(model):
+    return _model.is_type(model, FlexibleModel)
+
+
+@overload(_model.rhs, inline="always", jit_options={"cache": True})
+def _flexible_rhs(model, b0, t, Y, OUT):
+    if not _is_flexible(model):
+        return None
+    if Y.ndim == 1:
+        return lambda model, b0, t, Y, OUT: derivative(model, t, Y, OUT)
+
+    def impl(model, b0, t, Y, OUT):
+        for j in range(Y.shape[1]):
+            derivative(model, t, Y[:, j], OUT[:, j])
+
+    return impl
+
+
+@overload(_model.project, inline="always", jit_options={"cache": True})
+def _flexible_project(model, b0, t, Y):
+    if not _is_flexible(model):
+        return None
+    if Y.ndim == 1:
+        return lambda model, b0, t, Y: _model.normalize_quaternion(Y)
+    return lambda model, b0, t, Y: _model.normalize_quaternions(Y)
+
+
+@overload(_model.state_size, jit_options={"cache": True})
+def _flexible_state_size(model):
+    if not _is_flexible(model):
+        return None
+    return lambda model: 7 + 2 * model.stiffness.shape[0]
+
+
+@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+def _flexible_body_rate(model, Y, j):
+    if not _is_flexible(model):
+        return None
+    if Y.ndim == 1:
+        return lambda model, Y, j: (Y[4], Y[5], Y[6])
+    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
