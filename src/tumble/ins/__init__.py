@@ -1,0 +1,58 @@
+"""Gyroscopes and strapdown inertial navigation.
+
+================================  ==============================================================
+``Gyroscope``                     a spinning rotor on a pivot (``tumble.simulate``): precession
+                                  ``τ/(I_s ω_s)``, nutation ``I_s ω_s/I_t``, imbalance and friction drift
+``GimbaledGyro``                  a rotor in a two-axis gimbal with gimbal inertia (Lagrange's
+                                  equations on the model protocol, ``tumble.integrate.solve``)
+``Increments``                    angle (and velocity) increments over uniform sample intervals;
+``from_trajectory``               exact increments of a true motion; ``read_csv`` / ``write_csv``
+``SensorErrors``, ``Imu``         bias, ARW N, bias instability B, RRW K, scale factor,
+                                  misalignment, quantization (IEEE Std 952-1997), seeded
+``allan_deviation``               overlapping Allan deviation, N / B / K fits, ``allan_figure``
+``strapdown``                     rotation-vector attitude integration with none / one- / two- /
+                                  three-sample coning compensation, velocity with sculling
+``Coning``, ``drift_law``,        the classic coning motion (closed form) and the coning drift
+``measure_drift``                 of each algorithm, predicted and measured
+``demo_ins``, ``demo_coning``,    demonstrations that write figures and return their numbers
+``demo_gyroscope``
+================================  ==============================================================
+
+Conventions as everywhere in tumble: SI units, attitude ``q`` scalar-first
+body → inertial, rates and increments in body axes. See ``docs/ins.md``.
+"""
+
+from tumble.ins.allan import FLICKER_FACTOR, AllanDeviation, allan_deviation, allan_figure, gauss_markov_adev
+from tumble.ins.coning import Coning, drift_law, measure_drift
+from tumble.ins.demo import demo_coning, demo_gyroscope, demo_ins
+from tumble.ins.gimbal import GimbaledGyro, GimbalMotion
+from tumble.ins.gyroscope import Gyroscope
+from tumble.ins.increments import Increments, from_trajectory, read_csv, write_csv
+from tumble.ins.sensors import Imu, SensorErrors
+from tumble.ins.strapdown import ALGORITHMS, Navigation, strapdown
+
+__all__ = [
+    "ALGORITHMS",
+    "FLICKER_FACTOR",
+    "AllanDeviation",
+    "Coning",
+    "GimbalMotion",
+    "GimbaledGyro",
+    "Gyroscope",
+    "Imu",
+    "Increments",
+    "Navigation",
+    "SensorErrors",
+    "allan_deviation",
+    "allan_figure",
+    "demo_coning",
+    "demo_gyroscope",
+    "demo_ins",
+    "drift_law",
+    "from_trajectory",
+    "gauss_markov_adev",
+    "measure_drift",
+    "read_csv",
+    "strapdown",
+    "write_csv",
+]

@@ -1,0 +1,89 @@
+"""Mechanical gyroscopes simulated with Euler's equations (tumble.ins.gyroscope)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from tumble.analytic import measure_nutation
+from tumble.ins import Gyroscope
+from tumble._validate import ValidationError
+
+# Released at rest with its axis horizontal, the rotor precesses on average at
+# τ/(I_s ω_s) (1 − 2ε² + O(ε⁴)), ε = τ I_t/(I_s ω_s)² (from the exact heavy top,
+# tumble.analytic.HeavyTop: −1.08e-6 at ε = 7.4e-4, −1.73e-9 at ε = 2.9e-5). At
+# ω_s = 500 rad/s, ε = 2.9e-5, so the law holds to 2e-9 and the issue's 1e-6 is
+# limited by the integrator (dop853, rtol 1e-12): measured −4.3e-9.
+PRECESSION_RTOL = 1e-6
+# Nutation period 2π I_t/(I_s ω_s) (1 − 3ε² + …): at ε = 7.4e-4 the law is off by
+# 1.6e-6; the period measured from the simulation agrees with the exact heavy top to 1.6e-14.
+NUTATION_LAW_RTOL = 5 * (7.4e-4) ** 2
+NUTATION_EXACT_RTOL = 1e-9
+
+ROTOR = dict(spin_inertia=2e-3, transverse_inertia=1.5e-3, mass=0.1, offset=0.02)
+
+
+@pytest.mark.slow  # the first dop853 run with a torque program compiles it (~10 s of CPU cold)
+def test_precession_rate_is_torque_over_spin_momentum():
+    gyro = Gyroscope(spin=500.0, **ROTOR)
+    period = 2.0 * math.pi / gyro.nutation_frequency
+    cycles = 200
+    t = np.linspace(0.0, cycles * period, cycles * 40 + 1)
+    axis = gyro.axis(gyro.simulate(t))
+    # over whole nutation periods the nutation averages out of the azimuth
+    rate = (axis.phi[-1] - axis.phi[0]) / t[-1]
+    law = gyro.imbalance_torque / (gyro.spin_inertia * gyro.spin)
+    assert rate == pytest.approx(law, rel=PRECESSION_RTOL)
+    assert rate == pytest.approx(gyro.heavy_top().mean_precession_rate, rel=PRECESSION_RTOL)
+
+
+def test_steady_precession_has_no_nutation():
+    gyro = Gyroscope(spin=500.0, **ROTOR)
+    t = np.linspace(0.0, 10.0, 501)
+    axis = gyro.axis(gyro.simulate(t, released=False))
+    # exact for a horizontal axis; measured: rate to 3.7e-13, tilt constant to 2.7e-14 rad
+    assert np.polyfit(t, axis.phi, 1)[0] == pytest.approx(gyro.precession_rate, rel=1e-10)
+    assert np.ptp(axis.theta) < 1e-11
+
+
+def test_nutation_frequency():
+    gyro = Gyroscope(spin=100.0, **ROTOR)
+    top = gyro.heavy_top()
+    t = np.linspace(0.0, 50 * top.nutation_period, 50 * 200 + 1)
+    measured = measure_nutation(gyro.simulate(t), com=[0.0, 0.0, gyro.offset], g=[0.0, 0.0, -gyro.g])
+    assert measured.period == pytest.approx(top.nutation_period, rel=NUTATION_EXACT_RTOL)
+    assert 2 * math.pi / measured.period == pytest.approx(gyro.nutation_frequency, rel=NUTATION_LAW_RTOL)
+
+
+def test_spin_bearing_friction_speeds_up_the_imbalance_drift():
+    drag = 2e-3
+    gyro = Gyroscope(spin=500.0, spin_friction=drag, **ROTOR)
+    t = np.linspace(0.0, 100.0, 2001)
+    axis = gyro.axis(gyro.simulate(t, released=False))
+    spin = gyro.spin - drag * t / gyro.spin_inertia          # 500 → 400 rad/s
+    np.testing.assert_allclose(axis.spin, spin, rtol=1e-12)
+    phi = gyro.imbalance_torque / drag * np.log(gyro.spin / spin)
+    # adiabatic law: measured 3.0e-10 of the final azimuth (2.2 rad)
+    np.testing.assert_allclose(axis.phi, phi, rtol=0, atol=1e-8 * phi[-1])
+
+
+def test_pivot_friction_tilts_the_axis():
+    drag = 1e-4
+    gyro = Gyroscope(spin=500.0, pivot_friction=drag, **ROTOR)
+    t = np.linspace(0.0, 10.0, 2001)
+    axis = gyro.axis(gyro.simulate(t, released=False))
+    tilt_rate = np.polyfit(t, axis.theta, 1)[0]
+    # θ̇ = τ_p/(I_s ω_s) at θ = π/2; the axis tilts by 1 mrad, which changes the gravity torque
+    # by (1 − cos) ~ 5e-7: measured −4.3e-7 relative
+    assert tilt_rate == pytest.approx(drag / gyro.momentum, rel=1e-5)
+
+
+def test_gyroscope_validation():
+    with pytest.raises(ValidationError, match="spin"):
+        Gyroscope(spin=0.0, **ROTOR)
+    with pytest.raises(ValidationError, match="offset"):
+        Gyroscope(spin=10.0, **{**ROTOR, "offset": -1.0})
+    with pytest.raises(ValidationError, match="tilt"):
+        Gyroscope(spin=10.0, tilt=0.0, **ROTOR)
+    with pytest.raises(ValidationError, match="offset"):
+        Gyroscope(spin=10.0, **{**ROTOR, "offset": 0.0}).heavy_top()
