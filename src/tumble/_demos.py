@@ -21,8 +21,9 @@ Rows = Callable[[dict], list[tuple[str, str]]]
 
 
 def _written(summary: dict) -> tuple[str, str]:
-    """The row listing every path the demo wrote (keys ``nc``, ``png``, ``png_*``, ...)."""
-    paths = [str(v) for k, v in summary.items() if k in ("nc", "png", "csv") or k.startswith(("png_", "nc_"))]
+    """The row listing every path the demo wrote (keys ``nc``, ``png``, ``png_*``, ``*_png``, ...)."""
+    paths = [str(v) for k, v in summary.items()
+             if k in ("nc", "png") or k.startswith(("png_", "nc_")) or k.endswith(("_png", "_nc"))]
     return "wrote", ", ".join(paths)
 
 
@@ -61,5 +62,92 @@ _register(
                 f"final tilt {s['dive_final_tilt_deg']:.1f} deg"),
         ("|L|", f"largest relative drift {max(s['dive_momentum_drift'], s['twisting_somersault_momentum_drift']):.1e} "
                 "(torque-free flight: L is conserved)"),
+    ],
+)
+
+
+_register(
+    "flexible", "tumble.flexible:demo_flexible",
+    """A 30 deg rest-to-rest slew of a spacecraft with two flexible panel modes (0.2 and 1.1 Hz).
+
+    Bang-bang torque over 40 s, flexible hub against the rigid body (docs/flexible.md): the
+    panels keep vibrating after the manoeuvre and the hub jitters. Writes flexible.nc and
+    flexible.png in the directory.
+    """,
+    lambda s: [
+        ("torque", f"bang-bang, peak {s['peak_torque']:.4g} N m"),
+        ("modes", "residual amplitude " + ", ".join(f"{a:.3g}" for a in s["residual_modal_amplitude"])
+                  + " kg^0.5 m after the slew"),
+        ("jitter", f"{s['jitter_peak_arcsec']:.4g} arcsec peak, {s['jitter_rms_arcsec']:.4g} arcsec RMS, rate "
+                   f"{s['rate_jitter_peak_arcsec_per_s']:.4g} arcsec/s peak (rigid body: "
+                   f"{s['rigid_pointing_error_arcsec']:.2g} arcsec)"),
+    ],
+)
+
+_register(
+    "slosh", "tumble.slosh:demo_slosh",
+    """Fuel slosh turns a minor-axis spinner into a flat spin (pendulum analogue, docs/slosh.md).
+
+    The nutation angle grows exponentially at the rate of the linearised steady spin while the
+    sloshing fuel dissipates energy at constant |H|, until the spacecraft spins about its major
+    axis. Writes slosh.nc and slosh.png in the directory.
+    """,
+    lambda s: [
+        ("nutation", f"{s['nutation_initial_deg']:.3g} deg -> {s['nutation_final_deg']:.4g} deg"),
+        ("growth", f"time constant {s['growth_time_constant_s']:.4g} s (simulation), "
+                   f"{s['growth_time_constant_linear_s']:.4g} s (linearised steady spin)"),
+        ("energy", f"{s['energy_change']:+.1%}, final {s['energy_final']:.7g} J vs flat spin "
+                   f"{s['energy_flat_spin']:.7g} J, monotonic: {s['energy_monotonic']}"),
+        ("|H|", f"largest relative drift {s['momentum_norm_drift']:.1e}"),
+    ],
+)
+
+_register(
+    "gyro", "tumble.ins.demo:demo_gyroscope",
+    """A mechanical gyroscope: precession under a torque, nutation, and drift from imbalance and friction.
+
+    A rotor on a pivot simulated with Euler's equations (docs/ins.md): precession rate
+    torque/(I_s w_s) and nutation period against theory. Writes ins_gyro_precession.png and
+    ins_gyro_drift.png in the directory.
+    """,
+    lambda s: [
+        ("precession", f"{s['precession_rate_measured']:.9g} rad/s (simulated), "
+                       f"{s['precession_rate']:.9g} rad/s (torque/(I_s w_s))"),
+        ("nutation", f"period {s['nutation_period_s_measured']:.9g} s (simulated), "
+                     f"{s['nutation_period_s']:.9g} s (exact heavy top)"),
+        ("drift", f"against the laws: imbalance {s['imbalance_drift_error_rad']:.2g} rad, spin drag "
+                  f"{s['spin_drag_drift_error_rad']:.2g} rad, pivot friction {s['pivot_tilt_error_rad']:.2g} rad"),
+    ],
+)
+
+_register(
+    "coning", "tumble.ins.demo:demo_coning",
+    """The classic coning test of strapdown attitude algorithms (alpha = 0.01 rad, Omega = 2 pi rad/s).
+
+    Drift rate about the cone axis of the uncompensated, one-, two- and three-sample
+    algorithms against the laws alpha^2 Omega (Omega T)^4/960 and alpha^2 Omega (Omega T)^6/204120
+    (docs/ins.md). Writes ins_coning.png in the directory.
+    """,
+    lambda s: [(algorithm, f"measured drift within {s[algorithm]['max_relative_deviation']:.1%} of its law")
+               for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
+)
+
+_register(
+    "ins", "tumble.ins.demo:demo_ins",
+    """End to end: a tumbling body, a gyro with errors, strapdown integration, attitude error.
+
+    The exact torque-free motion is sampled by a 200 Hz gyro (error-free, angle random walk only,
+    all error terms) and integrated back with the three-sample algorithm for 60 s; the same gyro
+    at rest gives an Allan deviation from which N and B are recovered (docs/ins.md). Writes
+    ins_error.png and ins_allan.png in the directory.
+    """,
+    lambda s: [
+        *[(name, f"attitude error after {s['duration_s']:g} s: {s[name]['final_rad']:.2g} rad")
+          for name in ("error-free", "angle random walk", "all error terms")],
+        ("ARW", f"prediction N sqrt(3t) = {s['arw_prediction_rad']:.2g} rad"),
+        ("Allan", f"N {s['white_noise']:.3g} -> recovered "
+                  + ", ".join(f"{v:.3g}" for v in s["white_noise_recovered"])
+                  + f"; B {s['bias_instability']:.3g} -> recovered "
+                  + ", ".join(f"{v:.3g}" for v in s["bias_instability_recovered"])),
     ],
 )

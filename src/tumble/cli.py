@@ -338,7 +338,7 @@ def _written(output: Path, plot: Path | None) -> str:
 
 def _print_rows(rows: list[tuple[str, str]]) -> None:
     for label, value in rows:
-        typer.echo(f"{label:<10}{value}")
+        typer.echo(f"{label:<10}{value}" if len(label) < 10 else f"{label} {value}")
 
 
 # The extension packages' demos (tumble demo diver, ...): registered on demo_app.
