@@ -56,6 +56,8 @@ from tumble import attitude, integrate, torques
 from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.simulate import simulate
+from tumble.spacecraft.damper import SphericalDamper, simulate_damped
+from tumble.spacecraft.orbit import EARTH_RADIUS, Orbit
 from tumble.trajectory import Trajectory
 
 __all__ = ["Problem", "Scenario", "ScenarioError", "load_scenario", "parse_scenario", "run_scenario"]
@@ -368,7 +370,7 @@ class ConstantBodyTorque(_Table):
     value: _Vector
     renamed: ClassVar[dict[str, str]] = {"torque": "value"}
 
-    def build(self) -> torques.TorqueModel:
+    def build(self, body: RigidBody) -> torques.TorqueModel:
         return torques.ConstantBody(self.value)
 
 
@@ -379,7 +381,7 @@ class ConstantInertialTorque(_Table):
     value: _Vector
     renamed: ClassVar[dict[str, str]] = {"torque": "value"}
 
-    def build(self) -> torques.TorqueModel:
+    def build(self, body: RigidBody) -> torques.TorqueModel:
         return torques.ConstantInertial(self.value)
 
 
@@ -393,7 +395,7 @@ class TabulatedTorque(_Table):
     interpolation: Literal["linear", "previous"] | None = None
     renamed: ClassVar[dict[str, str]] = {"t": "times", "torque": "values"}
 
-    def build(self) -> torques.TorqueModel:
+    def build(self, body: RigidBody) -> torques.TorqueModel:
         options = self.model_dump(include={"frame", "interpolation"}, exclude_none=True)
         return torques.Tabulated(self.times, self.values, **options)
 
@@ -407,12 +409,75 @@ class GravityTorque(_Table):
     com: _Vector
     g: _Vector | None = None
 
-    def build(self) -> torques.TorqueModel:
+    def build(self, body: RigidBody) -> torques.TorqueModel:
         return torques.Gravity(self.mass, self.com, *([] if self.g is None else [self.g]))
 
 
-_Torque = Annotated[Union[ConstantBodyTorque, ConstantInertialTorque, TabulatedTorque, GravityTorque],
+class OrbitTable(_Table):
+    """A Kepler orbit, as :class:`tumble.spacecraft.orbit.Orbit`: ``altitude`` (m above the Earth's
+    equatorial radius, 6378137 m) or ``semi_major_axis`` (m); ``eccentricity``; angles ``inclination``,
+    ``raan``, ``arg_periapsis``, ``mean_anomaly`` (at t = 0) in degrees (or rad with ``degrees = false``);
+    ``mu`` (m³/s², default the Earth's)."""
+
+    altitude: _Number | None = None
+    semi_major_axis: _Positive | None = Field(None, validate_default=True)
+    eccentricity: _Number = 0.0
+    inclination: _Number = 0.0
+    raan: _Number = 0.0
+    arg_periapsis: _Number = 0.0
+    mean_anomaly: _Number = 0.0
+    degrees: _Bool = True
+    mu: _Positive | None = None
+
+    @field_validator("semi_major_axis")
+    @classmethod
+    def _one_size(cls, semi_major_axis, info):
+        if "altitude" in info.data and (info.data["altitude"] is None) == (semi_major_axis is None):
+            raise ValueError("give exactly one of altitude (m above 6378137 m) or semi_major_axis (m)")
+        return semi_major_axis
+
+    def build(self) -> Orbit:
+        a = self.semi_major_axis if self.altitude is None else EARTH_RADIUS + self.altitude
+        angle = np.radians if self.degrees else float
+        options = {} if self.mu is None else {"mu": self.mu}
+        return Orbit(semi_major_axis=a, eccentricity=self.eccentricity, inclination=angle(self.inclination),
+                     raan=angle(self.raan), arg_periapsis=angle(self.arg_periapsis),
+                     mean_anomaly=angle(self.mean_anomaly), **options)
+
+
+class GravityGradientTorque(_Table):
+    """Gravity gradient on the body on the Kepler orbit ``orbit``, as :class:`tumble.torques.GravityGradient`
+    (the body's own inertia; the orbit's t = 0 at the scenario's t = 0)."""
+
+    kind: Literal["gravity_gradient"]
+    orbit: OrbitTable
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        keys.update(self.orbit.argument_keys(f"{prefix}.orbit"))
+        keys["semi_major_axis"] = f"{prefix}.orbit." + ("altitude" if self.orbit.altitude is not None
+                                                        else "semi_major_axis")
+        return keys
+
+    def build(self, body: RigidBody) -> torques.TorqueModel:
+        return torques.GravityGradient(self.orbit.build(), body)
+
+
+_Torque = Annotated[Union[ConstantBodyTorque, ConstantInertialTorque, TabulatedTorque, GravityTorque,
+                          GravityGradientTorque],
                     Field(discriminator="kind")]
+
+
+class DamperTable(_Table):
+    """A spherical viscous nutation damper in the body (:mod:`tumble.spacecraft.damper`): sphere ``inertia``
+    J (kg m²), ``damping`` c (N m s), initial sphere rate ``omega`` (rad/s, body axes; default: the body's)."""
+
+    inertia: _Positive
+    damping: _Positive
+    omega: _Vector | None = None
+
+    def build(self) -> SphericalDamper:
+        return SphericalDamper(self.inertia, self.damping)
 
 
 # --------------------------------------------------------------------------
@@ -434,7 +499,9 @@ class Problem:
     ``omega0`` rad/s in body axes; ``q0`` unit quaternion ``[w, x, y, z]``,
     body → inertial; ``t`` output times, s; ``options`` the solver options
     given in the file (``rtol``, ``atol``, ``dt``); ``torque`` a torque model
-    or ``None`` (torque-free); ``source`` the file, for error messages.
+    or ``None`` (torque-free); ``source`` the file, for error messages;
+    ``damper`` a nutation damper in the body and ``damper_omega0`` its initial
+    rate (rad/s, body axes; ``None``: the body's), or ``None``.
     """
 
     body: RigidBody
@@ -445,10 +512,17 @@ class Problem:
     options: dict[str, float]
     torque: torques.TorqueModel | None
     source: str = "<scenario>"
+    damper: SphericalDamper | None = None
+    damper_omega0: np.ndarray | None = None
 
     def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-        """Run :func:`tumble.simulate`; an argument it refuses is reported against its scenario key."""
-        with _blame(self.source, "", _SIMULATE_KEYS):
+        """Run :func:`tumble.simulate` (or, with a damper, :func:`tumble.spacecraft.damper.simulate_damped`);
+        an argument it refuses is reported against its scenario key."""
+        with _blame(self.source, "", {**_SIMULATE_KEYS, "damper_omega0": "damper.omega"}):
+            if self.damper is not None:
+                return simulate_damped(self.body, self.damper, self.omega0, q0=self.q0, t=self.t,
+                                       damper_omega0=self.damper_omega0, method=self.method, torque=self.torque,
+                                       progress=progress, **self.options)
             return simulate(self.body, self.omega0, q0=self.q0, t=self.t, method=self.method,
                             torque=self.torque, progress=progress, **self.options)
 
@@ -463,6 +537,7 @@ class Scenario(_Table):
     time: Time
     solver: Solver = Solver()
     torque: list[_Torque] = []
+    damper: DamperTable | None = None
 
     _source: str = PrivateAttr("<scenario>")
 
@@ -486,7 +561,7 @@ class Scenario(_Table):
         models = []
         for i, entry in enumerate(self.torque):
             with _blame(self.source, f"torque[{i}]", entry.argument_keys(f"torque[{i}]")):
-                models.append(entry.build())
+                models.append(entry.build(body))
         return Problem(
             body=body,
             omega0=np.array(self.initial.omega),
@@ -496,6 +571,8 @@ class Scenario(_Table):
             options=self.solver.options(),
             torque=functools.reduce(operator.add, models) if models else None,
             source=self.source,
+            damper=None if self.damper is None else self.damper.build(),
+            damper_omega0=None if self.damper is None or self.damper.omega is None else np.array(self.damper.omega),
         )
 
 

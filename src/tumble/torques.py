@@ -16,6 +16,8 @@ Models add with ``+``. The built-in models run compiled inside the integrators
                         zero-order-hold interpolation, end values held
 ``Gravity(m, r, g)``    uniform gravity on a body pivoting about a fixed point:
                         ``τ_B = r_B × m R(q)ᵀ g_N`` (heavy top)
+``GravityGradient``     gravity gradient on a body of inertia ``I`` on an orbit:
+                        ``τ_B = 3μ/|r|⁵ r_B × (I r_B)``, ``r_B = R(q)ᵀ r_N(t)``
 =====================  ==========================================================
 
 Any Python callable ``f(t, q, omega) -> torque`` (body axes) is accepted too,
@@ -39,9 +41,10 @@ import numpy as np
 from numba import njit, objmode
 from numba.extending import register_jitable
 
-from tumble import _quat
+from tumble import _gravity, _quat
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.attitude import rotate_inverse
+from tumble.body import RigidBody, principal_axes
 
 __all__ = [
     "TorqueModel",
@@ -49,6 +52,7 @@ __all__ = [
     "ConstantInertial",
     "Tabulated",
     "Gravity",
+    "GravityGradient",
     "FunctionOfTime",
     "PythonTorque",
     "as_torque_model",
@@ -59,6 +63,7 @@ _CONST_BODY = 1
 _CONST_INERTIAL = 2
 _TABULATED = 3
 _GRAVITY = 4
+_GRAVITY_GRADIENT = 5
 _PYTHON = 9
 
 
@@ -204,6 +209,48 @@ class Gravity(TorqueModel):
 
     def __repr__(self):
         return f"Gravity(mass={self.mass}, com={self.com.tolist()}, g={self.g.tolist()})"
+
+
+class GravityGradient(TorqueModel):
+    """Gravity-gradient torque on a body on a Kepler orbit about a point mass.
+
+    ``τ_B = (3 μ / |r|⁵) r_B × (I r_B)`` with ``r_B = R(q)ᵀ r_N(t)`` the
+    position of the centre of mass in body axes (m), ``r_N(t)`` from the orbit
+    (inertial axes, the orbit's epoch at ``t = 0``) and ``I`` the body's
+    inertia tensor about its centre of mass, in body axes (kg·m²). Hughes,
+    *Spacecraft Attitude Dynamics*, ch. 8; the compiled kernel is
+    :func:`tumble.spacecraft.environment.gravity_gradient_torque`.
+
+    orbit   : a :class:`tumble.spacecraft.orbit.Orbit` (anything with an
+              ``elements()`` method returning ``[a, e, i, Ω, ω, M₀, μ]``)
+    inertia : the simulated body's inertia (a :class:`~tumble.RigidBody` or a
+              (3, 3) tensor, kg·m², body axes). The torque model needs it to be a
+              complete function ``τ(t, q, ω)``; give the same body you simulate
+              (a batch with dispersed inertia needs one model per member).
+
+    The body's orbital motion is prescribed (a fixed Kepler orbit): the
+    attitude does not act back on the orbit.
+    """
+
+    def __init__(self, orbit, inertia):
+        if not callable(getattr(orbit, "elements", None)):
+            raise ValidationError(f"orbit: must be a tumble.spacecraft.orbit.Orbit, got {type(orbit).__name__}")
+        self.orbit = orbit
+        self.elements = as_array(orbit.elements(), "orbit.elements()", tail=(7,))
+        if isinstance(inertia, RigidBody):
+            inertia = inertia.inertia
+        self.inertia = principal_axes(as_array(inertia, "inertia", tail=(3, 3)), "inertia", check_triangle=False)[0]
+        if self.inertia.ndim != 2:
+            raise ValidationError(f"inertia: must have shape (3, 3), got {self.inertia.shape}")
+
+    def _params(self, axes):
+        i = axes.T @ self.inertia @ axes  # in the axes the program is compiled for
+        return _GRAVITY_GRADIENT, np.concatenate(
+            [self.elements, [i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]]]
+        )
+
+    def __repr__(self):
+        return f"GravityGradient({self.orbit!r}, inertia={self.inertia.tolist()})"
 
 
 class PythonTorque(TorqueModel):
@@ -396,6 +443,17 @@ def evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
             gx, gy, gz = _quat.qrotate_inv(qw, qx, qy, qz, P[row, o + 3], P[row, o + 4], P[row, o + 5])
             rx, ry, rz = P[row, o], P[row, o + 1], P[row, o + 2]
             a, b, c = ry * gz - rz * gy, rz * gx - rx * gz, rx * gy - ry * gx
+        elif code == _GRAVITY_GRADIENT:
+            # orbit position (inertial), into the program's axes, then 3μ/r⁵ r × (I r)
+            rx, ry, rz, _, _, _ = _gravity.kepler_state(
+                P[row, o], P[row, o + 1], P[row, o + 2], P[row, o + 3], P[row, o + 4], P[row, o + 5],
+                P[row, o + 6], t,
+            )
+            rx, ry, rz = _quat.qrotate_inv(qw, qx, qy, qz, rx, ry, rz)
+            a, b, c = _gravity.gravity_gradient_torque(
+                P[row, o + 6], rx, ry, rz, P[row, o + 7], P[row, o + 8], P[row, o + 9], P[row, o + 10],
+                P[row, o + 11], P[row, o + 12],
+            )
         else:  # a Python callback: see evaluate
             continue
         t1 += a
