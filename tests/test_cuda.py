@@ -8,6 +8,7 @@ toolkit's NVVM is installed, which the simulator alone would not check.
 """
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -180,7 +181,12 @@ def test_compiles_for_a_gpu(monkeypatch, torque):
                  float64[:, :, ::1])
     ptx, _ = cuda.compile_ptx(_cuda._rk4_kernel.py_func, signature, cc=(9, 0))
     assert ptx.count(".entry") == 1
-    assert ".local" not in ptx
+    # The kernel keeps every state in registers. The one local array allowed is
+    # libdevice's Payne–Hanek argument reduction for sin/cos of huge angles
+    # (the gravity-gradient torque's orbit), a 40-byte scratch of that function.
+    functions = re.split(r"\n(?=\.(?:visible \.)?(?:entry|func))", ptx)
+    with_local = [re.search(r"([\w$]+)\($", f.splitlines()[0].rstrip()).group(1) for f in functions if ".local" in f]
+    assert set(with_local) <= {"__internal_trig_reduction_slowpathd"}, with_local
     assert "fma.rn.f64" in ptx  # NVVM's default contraction, as docs/gpu.md says
 
 

@@ -57,7 +57,8 @@ def from_principal(moments, axes, model) -> RigidModel:
     torque no per-body work is done beyond the Euler coefficients, so a batch
     of a million bodies with dispersed inertia is set up in milliseconds.
     """
-    moments = np.ascontiguousarray(moments, dtype=np.float64)
+    # a writeable copy: RigidBody.moments is read-only, and Numba would compile every integrator once more
+    moments = np.array(moments, dtype=np.float64, order="C")
     coefficients = np.stack(euler_coefficients(moments[:, 0], moments[:, 1], moments[:, 2]), axis=-1)
     if model is None:
         codes, params = None, np.zeros((1, 0))
