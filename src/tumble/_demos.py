@@ -21,9 +21,8 @@ Rows = Callable[[dict], list[tuple[str, str]]]
 
 
 def _written(summary: dict) -> tuple[str, str]:
-    """The row listing every path the demo wrote (keys ``nc``, ``png``, ``png_*``, ``*_png``, ...)."""
-    paths = [str(v) for k, v in summary.items()
-             if k in ("nc", "png") or k.startswith(("png_", "nc_")) or k.endswith(("_png", "_nc"))]
+    """The row listing every file the demo wrote (the summary's values that are paths of figures or data)."""
+    paths = [str(v) for v in summary.values() if isinstance(v, (str, Path)) and str(v).endswith((".png", ".nc"))]
     return "wrote", ", ".join(paths)
 
 
@@ -149,5 +148,42 @@ _register(
                   + ", ".join(f"{v:.3g}" for v in s["white_noise_recovered"])
                   + f"; B {s['bias_instability']:.3g} -> recovered "
                   + ", ".join(f"{v:.3g}" for v in s["bias_instability_recovered"])),
+    ],
+)
+
+_register(
+    "explorer1", "tumble.spacecraft.passive:demo_explorer1",
+    """Explorer 1 (1958): a spin about the minor axis decays into a flat spin about the major axis.
+
+    The satellite (750 rpm about its long, minor axis) dissipates energy in a spherical viscous
+    damper standing in for its whip antennas; the nutation angle grows to 90 deg at constant |L|
+    with the energy-sink time constant (docs/passive_stability.md). Writes explorer1.nc and
+    explorer1.png in the directory.
+    """,
+    lambda s: [
+        ("time", f"constant {s['time_constant_s']:.4g} s (simulation), {s['time_constant_estimate_s']:.4g} s "
+                 "(energy-sink estimate)"),
+        ("nutation", f"final {s['final_nutation_deg']:.4f} deg: a flat spin about the major axis"),
+        ("energy", f"{s['energy_initial_J']:.4g} J -> {s['energy_final_J']:.4g} J, "
+                   + ("falling at every sample" if s["max_energy_increase"] < 0.0 else
+                      f"rising by up to {s['max_energy_increase']:.1e} (relative) between samples")),
+        ("|L|", f"largest relative drift {s['momentum_drift']:.1e} (magnitude), {s['momentum_vector_drift']:.1e} "
+                "(inertial vector), hub and damper together"),
+    ],
+)
+
+_register(
+    "gravity-gradient", "tumble.spacecraft.passive:demo_gravity_gradient",
+    """A gravity-gradient-stabilised satellite librating about the local-vertical frame (LVLH).
+
+    Classifies the spacecraft in the (k_R, k_Y) plane (Lagrange and DeBra-Delp regions),
+    simulates its libration on a circular orbit and draws both (docs/passive_stability.md).
+    """,
+    lambda s: [
+        ("region", f"{s['region']} (k_R = {s['k_roll']:.4g}, k_Y = {s['k_yaw']:.4g})"),
+        ("frequency", f"pitch {s['pitch_frequency']:.5g} n, roll/yaw "
+                      + ", ".join(f"{f:.5g}" for f in s["roll_yaw_frequencies"])
+                      + f" n (orbit period {s['orbit_period_s']:.6g} s)"),
+        ("libration", f"largest roll/pitch/yaw angle {s['max_angle_deg']:.3g} deg"),
     ],
 )

@@ -329,6 +329,9 @@ def _summary(traj: Trajectory) -> list[tuple[str, str]]:
     ]
     if torque != "none":
         rows.append(("", f"(torque {torque} acts: T and |L| need not be conserved)"))
+    if traj.extras:
+        rows.append(("", "(drifts of the rigid hub alone; the model's internal states ("
+                         + ", ".join(traj.extras) + ") exchange momentum and energy with it)"))
     return rows
 
 
