@@ -27,7 +27,7 @@ def main(n_bodies: int = 10**6) -> None:
     # compile on a small batch first
     ensemble_statistics(inertia[:100], omega0[:100], t=t, method="rk4", dt=0.01, chunk=64)
     start = time.perf_counter()
-    ds = ensemble_statistics(inertia, omega0, t=t, method="rk4", dt=0.01, chunk=2**16)
+    ds = ensemble_statistics(inertia, omega0, t=t, method="rk4", dt=0.01)
     wall = time.perf_counter() - start
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20  # kB -> GB (Linux)
     whole = t.size * n_bodies * 7 * 8 / 2**30

@@ -11,7 +11,7 @@ tensor about the centre of mass in body axes. See ``docs/conventions.md``.
     >>> traj = tumble.simulate(body, [1e-3, 1.0, 1e-3], t=np.linspace(0, 100, 1001))
 """
 
-from tumble import attitude, dynamics, integrate, torques
+from tumble import attitude, dynamics, integrate, limits, torques
 from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.integrate import SolverError
@@ -23,7 +23,8 @@ __version__ = "0.1.0"
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
-_LAZY = ("analytic", "viz", "scenario", "analysis")
+_LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
+         "robot")
 
 
 def __getattr__(name):
@@ -43,10 +44,18 @@ __all__ = [
     "ValidationError",
     "attitude",
     "dynamics",
+    "ensemble",
+    "flexible",
+    "ins",
     "integrate",
+    "limits",
     "load",
+    "robot",
     "scenario",
     "simulate",
+    "slosh",
+    "spacecraft",
     "torques",
+    "variable",
     "viz",
 ]

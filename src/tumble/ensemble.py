@@ -26,7 +26,11 @@ from tumble.body import RigidBody
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
 
-__all__ = ["ensemble_statistics", "DEFAULT_QUANTITIES", "STATISTICS"]
+__all__ = ["ensemble_statistics", "DEFAULT_QUANTITIES", "SAMPLES_PER_CHUNK", "STATISTICS"]
+
+#: Default chunk size in body-samples (bodies × output times): states, trajectory and statistics of a chunk
+#: take about 400 bytes per body-sample, so about 200 MB.
+SAMPLES_PER_CHUNK = 2**19
 
 #: The statistics computed for every quantity, in the order of the ``statistic`` dimension.
 STATISTICS = ("mean", "std", "min", "max")
@@ -47,7 +51,7 @@ def ensemble_statistics(
     t,
     q0=None,
     quantities: Mapping[str, Callable[[Trajectory], np.ndarray]] | None = None,
-    chunk: int = 65536,
+    chunk: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     **options,
 ):
@@ -66,9 +70,11 @@ def ensemble_statistics(
         What to reduce, computed on each chunk's :class:`~tumble.Trajectory`
         (``c`` bodies); default :data:`DEFAULT_QUANTITIES` (``omega`` and the
         drifts of energy and momentum).
-    chunk : int
+    chunk : int, optional
         Bodies per chunk; the peak memory is about that of a
-        :func:`~tumble.simulate` of ``chunk`` bodies.
+        :func:`~tumble.simulate` of ``chunk`` bodies, some 400 bytes per body
+        and output time. Default: :data:`SAMPLES_PER_CHUNK` ``// len(t)``
+        (at least 1024), about 200 MB.
     progress : callable ``progress(done, total)``, optional
         Called after each chunk with the number of bodies done.
     **options
@@ -88,6 +94,8 @@ def ensemble_statistics(
     if omega0.ndim != 2:
         raise ValidationError(f"omega0: must have shape (N, 3) (one rate per body), got {omega0.shape}")
     n_bodies = omega0.shape[0]
+    if chunk is None:
+        chunk = max(1024, SAMPLES_PER_CHUNK // max(1, np.size(t)))
     if int(chunk) < 1:
         raise ValidationError(f"chunk: must be >= 1 body, got {chunk}")
     chunk = int(chunk)
