@@ -47,3 +47,11 @@ def require_positive(x: float, name: str) -> float:
     if not np.isfinite(x) or x <= 0.0:
         raise ValidationError(f"{name}: must be a finite number > 0, got {x}")
     return x
+
+
+def require_non_negative(x: float, name: str) -> float:
+    """Return ``float(x)`` if it is finite and >= 0, else raise naming ``name``."""
+    x = float(x)
+    if not np.isfinite(x) or x < 0.0:
+        raise ValidationError(f"{name}: must be a finite number >= 0, got {x}")
+    return x

@@ -60,7 +60,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble import _slosh, attitude, torques
-from tumble._validate import ValidationError, as_array, require_positive
+from tumble._validate import ValidationError, as_array, require_non_negative, require_positive
 from tumble.body import RigidBody
 from tumble.flexible import initial_states, integrate_model
 from tumble.simulate import _output_times
@@ -69,12 +69,6 @@ from tumble.trajectory import Extra, Trajectory, write_atomic
 __all__ = ["Pendulum", "SloshBody", "simulate", "energy", "momentum_body", "nutation_angle",
            "in_plane_frequency", "flat_spin_energy", "growth_time_constant", "steady_spin_eigenvalues", "demo_slosh"]
 
-
-def _non_negative(value, name):
-    value = float(value)
-    if not math.isfinite(value) or value < 0.0:
-        raise ValidationError(f"{name}: must be a finite number >= 0, got {value}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -94,9 +88,9 @@ class Pendulum:
     damping: float = 0.0
 
     def __post_init__(self):
-        object.__setattr__(self, "mass", _non_negative(self.mass, "mass"))
+        object.__setattr__(self, "mass", require_non_negative(self.mass, "mass"))
         object.__setattr__(self, "length", require_positive(self.length, "length"))
-        object.__setattr__(self, "damping", _non_negative(self.damping, "damping"))
+        object.__setattr__(self, "damping", require_non_negative(self.damping, "damping"))
         hinge = as_array(self.hinge, "hinge", tail=(3,))
         if hinge.ndim != 1:
             raise ValidationError(f"hinge: must have shape (3,), got {hinge.shape}")

@@ -49,7 +49,7 @@ from numba import njit
 from numba.extending import overload
 
 from tumble import _model, _quat, attitude, integrate
-from tumble._validate import ValidationError, require_positive
+from tumble._validate import ValidationError, require_non_negative, require_positive
 from tumble.trajectory import Trajectory
 
 __all__ = ["GimbalMotion", "GimbaledGyro"]
@@ -143,12 +143,6 @@ class GimbalMotion:
     rotor: Trajectory
 
 
-def _non_negative(value, name):
-    value = float(value)
-    if not (math.isfinite(value) and value >= 0.0):
-        raise ValidationError(f"{name}: must be a finite number >= 0, got {value}")
-    return value
-
 
 @dataclass(frozen=True)
 class GimbaledGyro:
@@ -175,12 +169,12 @@ class GimbaledGyro:
     def __post_init__(self):
         for name in ("spin_inertia", "transverse_inertia"):
             object.__setattr__(self, name, require_positive(getattr(self, name), name))
-        ring = tuple(_non_negative(v, f"inner_gimbal[{i}]") for i, v in enumerate(self.inner_gimbal))
+        ring = tuple(require_non_negative(v, f"inner_gimbal[{i}]") for i, v in enumerate(self.inner_gimbal))
         if len(ring) != 3:
             raise ValidationError(f"inner_gimbal: must be three moments (A, B, C), got {len(ring)}")
         object.__setattr__(self, "inner_gimbal", ring)
         for name in ("outer_gimbal", "outer_friction", "spin_friction"):
-            object.__setattr__(self, name, _non_negative(getattr(self, name), name))
+            object.__setattr__(self, name, require_non_negative(getattr(self, name), name))
         for name in ("imbalance", "inner_torque", "outer_torque"):
             value = float(getattr(self, name))
             if not math.isfinite(value):

@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble import attitude, torques
-from tumble._validate import ValidationError, require_positive
+from tumble._validate import ValidationError, require_non_negative, require_positive
 from tumble.analytic import AxisMotion, HeavyTop, axis_motion
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
@@ -56,12 +56,6 @@ __all__ = ["Gyroscope"]
 
 STANDARD_GRAVITY = 9.80665
 
-
-def _non_negative(value, name):
-    value = float(value)
-    if not (math.isfinite(value) and value >= 0.0):
-        raise ValidationError(f"{name}: must be a finite number >= 0, got {value}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -93,7 +87,7 @@ class Gyroscope:
         for name in ("spin_inertia", "transverse_inertia", "mass", "g"):
             object.__setattr__(self, name, require_positive(getattr(self, name), name))
         for name in ("offset", "spin_friction", "pivot_friction"):
-            object.__setattr__(self, name, _non_negative(getattr(self, name), name))
+            object.__setattr__(self, name, require_non_negative(getattr(self, name), name))
         spin = float(self.spin)
         if not math.isfinite(spin) or spin == 0.0:
             raise ValidationError(f"spin: must be a finite non-zero rate (rad/s), got {spin}")

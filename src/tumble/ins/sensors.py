@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
-from tumble._validate import ValidationError, as_array
+from tumble._validate import ValidationError, as_array, require_non_negative
 from tumble.ins.increments import Increments, from_trajectory
 from tumble.trajectory import Trajectory
 
@@ -68,12 +68,6 @@ def _vector3(value, name):
         raise ValidationError(f"{name}: must have shape (3,), got {arr.shape}")
     return arr
 
-
-def _non_negative(value, name):
-    value = float(value)
-    if not (math.isfinite(value) and value >= 0.0):
-        raise ValidationError(f"{name}: must be a finite number >= 0, got {value}")
-    return value
 
 
 @dataclass(frozen=True)
@@ -99,7 +93,7 @@ class SensorErrors:
             raise ValidationError("misalignment: the diagonal must be zero (scale errors go in scale_factor)")
         object.__setattr__(self, "misalignment", m)
         for name in ("white_noise", "bias_instability", "random_walk", "quantization"):
-            object.__setattr__(self, name, _non_negative(getattr(self, name), name))
+            object.__setattr__(self, name, require_non_negative(getattr(self, name), name))
         band = tuple(float(x) for x in as_array(self.flicker_band, "flicker_band"))
         if len(band) != 2 or not 0.0 < band[0] < band[1]:
             raise ValidationError(f"flicker_band: must be (T_min, T_max) with 0 < T_min < T_max (s), got {band}")
