@@ -346,3 +346,6 @@ def _print_rows(rows: list[tuple[str, str]]) -> None:
 
 # The extension packages' demos (tumble demo diver, ...): registered on demo_app.
 from tumble import _demos  # noqa: E402,F401  (imported for its registrations)
+from tumble.robot.cli import app as _robot_app  # noqa: E402
+
+app.add_typer(_robot_app, name="robot", help="Robot arms (serial chains from DH tables or URDF): joint torques.")
