@@ -16,6 +16,7 @@ Documented in ``docs/cli.md``.
 
 from __future__ import annotations
 
+import tomllib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -102,15 +103,26 @@ def run(
     A bad scenario is reported on stderr (file, key, rule) with exit code 2, and nothing is written.
     """
     with _exit_codes():
-        spec = load_scenario(scenario)
-        problem = spec.build()  # every rule of the file is checked before anything runs
-        _check_outputs(output, plot, inputs=(scenario,))
-        with _progress_bar("simulating", enabled=not quiet) as progress:
-            traj = problem.simulate(progress=progress)
-        figure = traj.plot(title=spec.name) if plot is not None else None
+        if _has_table(scenario, "spacecraft"):  # a spacecraft with actuators: tumble.spacecraft.scenario
+            from tumble.spacecraft.scenario import load_spacecraft_scenario
+
+            spec = load_spacecraft_scenario(scenario)
+            _check_outputs(output, plot, inputs=(scenario,))
+            with _progress_bar("simulating", enabled=not quiet) as progress:
+                traj = spec.run(progress=progress)
+            figure = spec.figure(traj) if plot is not None else None
+            extra_rows = _spacecraft_rows(traj)
+        else:
+            spec = load_scenario(scenario)
+            problem = spec.build()  # every rule of the file is checked before anything runs
+            _check_outputs(output, plot, inputs=(scenario,))
+            with _progress_bar("simulating", enabled=not quiet) as progress:
+                traj = problem.simulate(progress=progress)
+            figure = traj.plot(title=spec.name) if plot is not None else None
+            extra_rows = []
         _save(traj, output, figure, plot)
     _print_rows([("scenario", f"{scenario}" + (f" ({spec.name})" if spec.name else "")),
-                 *_summary(traj), ("wrote", _written(output, plot))])
+                 *_summary(traj), *extra_rows, ("wrote", _written(output, plot))])
 
 
 @demo_app.command("racket")
@@ -330,8 +342,30 @@ def _summary(traj: Trajectory) -> list[tuple[str, str]]:
     if torque != "none":
         rows.append(("", f"(torque {torque} acts: T and |L| need not be conserved)"))
     if traj.extras:
-        rows.append(("", "(drifts of the rigid hub alone; the model's internal states ("
-                         + ", ".join(traj.extras) + ") exchange momentum and energy with it)"))
+        rows.append(("", f"(drifts of the rigid hub alone: it exchanges momentum and energy with the model's "
+                         f"{len(traj.extras)} other states, saved with it)"))
+    return rows
+
+
+def _has_table(path: Path, name: str) -> bool:
+    """True when the TOML file ``path`` has a top-level table ``name`` (False if unreadable: the loader says why)."""
+    try:
+        return isinstance(tomllib.loads(path.read_text(encoding="utf-8")).get(name), dict)
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return False
+
+
+def _spacecraft_rows(traj: Trajectory) -> list[tuple[str, str]]:
+    """Rows for a spacecraft run: final rate, wheels (peak speed, saturation), total momentum drift."""
+    rows = [("rate", f"final |omega| {np.linalg.norm(traj.omega[-1]):.3g} rad/s")]
+    if "wheel_speed" in traj.extras:
+        speed = np.abs(traj.extras["wheel_speed"].data)
+        saturated = "wheel_saturated" in traj.extras and bool(np.any(traj.extras["wheel_saturated"].data > 0))
+        rows.append(("wheels", f"peak speed {speed.max():.4g} rad/s" + (", SATURATED" if saturated else "")))
+    if "total_momentum_inertial" in traj.extras:
+        h = traj.extras["total_momentum_inertial"].data
+        change = np.linalg.norm(h - h[0], axis=-1).max()
+        rows.append(("momentum", f"total (hub + actuators), inertial: largest change {change:.3g} N m s"))
     return rows
 
 
@@ -345,7 +379,9 @@ def _print_rows(rows: list[tuple[str, str]]) -> None:
 
 
 # The extension packages' demos (tumble demo diver, ...): registered on demo_app.
-from tumble import _demos  # noqa: E402,F401  (imported for its registrations)
+from tumble import _demos  # noqa: E402  (imported for its registrations)
 from tumble.robot.cli import app as _robot_app  # noqa: E402
+
+del _demos
 
 app.add_typer(_robot_app, name="robot", help="Robot arms (serial chains from DH tables or URDF): joint torques.")
