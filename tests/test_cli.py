@@ -27,7 +27,10 @@ def invoke(*args):
 
 @pytest.mark.parametrize(
     "command",
-    [[], ["run"], ["demo"], ["demo", "racket"], ["demo", "polhode"], ["demo", "top"], ["info"]],
+    [[], ["run"], ["demo"], ["demo", "racket"], ["demo", "polhode"], ["demo", "top"], ["info"],
+     *[["demo", name] for name in ("diver", "flexible", "slosh", "explorer1", "gravity-gradient", "gyro", "coning",
+                                   "ins")],
+     ["robot"], ["robot", "torques"]],
     ids=" ".join,
 )
 def test_help_of_every_command(command):
@@ -209,3 +212,45 @@ def test_info_on_a_file_that_is_not_a_trajectory_exits_2(tmp_path):
     result = invoke("info", junk)
     assert result.exit_code == 2
     assert "junk.nc: not a readable tumble trajectory" in result.stderr
+
+
+# -- extension packages ---------------------------------------------------------------
+
+
+def test_demo_of_an_extension_writes_its_figure_and_prints_its_numbers(tmp_path):
+    from tumble.ins.demo import demo_coning
+
+    result = invoke("demo", "coning", "-o", tmp_path)
+    assert result.exit_code == 0, result.output
+    expected = demo_coning(tmp_path)  # the same computation, called directly
+    for algorithm in ("none", "one-sample", "two-sample", "three-sample"):
+        line = next(row for row in result.stdout.splitlines() if row.split()[0] == algorithm)
+        assert f"measured drift within {expected[algorithm]['max_relative_deviation']:.1%} of its law" in line
+    assert f"wrote     {tmp_path / 'ins_coning.png'}" in result.stdout
+    assert (tmp_path / "ins_coning.png").read_bytes()[:8] == PNG_MAGIC
+
+
+def test_extension_demo_refuses_a_missing_directory(tmp_path):
+    result = invoke("demo", "coning", "-o", tmp_path / "missing")
+    assert result.exit_code == 2
+    assert "is not an existing directory" in result.output
+
+
+def test_robot_torques_prints_the_published_puma_gravity_load():
+    # Corke's Robotics Toolbox: gravload(qn) = [0, 31.6399, 6.0351, 0, 0.0283, 0] N m for the PUMA 560
+    # at qn = [0, pi/4, pi, 0, pi/4, 0] (4 significant digits, hence 5e-5 relative)
+    q = "0 0.7853981633974483 3.141592653589793 0 0.7853981633974483 0"
+    result = invoke("robot", "torques", EXAMPLES / "robots" / "puma560.toml", "--q", q)
+    assert result.exit_code == 0, result.output
+    printed = [float(x) for x in re.findall(r"tau =\s+(\S+) N m", result.stdout)]
+    np.testing.assert_allclose(printed, [0.0, 31.6399, 6.0351, 0.0, 0.0283, 0.0], rtol=5e-5, atol=5e-5)
+
+
+def test_run_dispatches_a_spacecraft_scenario(tmp_path):
+    out = tmp_path / "slew.nc"
+    result = invoke("run", EXAMPLES / "spacecraft" / "slew_wheels.toml", "-o", out, "--quiet")
+    assert result.exit_code == 0, result.output
+    traj = tumble.load(out)
+    assert "wheel_speed" in traj.extras and traj.extras["wheel_speed"].data.shape == (len(traj), 4)
+    peak = np.abs(traj.extras["wheel_speed"].data).max()
+    assert f"peak speed {peak:.4g} rad/s" in result.stdout
