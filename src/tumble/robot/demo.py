@@ -28,15 +28,14 @@ _TOLERANCE = 1e-12
 _LINTHRESH = 1e-14
 
 
-def demo_robot(out_dir: Path, *, robot_file: Path | None = None) -> dict:
-    """Simulate the Panda falling for 2 s (dop853, rtol = atol = 1e-12); write ``robot_fall.nc`` and ``.png``.
+def demo_robot(out_dir: Path, robot_file: Path) -> dict:
+    """Simulate an arm (the Panda: ``examples/robots/panda.urdf``) falling for 2 s from a bent pose
+    (dop853, rtol = atol = 1e-12); write ``robot_fall.nc`` and ``.png``.
 
     Returns a summary: the written paths, the largest energy drift (J) and
     the energy scale (J). ``out_dir`` must exist.
     """
     out_dir = Path(out_dir)
-    if robot_file is None:
-        robot_file = Path(__file__).resolve().parents[3] / "examples" / "robots" / "panda.urdf"
     chain = load(robot_file)
     t = np.linspace(0.0, _DURATION, _SAMPLES)
     run = simulate(chain, np.array(_Q0), np.zeros(chain.dof), t=t, method="dop853", rtol=_TOLERANCE,
