@@ -88,18 +88,46 @@ def _clip(x, limit):
 
 
 @functools.lru_cache(maxsize=None)
-def _kernels(model):
+def _kernels(model, ndim):
     """Compile-time assembly of the right-hand side for the Numba type ``model`` of a SpacecraftModel.
 
-    Returns ``(derivative, sample)``, which work on lane ``j`` of blocks (state × lanes, C order):
+    Returns ``(derivative, sample)``, which work on lane ``j`` of blocks (state × lanes, C order)
+    when ``ndim`` is 2, or on state vectors (``j`` unused) when ``ndim`` is 1:
     ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` into ``out[:, j]`` (and,
     when ``store``, the diagnostics of :func:`aux_layout` into ``aux[:, j]``);
     ``sample(model, t, y, j, hold)`` applies the discrete updates of the end of a step to
-    ``y[:, j]`` in place. Cached per model type, so
-    that the right-hand side, the projection and the diagnostics share one compiled kernel.
+    ``y[:, j]`` in place. Both are inlined into their callers (a call would cost more than
+    the equations). Cached per model type and ``ndim``, so that the right-hand side, the
+    projection and the diagnostics share their kernels.
     """
     inline = njit(inline="always")
     has_cmg, has_thr = _has(model, "cmg"), _has(model, "thrusters")
+
+    # ---- state access: lane j of a block (state × lanes), or a state vector (ndim 1, j unused) ----
+    # scalar reads and writes only: a reshaped or sliced view would cost a helper call and
+    # reference counting in every evaluation
+    if ndim == 1:
+        @inline
+        def at(y, i, j):
+            return y[i]
+
+        @inline
+        def put(y, i, j, value):
+            y[i] = value
+    else:
+        @inline
+        def at(y, i, j):
+            return y[i, j]
+
+        @inline
+        def put(y, i, j, value):
+            y[i, j] = value
+
+    @inline
+    def put3(y, i, j, v1, v2, v3):
+        put(y, i, j, v1)
+        put(y, i + 1, j, v2)
+        put(y, i + 2, j, v3)
 
     # ---- environment: field in body axes, gravity-gradient torque ------------------------
     if _has(model, "dipole_field"):
@@ -187,7 +215,7 @@ def _kernels(model):
             h1 = h2 = h3 = 0.0
             for i in range(model.n_gyros):
                 b = model.o_cmg + 4 + GYRO_STRIDE * i
-                cd, sd, h = math.cos(y[o_g + i, j]), math.sin(y[o_g + i, j]), d[b + 9]
+                cd, sd, h = math.cos(at(y, o_g + i, j)), math.sin(at(y, o_g + i, j)), d[b + 9]
                 h1 += h * (cd * d[b + 3] + sd * d[b + 6])
                 h2 += h * (cd * d[b + 4] + sd * d[b + 7])
                 h3 += h * (cd * d[b + 5] + sd * d[b + 8])
@@ -200,7 +228,7 @@ def _kernels(model):
             m00 = m01 = m02 = m11 = m12 = m22 = 0.0
             for i in range(model.n_gyros):  # A Aᵀ, columns A_i = h (cos δ t0 − sin δ s0)
                 b = law + 4 + GYRO_STRIDE * i
-                cd, sd, h = math.cos(y[o_g + i, j]), math.sin(y[o_g + i, j]), d[b + 9]
+                cd, sd, h = math.cos(at(y, o_g + i, j)), math.sin(at(y, o_g + i, j)), d[b + 9]
                 x1 = h * (cd * d[b + 6] - sd * d[b + 3])
                 x2 = h * (cd * d[b + 7] - sd * d[b + 4])
                 x3 = h * (cd * d[b + 8] - sd * d[b + 5])
@@ -219,19 +247,19 @@ def _kernels(model):
             nw = model.n_wheels
             for i in range(model.n_gyros):
                 b = law + 4 + GYRO_STRIDE * i
-                cd, sd, h = math.cos(y[o_g + i, j]), math.sin(y[o_g + i, j]), d[b + 9]
+                cd, sd, h = math.cos(at(y, o_g + i, j)), math.sin(at(y, o_g + i, j)), d[b + 9]
                 a1 = h * (cd * d[b + 6] - sd * d[b + 3])
                 a2 = h * (cd * d[b + 7] - sd * d[b + 4])
                 a3 = h * (cd * d[b + 8] - sd * d[b + 5])
                 rate = _clip(a1 * x1 + a2 * x2 + a3 * x3, d[law + 3])
-                out[o_g + i, j] = rate
+                put(out, o_g + i, j, rate)
                 t1 -= a1 * rate
                 t2 -= a2 * rate
                 t3 -= a3 * rate
                 if store:
-                    aux[3 * nw + i, j] = rate
+                    put(aux, 3 * nw + i, j, rate)
             if store:
-                aux[3 * nw + model.n_gyros, j] = math.sqrt(max(det, 0.0))
+                put(aux, 3 * nw + model.n_gyros, j, math.sqrt(max(det, 0.0)))
             return t1, t2, t3
     else:
         @inline
@@ -249,15 +277,15 @@ def _kernels(model):
             """Torque of the firing thrusters; writes the PWPF filter rates ``ḟ``."""
             p = model.o_thrusters
             km, tm = d[p], d[p + 1]
-            out[o_p, j] = (km * (u1 / d[p + 5] - y[o_p + 3, j]) - y[o_p, j]) / tm
-            out[o_p + 1, j] = (km * (u2 / d[p + 6] - y[o_p + 4, j]) - y[o_p + 1, j]) / tm
-            out[o_p + 2, j] = (km * (u3 / d[p + 7] - y[o_p + 5, j]) - y[o_p + 2, j]) / tm
+            put(out, o_p, j, (km * (u1 / d[p + 5] - at(y, o_p + 3, j)) - at(y, o_p, j)) / tm)
+            put(out, o_p + 1, j, (km * (u2 / d[p + 6] - at(y, o_p + 4, j)) - at(y, o_p + 1, j)) / tm)
+            put(out, o_p + 2, j, (km * (u3 / d[p + 7] - at(y, o_p + 5, j)) - at(y, o_p + 2, j)) / tm)
             for k in range(6):
-                out[o_p + 3 + k, j] = 0.0
+                put(out, o_p + 3 + k, j, 0.0)
             t1 = t2 = t3 = 0.0
             for i in range(model.n_thrusters):
                 b = p + 8 + THRUSTER_STRIDE * i
-                if y[o_p + 3 + int(d[b + 3]), j] == d[b + 4]:
+                if at(y, o_p + 3 + int(d[b + 3]), j) == d[b + 4]:
                     t1 += d[b]
                     t2 += d[b + 1]
                     t3 += d[b + 2]
@@ -268,13 +296,13 @@ def _kernels(model):
             """Schmitt triggers with a minimum on-time, at a sample time ``t``."""
             p = model.o_thrusters
             for k in range(3):
-                f, state, start = y[o_p + k, j], y[o_p + 3 + k, j], y[o_p + 6 + k, j]
+                f, state, start = at(y, o_p + k, j), at(y, o_p + 3 + k, j), at(y, o_p + 6 + k, j)
                 if state == 0.0:
                     if abs(f) > d[p + 2]:
-                        y[o_p + 3 + k, j] = 1.0 if f > 0.0 else -1.0
-                        y[o_p + 6 + k, j] = t
+                        put(y, o_p + 3 + k, j, 1.0 if f > 0.0 else -1.0)
+                        put(y, o_p + 6 + k, j, t)
                 elif state * f < d[p + 3] and t - start >= d[p + 4] * (1.0 - SAMPLE_TOLERANCE):
-                    y[o_p + 3 + k, j] = 0.0
+                    put(y, o_p + 3 + k, j, 0.0)
     else:
         @inline
         def thruster_torque(model, d, y, j, out, o_p, u1, u2, u3):
@@ -300,21 +328,22 @@ def _kernels(model):
     @inline
     def momenta(model, d, y, j):
         """(H, h_wheels): total and wheel angular momentum, body axes, N·m·s."""
-        H1, H2, H3 = _mat3(d, 9, y[4, j], y[5, j], y[6, j])
+        H1, H2, H3 = _mat3(d, 9, at(y, 4, j), at(y, 5, j), at(y, 6, j))
         h1 = h2 = h3 = 0.0
         for i in range(model.n_wheels):
             b = model.o_wheels + WHEEL_STRIDE * i
-            h1 += d[b] * y[7 + i, j]
-            h2 += d[b + 1] * y[7 + i, j]
-            h3 += d[b + 2] * y[7 + i, j]
+            h1 += d[b] * at(y, 7 + i, j)
+            h2 += d[b + 1] * at(y, 7 + i, j)
+            h3 += d[b + 2] * at(y, 7 + i, j)
         c1, c2, c3 = cmg_momentum(model, d, y, j)
         return H1 + h1 + c1, H2 + h2 + c2, H3 + h3 + c3, h1, h2, h3
 
     @inline
     def command(model, d, t, y, j, H1, H2, H3, h1, h2, h3, b1, b2, b3):
         """The controller's torque (N·m) and dipole (A·m²) commands, body axes."""
-        u1, u2, u3 = attitude_law(model, d, y[0, j], y[1, j], y[2, j], y[3, j], y[4, j], y[5, j], y[6, j], H1, H2, H3)
-        m1, m2, m3 = bdot_law(model, d, y[4, j], y[5, j], y[6, j], b1, b2, b3)
+        u1, u2, u3 = attitude_law(model, d, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j),
+                                  at(y, 4, j), at(y, 5, j), at(y, 6, j), H1, H2, H3)
+        m1, m2, m3 = bdot_law(model, d, at(y, 4, j), at(y, 5, j), at(y, 6, j), b1, b2, b3)
         e1, e2, e3 = dumping_law(model, d, h1, h2, h3, b1, b2, b3)
         m1, m2, m3 = m1 + e1, m2 + e2, m3 + e3
         if d[29] == ROUTE_MAGNETORQUERS:  # m = B × u / |B|²: the part of u normal to B
@@ -324,30 +353,31 @@ def _kernels(model):
         return u1, u2, u3, m1, m2, m3
 
     # ---- the right-hand side -----------------------------------------------------------------
-    @njit
+    @inline
     def derivative(model, t, y, j, out, aux, store):
         d = model.data
         nw = model.n_wheels
         o_w = 7 + nw + model.n_gyros
         o_c = o_w + 1
-        qw, qx, qy, qz, w1, w2, w3 = y[0, j], y[1, j], y[2, j], y[3, j], y[4, j], y[5, j], y[6, j]
+        qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
+        w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
         H1, H2, H3, h1, h2, h3 = momenta(model, d, y, j)
         b1, b2, b3 = field(model, d, t, qw, qx, qy, qz)
         if d[27] > 0.0:  # zero-order hold: the commands held in the state
-            u1, u2, u3 = y[o_c, j], y[o_c + 1, j], y[o_c + 2, j]
-            m1, m2, m3 = y[o_c + 3, j], y[o_c + 4, j], y[o_c + 5, j]
+            u1, u2, u3 = at(y, o_c, j), at(y, o_c + 1, j), at(y, o_c + 2, j)
+            m1, m2, m3 = at(y, o_c + 3, j), at(y, o_c + 4, j), at(y, o_c + 5, j)
         else:
             u1, u2, u3, m1, m2, m3 = command(model, d, t, y, j, H1, H2, H3, h1, h2, h3, b1, b2, b3)
         if store:
             s = 3 * nw + model.n_gyros + (1 if has_cmg else 0) + 12
-            aux[s, j], aux[s + 1, j], aux[s + 2, j] = u1, u2, u3
-            aux[s + 3, j], aux[s + 4, j], aux[s + 5, j] = m1, m2, m3
+            put3(aux, s, j, u1, u2, u3)
+            put3(aux, s + 3, j, m1, m2, m3)
         t1 = t2 = t3 = 0.0
         power = 0.0
         for i in range(nw):  # reaction wheels
             b = model.o_wheels + WHEEL_STRIDE * i
             a1, a2, a3 = d[b], d[b + 1], d[b + 2]
-            speed = y[7 + i, j] / d[b + 3] - (a1 * w1 + a2 * w2 + a3 * w3)
+            speed = at(y, 7 + i, j) / d[b + 3] - (a1 * w1 + a2 * w2 + a3 * w3)
             motor = _clip(-(d[b + 9] * u1 + d[b + 10] * u2 + d[b + 11] * u3), d[b + 4])
             saturated = abs(speed) >= d[b + 5] and motor * speed > 0.0
             if saturated:
@@ -355,15 +385,15 @@ def _kernels(model):
             hdot = motor - d[b + 6] * speed
             if d[b + 7] != 0.0:  # Coulomb friction, smoothed
                 hdot -= d[b + 7] * math.tanh(speed / d[b + 8])
-            out[7 + i, j] = hdot
+            put(out, 7 + i, j, hdot)
             t1 -= a1 * hdot
             t2 -= a2 * hdot
             t3 -= a3 * hdot
             power += hdot * speed
             if store:
-                aux[i, j] = speed
-                aux[nw + i, j] = motor
-                aux[2 * nw + i, j] = 1.0 if saturated else 0.0
+                put(aux, i, j, speed)
+                put(aux, nw + i, j, motor)
+                put(aux, 2 * nw + i, j, 1.0 if saturated else 0.0)
         c1, c2, c3 = cmg_torque(model, d, y, j, out, u1, u2, u3, aux, store)
         r1, r2, r3 = thruster_torque(model, d, y, j, out, o_c + 6, u1, u2, u3)
         n1, n2, n3, m1, m2, m3 = magnetic_torque(model, d, m1, m2, m3, b1, b2, b3)
@@ -372,19 +402,20 @@ def _kernels(model):
         k1, k2, k3 = _cross(w1, w2, w3, H1, H2, H3)
         a1, a2, a3 = _mat3(d, 18, x1 + g1 - k1, x2 + g2 - k2, x3 + g3 - k3)
         e = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-        out[0, j], out[1, j], out[2, j], out[3, j] = 0.5 * e[0], 0.5 * e[1], 0.5 * e[2], 0.5 * e[3]
-        out[4, j], out[5, j], out[6, j] = a1, a2, a3
-        out[o_w, j] = power
+        put(out, 0, j, 0.5 * e[0])
+        put3(out, 1, j, 0.5 * e[1], 0.5 * e[2], 0.5 * e[3])
+        put3(out, 4, j, a1, a2, a3)
+        put(out, o_w, j, power)
         for k in range(6):
-            out[o_c + k, j] = 0.0
+            put(out, o_c + k, j, 0.0)
         if store:
             s = 3 * nw + model.n_gyros + (1 if has_cmg else 0)
-            aux[s, j], aux[s + 1, j], aux[s + 2, j] = m1, m2, m3
-            aux[s + 3, j], aux[s + 4, j], aux[s + 5, j] = b1, b2, b3
-            aux[s + 6, j], aux[s + 7, j], aux[s + 8, j] = g1, g2, g3
-            aux[s + 9, j], aux[s + 10, j], aux[s + 11, j] = x1, x2, x3
+            put3(aux, s, j, m1, m2, m3)
+            put3(aux, s + 3, j, b1, b2, b3)
+            put3(aux, s + 6, j, g1, g2, g3)
+            put3(aux, s + 9, j, x1, x2, x3)
 
-    @njit
+    @inline
     def sample(model, t, y, j, hold):
         """Discrete updates at the end of a step: with ``hold`` (a sample time of a zero-order hold),
         the held commands; then the PWPF triggers."""
@@ -392,9 +423,10 @@ def _kernels(model):
         o_c = 8 + model.n_wheels + model.n_gyros
         if hold:
             H1, H2, H3, h1, h2, h3 = momenta(model, d, y, j)
-            b1, b2, b3 = field(model, d, t, y[0, j], y[1, j], y[2, j], y[3, j])
-            y[o_c, j], y[o_c + 1, j], y[o_c + 2, j], y[o_c + 3, j], y[o_c + 4, j], y[o_c + 5, j] = command(
-                model, d, t, y, j, H1, H2, H3, h1, h2, h3, b1, b2, b3)
+            b1, b2, b3 = field(model, d, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
+            u1, u2, u3, m1, m2, m3 = command(model, d, t, y, j, H1, H2, H3, h1, h2, h3, b1, b2, b3)
+            put3(y, o_c, j, u1, u2, u3)
+            put3(y, o_c + 3, j, m1, m2, m3)
         trigger(model, d, t, y, j, o_c + 6)
 
     return derivative, sample
@@ -408,13 +440,10 @@ def _is_spacecraft(model):
 def _spacecraft_rhs(model, b0, t, Y, OUT):
     if not _is_spacecraft(model):
         return None
-    derivative, _ = _kernels(model)
-    # The kernels take a block (state × lanes) and a lane: a state vector is viewed as a block of
-    # one lane, so that every caller shares one compiled kernel.
+    derivative, _ = _kernels(model, Y.ndim)
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
-            Y2 = Y.reshape((Y.shape[0], 1))
-            derivative(model, t, Y2, 0, OUT.reshape((OUT.shape[0], 1)), Y2, False)
+            derivative(model, t, Y, 0, OUT, Y, False)
     else:
         def impl(model, b0, t, Y, OUT):
             for j in range(Y.shape[1]):
@@ -426,29 +455,27 @@ def _spacecraft_rhs(model, b0, t, Y, OUT):
 def _spacecraft_project(model, b0, t, Y):
     if not _is_spacecraft(model):
         return None
-    _, sample = _kernels(model)
-
-    @njit
-    def lanes(model, t, Y):
-        period, start = model.data[27], model.data[28]
-        hold = False
-        if period > 0.0:
-            k = round((t - start) / period)
-            hold = abs(t - start - k * period) <= SAMPLE_TOLERANCE * period
-            if not hold:
-                return
-        # continuous control: the commands are not held; the PWPF triggers sample every step
-        for j in range(Y.shape[1]):
-            sample(model, t, Y, j, hold)
-
+    _, sample = _kernels(model, Y.ndim)
+    # with continuous control only the PWPF triggers sample after every step: without
+    # thrusters the projection is the normalisation alone
+    continuous_updates = _has(model, "thrusters")
     if Y.ndim == 1:
-        def impl(model, b0, t, Y):
-            _model.normalize_quaternion(Y)
-            lanes(model, t, Y.reshape((Y.shape[0], 1)))
+        normalize, lanes = _model.normalize_quaternion, njit(inline="always")(lambda Y: 1)
     else:
-        def impl(model, b0, t, Y):
-            _model.normalize_quaternions(Y)
-            lanes(model, t, Y)
+        normalize, lanes = _model.normalize_quaternions, njit(inline="always")(lambda Y: Y.shape[1])
+
+    def impl(model, b0, t, Y):
+        normalize(Y)
+        period = model.data[27]
+        if period > 0.0:
+            start = model.data[28]
+            k = round((t - start) / period)
+            if abs(t - start - k * period) <= SAMPLE_TOLERANCE * period:
+                for j in range(lanes(Y)):
+                    sample(model, t, Y, j, True)
+        elif continuous_updates:
+            for j in range(lanes(Y)):
+                sample(model, t, Y, j, False)
     return impl
 
 
@@ -479,13 +506,12 @@ def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload 
 
 @overload(_evaluate, jit_options={"cache": True})
 def _evaluate_overload(model, t, y, aux):
-    derivative, _ = _kernels(model)
+    derivative, _ = _kernels(model, 1)
 
     def impl(model, t, y, aux):
-        n, m = y.shape[1], aux.shape[1]
-        out = np.empty((n, 1))
+        out = np.empty(y.shape[1])
         for k in range(y.shape[0]):
-            derivative(model, t[k], y[k].reshape((n, 1)), 0, out, aux[k].reshape((m, 1)), True)
+            derivative(model, t[k], y[k], 0, out, aux[k], True)
 
     return impl
 
@@ -496,8 +522,8 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sample = _kernels(model)
-    return lambda model, t, y: sample(model, t, y.reshape((y.shape[0], 1)), 0, True)
+    _, sample = _kernels(model, 1)
+    return lambda model, t, y: sample(model, t, y, 0, True)
 
 
 @njit(cache=True)

@@ -20,6 +20,7 @@ wheel momenta), see :mod:`tumble.spacecraft._kernel`.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from collections.abc import Callable, Sequence
@@ -174,12 +175,13 @@ class Spacecraft:
         """J: inertia of the whole spacecraft about its centre of mass, kg·m², body axes (wheels included)."""
         return self.body.inertia
 
-    @property
+    @functools.cached_property  # a frozen description: computed once, read-only
     def rate_inertia(self) -> np.ndarray:
         """J_ω = J − Σ I_s a aᵀ: the inertia the body rate answers to, kg·m² (wheel spins excluded)."""
         j = self.body.inertia.copy()
         for w in self.wheels:
             j -= w.inertia * np.outer(w.axis, w.axis)
+        j.setflags(write=False)
         return j
 
     def layout(self) -> dict[str, slice]:
