@@ -105,23 +105,14 @@ def _is_flexible(model):
 def _flexible_rhs(model, b0, t, Y, OUT):
     if not _is_flexible(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, b0, t, Y, OUT: derivative(model, t, Y, OUT)
-
-    def impl(model, b0, t, Y, OUT):
-        for j in range(Y.shape[1]):
-            derivative(model, t, Y[:, j], OUT[:, j])
-
-    return impl
+    return _model.lanewise_rhs(derivative, Y)
 
 
 @overload(_model.project, inline="always", jit_options={"cache": True})
 def _flexible_project(model, b0, t, Y):
     if not _is_flexible(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, b0, t, Y: _model.normalize_quaternion(Y)
-    return lambda model, b0, t, Y: _model.normalize_quaternions(Y)
+    return _model.quaternion_projection(Y)
 
 
 @overload(_model.state_size, jit_options={"cache": True})
@@ -135,6 +126,4 @@ def _flexible_state_size(model):
 def _flexible_body_rate(model, Y, j):
     if not _is_flexible(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, Y, j: (Y[4], Y[5], Y[6])
-    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
+    return _model.rate_at(4, Y)

@@ -123,3 +123,34 @@ def normalize_quaternion(y):
     s = quaternion_scale(y[0], y[1], y[2], y[3])
     for i in range(4):
         y[i] *= s
+
+
+# Implementations shared by the models' overloads (each returns the ``impl`` an overload returns).
+
+
+def quaternion_projection(Y):
+    """``project`` for a model whose only constraint is the unit quaternion ``Y[0:4]``: normalise it
+    (the state vector, or every lane of a block)."""
+    if Y.ndim == 1:
+        return lambda model, b0, t, Y: normalize_quaternion(Y)
+    return lambda model, b0, t, Y: normalize_quaternions(Y)
+
+
+def rate_at(offset, Y):
+    """``body_rate`` for a model that stores ``(ω₁, ω₂, ω₃)`` at ``Y[offset:offset + 3]``."""
+    if Y.ndim == 1:
+        return lambda model, Y, j: (Y[offset], Y[offset + 1], Y[offset + 2])
+    return lambda model, Y, j: (Y[offset, j], Y[offset + 1, j], Y[offset + 2, j])
+
+
+def lanewise_rhs(derivative, Y):
+    """``rhs`` for a model whose jitted ``derivative(model, t, y, out)`` works on one state vector:
+    called on the state itself, or on each lane ``Y[:, j]`` of a block."""
+    if Y.ndim == 1:
+        return lambda model, b0, t, Y, OUT: derivative(model, t, Y, OUT)
+
+    def impl(model, b0, t, Y, OUT):
+        for j in range(Y.shape[1]):
+            derivative(model, t, Y[:, j], OUT[:, j])
+
+    return impl

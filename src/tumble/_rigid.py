@@ -133,18 +133,7 @@ def _rigid_rhs(model, b0, t, Y, OUT):
 def _rigid_project(model, b0, t, Y):
     if not _is_rigid(model):
         return None
-
-    if Y.ndim == 1:
-
-        def impl(model, b0, t, Y):
-            _model.normalize_quaternion(Y)
-
-    else:
-
-        def impl(model, b0, t, Y):
-            _model.normalize_quaternions(Y)
-
-    return impl
+    return _model.quaternion_projection(Y)
 
 
 @overload(_model.state_size, jit_options={"cache": True})
@@ -162,9 +151,7 @@ def _rigid_state_size(model):
 def _rigid_body_rate(model, Y, j):
     if not _is_rigid(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, Y, j: (Y[4], Y[5], Y[6])
-    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
+    return _model.rate_at(4, Y)
 
 
 @overload(_model.inverse_moments, inline="always", jit_options={"cache": True})

@@ -116,14 +116,7 @@ def _is_slosh(model):
 def _slosh_rhs(model, b0, t, Y, OUT):
     if not _is_slosh(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, b0, t, Y, OUT: derivative(model, t, Y, OUT)
-
-    def impl(model, b0, t, Y, OUT):
-        for j in range(Y.shape[1]):
-            derivative(model, t, Y[:, j], OUT[:, j])
-
-    return impl
+    return _model.lanewise_rhs(derivative, Y)
 
 
 @overload(_model.project, inline="always", jit_options={"cache": True})
@@ -151,6 +144,4 @@ def _slosh_state_size(model):
 def _slosh_body_rate(model, Y, j):
     if not _is_slosh(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, Y, j: (Y[4], Y[5], Y[6])
-    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
+    return _model.rate_at(4, Y)

@@ -113,9 +113,7 @@ def _gimbal_rhs(model, b0, t, Y, OUT):
 def _gimbal_project(model, b0, t, Y):
     if not _model.is_type(model, GimbalModel):
         return None
-    if Y.ndim == 1:
-        return lambda model, b0, t, Y: _model.normalize_quaternion(Y)
-    return lambda model, b0, t, Y: _model.normalize_quaternions(Y)
+    return _model.quaternion_projection(Y)
 
 
 @overload(_model.state_size, jit_options={"cache": True})

@@ -495,9 +495,7 @@ def _spacecraft_state_size(model):
 def _spacecraft_body_rate(model, Y, j):
     if not _is_spacecraft(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, Y, j: (Y[4], Y[5], Y[6])
-    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
+    return _model.rate_at(4, Y)
 
 
 def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload in compiled code

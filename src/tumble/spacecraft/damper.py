@@ -195,9 +195,7 @@ def _damper_rhs(model, b0, t, Y, OUT):
 def _damper_project(model, b0, t, Y):
     if not _is_damper(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, b0, t, Y: _model.normalize_quaternion(Y)
-    return lambda model, b0, t, Y: _model.normalize_quaternions(Y)
+    return _model.quaternion_projection(Y)
 
 
 @overload(_model.state_size, jit_options={"cache": True})
@@ -211,9 +209,7 @@ def _damper_state_size(model):
 def _damper_body_rate(model, Y, j):
     if not _is_damper(model):
         return None
-    if Y.ndim == 1:
-        return lambda model, Y, j: (Y[4], Y[5], Y[6])
-    return lambda model, Y, j: (Y[4, j], Y[5, j], Y[6, j])
+    return _model.rate_at(4, Y)
 
 
 def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0, *, t, q0=None, damper_omega0=None,
