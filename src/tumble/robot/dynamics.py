@@ -104,6 +104,14 @@ def _explain(what: str, cause: str, **inputs) -> None:
     raise ValidationError(f"{what}: the result is not finite although the inputs are: {cause}")
 
 
+def _loads(chain: SerialChain, q, gravity, f_ext):
+    """The gravity vector (m/s²) and the end-link wrench array of a call (the chain's defaults when None)."""
+    g = chain._gravity if gravity is None else _gravity(gravity)
+    if f_ext is None:
+        return g, (chain._no_wrench if q.ndim == 1 else chain._no_wrenches)
+    return g, _wrench(chain, f_ext, q)
+
+
 def rnea(chain: SerialChain, q, qd, qdd, *, gravity=None, f_ext=None) -> np.ndarray:
     """Inverse dynamics ``τ = M(q) q̈ + C(q, q̇) q̇ + g(q) − J(q)ᵀ w_ext`` (recursive Newton–Euler).
 
@@ -112,11 +120,7 @@ def rnea(chain: SerialChain, q, qd, qdd, *, gravity=None, f_ext=None) -> np.ndar
     (2008) Table 5.1, with gravity as a base acceleration ``a₀ = −g``.
     """
     q, qd, qdd = _three(chain, q, qd, qdd, ("q", "qd", "qdd"))
-    g = chain._gravity if gravity is None else _gravity(gravity)
-    if f_ext is None:
-        f = chain._no_wrench if q.ndim == 1 else chain._no_wrenches
-    else:
-        f = _wrench(chain, f_ext, q)
+    g, f = _loads(chain, q, gravity, f_ext)
     tau = np.empty(q.shape)
     if q.ndim == 1:
         ok = _kernels.rnea(chain._params, q, qd, qdd, g, f, tau)
@@ -166,11 +170,7 @@ def forward_dynamics(chain: SerialChain, q, qd, tau, *, gravity=None, f_ext=None
     units as :func:`rnea`; returns ``q̈``.
     """
     q, qd, tau = _three(chain, q, qd, tau, ("q", "qd", "tau"))
-    g = chain._gravity if gravity is None else _gravity(gravity)
-    if f_ext is None:
-        f = chain._no_wrench if q.ndim == 1 else chain._no_wrenches
-    else:
-        f = _wrench(chain, f_ext, q)
+    g, f = _loads(chain, q, gravity, f_ext)
     qdd = np.empty(q.shape)
     if q.ndim == 1:
         ok = _kernels.aba(chain._params, q, qd, tau, g, f, qdd)
