@@ -41,6 +41,10 @@ PHASE = {  # method, dt (s), torque: max |ΔR(q)| bound
 # so |L| stays within a few roundings: measured 4.4e-16 (splitting2) and
 # 2.2e-16 (splitting4); bound 16 EPS = 3.6e-15.
 TOL_MOMENTUM_NORM = 16 * EPS
+# With a progress callback the run goes in 100 segments, each rescaling to its own
+# start: the segments' few roundings add up (measured 7.1e-15 and 7.0e-15); the
+# issue's bound, 1e-13, still holds.
+TOL_MOMENTUM_NORM_SEGMENTS = 1e-13
 # L_N and |q| − 1 (no projection): each exact turn rounds the quaternion and
 # two components of L once, a random walk of ~EPS·√(turns) (2 turns per step
 # for splitting2, 12 for splitting4): measured 7.9e-14 and 2.0e-13 (L_N),
@@ -201,10 +205,10 @@ def test_lands_on_every_output_time(method, dt):
 # -- long runs: invariants ---------------------------------------------------------------------
 
 
-def long_run(method, steps=10**6, dt=0.05):
+def long_run(method, steps=10**6, dt=0.05, progress=None):
     """diag(1, 2, 3), ω₀ = (0.3, 1, −0.2) rad/s, 1e6 steps of 0.05 s (about 8000 turns), 1001 samples."""
     t = np.linspace(0.0, steps * dt, 1001)
-    traj = tumble.simulate(tumble.RigidBody(DIAG), OMEGA0, t=t, method=method, dt=dt)
+    traj = tumble.simulate(tumble.RigidBody(DIAG), OMEGA0, t=t, method=method, dt=dt, progress=progress)
     energy = dynamics.kinetic_energy(DIAG, traj.omega)
     error = np.abs(energy / energy[0] - 1.0)
     return traj, error[1:101].max(), error[-100:].max()
@@ -221,6 +225,15 @@ def test_splitting_keeps_momentum_and_bounds_the_energy_error_over_a_million_ste
     # no drift: the energy error oscillates (splitting2 2.9e-5, splitting4 2.1e-11 in both tenths)
     assert last <= 2.0 * first
     assert np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0).max() <= EPS * np.sqrt(turns)
+
+
+@pytest.mark.parametrize("method", ["splitting2", "splitting4"])
+def test_splitting_keeps_momentum_when_run_in_progress_segments(method):
+    reported = []
+    traj, _, _ = long_run(method, progress=lambda done, total: reported.append(done))
+    assert len(reported) == 100 and reported[-1] == traj.t.size
+    norm = np.linalg.norm(dynamics.angular_momentum(DIAG, traj.omega), axis=-1)
+    assert np.abs(norm / norm[0] - 1.0).max() <= TOL_MOMENTUM_NORM_SEGMENTS
 
 
 @pytest.mark.parametrize("method", ["rk4", "cf4"])

@@ -49,7 +49,9 @@ would random-walk by about ``ε √(turns)`` (2.6e-13 after 1e6 steps of
 therefore rescaled to its length at the start of the run (kept in the
 workspace), a correction of a few ulps along ``L`` that leaves its direction,
 the attitude and the order of the method untouched: ``|L|`` then stays within
-a few roundings of its initial value however long the run.
+a few roundings of its initial value however long the run. (A run reported
+in segments, with a ``progress`` callback, rescales to the start of each
+segment: 7e-15 after 1e6 steps in 100 segments.)
 """
 
 from __future__ import annotations
