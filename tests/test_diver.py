@@ -4,10 +4,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 import tumble
 from tumble import attitude
 from tumble.variable import diver
+from tumble.variable.demo import demo_diver
 from tumble.variable.human import DE_LEVA_MALE, Human, Motion
 
 HUMAN = Human.de_leva()
@@ -104,19 +106,124 @@ def test_twisting_somersault():
     assert np.abs(rigid.omega - v.omega[k:]).max() < RIGID_CONTINUATION_TOL
 
 
-# The rule of thumb sin θ (I_s/I_l − 1) is exact for an axisymmetric body (measured agreement
-# 4.4e-11 over 20 s, dop853 at rtol = 1e-11) ...
+# (b) The rule of thumb sin θ (I_s/I_l − 1) is exact for an axisymmetric body at every tilt (measured
+# 4e-15 at 2°–5°, 8e-15 at 10°; dop853 at rtol = 1e-11 over whole polhode periods) ...
 AXISYMMETRIC_TOL = 1e-9
-# ... and for the de Leva layout (I_x = 12.09, I_y = 12.36, I_z = 0.90 kg m²) within 3 % for
-# tilts of 10°–20°: measured +2.6 %, +1.8 %, +1.6 % at 10°, 15°, 20°. (Below ~5° it fails: the
-# somersault axis is the intermediate axis, and at 2° the simulation twists 28 % more.)
-RULE_TOL = 0.03
+# ... and holds for the de Leva layout (I_x = 12.09, I_y = 12.36, I_z = 0.90 kg m²) at small tilts when θ
+# is the mean tilt of the motion: I_x ≠ I_y makes the tilt oscillate (from 2° initially it swings up to
+# 3.14°, mean 2.54°), and the rule at the mean tilt is within 1.08 %, 1.14 %, 1.18 %, 1.21 % of the simulation
+# at initial tilts 2°, 3°, 5°, 10° (measured; what remains is I_y ≠ I_x, +1.2 % at every tilt up to 30°). At
+# the initial tilt it is +28 %, +15 %, +6.7 %, +2.6 % off: near 0° the layout somersaults about its
+# intermediate axis, whose separatrix the motion then skirts.
+RULE_TOL = 0.02
+INITIAL_TILT_TOL = 0.03   # at 10° and above with the initial tilt (measured +2.6 % at 10°, +1.3 % at 30°)
+SMALL_TILTS = np.radians([2.0, 3.0, 5.0, 10.0])
 
 
-def test_twist_rule_of_thumb():
-    sweep = diver.twist_rule_sweep(np.radians([10.0, 15.0, 20.0]), duration=20.0, n=401)
+def test_twist_rule_of_thumb_at_small_tilts():
+    sweep = diver.twist_rule_sweep(SMALL_TILTS, duration=10.0, n=801)
     assert np.abs(sweep["axisymmetric"] / sweep["rule"] - 1.0).max() < AXISYMMETRIC_TOL
-    assert np.abs(sweep["simulated"] / sweep["rule"] - 1.0).max() < RULE_TOL
+    assert np.abs(sweep["simulated"] / sweep["rule_mean_tilt"] - 1.0).max() < RULE_TOL
+    assert sweep["simulated"][0] / sweep["rule"][0] - 1.0 > 0.2   # with the initial tilt it fails at 2°
+    assert abs(sweep["simulated"][3] / sweep["rule"][3] - 1.0) < INITIAL_TILT_TOL   # but holds from 10°
+
+
+# The simulated ratio against the closed form (independent of the integrator and of orientation_angles):
+# over one polhode period P = 4K/λ (tumble.analytic) the body twists once and somersaults by
+# ΔΦ = ∫₀ᴾ φ̇ dt, φ̇ = |L| (I_x ω_x² + I_y ω_y²)/(I_x² ω_x² + I_y² ω_y²) the precession of the long axis about L
+# (Landau & Lifshitz, Mechanics, §37), with ω(t) the exact Jacobi-elliptic rates of tumble.analytic.torque_free
+# and the periodic integrand averaged by the trapezoidal rule (spectrally accurate; 2048 points).
+# Measured agreement 3e-13 relative at 2° and 5°.
+CLOSED_FORM_TOL = 1e-9
+
+
+def test_twists_per_somersault_equal_the_closed_form():
+    inertia = HUMAN.inertia(None)
+    body = tumble.RigidBody(inertia)
+    ix, iy = inertia[0, 0], inertia[1, 1]
+    tilts = SMALL_TILTS[[0, 2]]
+    sweep = diver.twist_rule_sweep(tilts, duration=10.0, n=801)
+    for tilt, simulated in zip(tilts, sweep["simulated"]):
+        q0 = attitude.from_rotvec([0.0, tilt, 0.0])
+        omega0 = np.linalg.solve(inertia, attitude.rotate_inverse(q0, [diver.MOMENTUM, 0.0, 0.0]))
+        period = tumble.analytic.polhode_period(body, omega0)
+        w = tumble.analytic.torque_free(body, omega0, t=np.arange(2048) * period / 2048).omega
+        rate = diver.MOMENTUM * (ix * w[:, 0] ** 2 + iy * w[:, 1] ** 2) / (ix**2 * w[:, 0] ** 2 + iy**2 * w[:, 1] ** 2)
+        exact = 2.0 * np.pi / (period * rate.mean())
+        assert abs(simulated / exact - 1.0) < CLOSED_FORM_TOL
+
+
+# The same arm drop integrated by scipy's solve_ivp (DOP853, rtol = atol = 1e-10) from the body-axis
+# equations, d(Iω + A)/dt + ω × (Iω + A) = 0, i.e. I ω̇ = −İω − Ȧ − ω × (Iω + A), with q̇ = ½ q ⊗ [0, ω]
+# (a tiny independent integrator on the same splines I, A): measured 5.8e-7 rad from tumble's attitude and
+# 9e-8 twist (solve_ivp's own error: its |L| drifts by 3.5e-9, tumble's by 9e-16).
+INDEPENDENT_TOL = 5e-6
+# The naive I ω̇ + ω × Iω = 0 on the same splines: |L| falls by 11.3 % and the diver twists 0.10 times
+# instead of 2.99 (measured; docs/variable_inertia.md).
+
+
+def _body_axis_flight(body, omega0, t, naive):
+    def rhs(s, y):
+        q, w = y[:4], y[4:]
+        inertia = body.inertia(s)
+        if naive:
+            torque_like = -np.cross(w, inertia @ w)
+        else:
+            torque_like = (-body.inertia(s, 1) @ w - body.shape_momentum(s, 1)
+                           - np.cross(w, inertia @ w + body.shape_momentum(s)))
+        q_dot = 0.5 * np.concatenate([[-q[1:] @ w], q[0] * w + np.cross(q[1:], w)])
+        return np.concatenate([q_dot, np.linalg.solve(inertia, torque_like)])
+
+    sol = solve_ivp(rhs, (t[0], t[-1]), np.concatenate([[1.0, 0.0, 0.0, 0.0], omega0]), method="DOP853",
+                    t_eval=t, rtol=1e-10, atol=1e-10)
+    q = attitude.normalize(sol.y[:4].T)
+    momentum = np.einsum("nij,nj->ni", body.inertia(t), sol.y[4:].T) + (0.0 if naive else body.shape_momentum(t))
+    return q, attitude.rotate(q, momentum)
+
+
+def test_independent_body_axis_integration_and_the_naive_equation():
+    t = np.linspace(0.0, 2.0, 401)
+    dive = diver.simulate_dive(HUMAN, ARM_DROP, momentum=80.0, t=t)
+    body = HUMAN.variable_body(ARM_DROP, t_span=(0.0, 2.0))
+    omega0 = dive.trajectory.omega[0]
+    q, momentum = _body_axis_flight(body, omega0, t, naive=False)
+    assert attitude.relative_angle(q, dive.trajectory.q).max() < INDEPENDENT_TOL
+    assert abs(diver.orientation_angles(q, [80.0, 0.0, 0.0]).twists - dive.twists) < INDEPENDENT_TOL
+    q, momentum = _body_axis_flight(body, omega0, t, naive=True)
+    assert np.linalg.norm(momentum[-1]) / 80.0 - 1.0 < -0.10         # |L| is not conserved: −11.3 %
+    assert abs(diver.orientation_angles(q, [80.0, 0.0, 0.0]).twists) < 0.2   # and the twist is lost
+
+
+# (c) The 513XD-like dive: 1½ somersaults and 2½ twists (the design of dive_513xd), counted from the motion.
+# The counts are read a second way, without Euler angles: in Yeadon's frame F (here the inertial axes:
+# F_x = the trunk's x at take-off, L = −74 x̂ kg m²/s), the twist is ψ = atan2(−ŷ_B·F_x, x̂_B·F_x) and the
+# somersault φ = atan2(−ẑ_B·F_y, ẑ_B·F_z) (from R_FB = R_x(φ)R_y(θ)R_z(ψ) with cos θ > 0), unwrapped.
+# Measured: −1.5155 somersaults (forward), −2.5125 twists, final tilt 1.94°; the two counts agree to 1e-15.
+COUNT_TOL = 0.05   # turns: the dive is designed for 1.5 and 2.5
+
+
+def test_513xd_dive_counts_somersaults_and_twists():
+    dive = diver.dive_513xd()
+    R = attitude.to_matrix(dive.trajectory.q)              # columns: the body axes in F (inertial) axes
+    twist = np.unwrap(np.arctan2(-R[:, 0, 1], R[:, 0, 0]))
+    somersault = np.unwrap(np.arctan2(-R[:, 1, 2], R[:, 2, 2]))
+    assert abs((twist[-1] - twist[0]) / (2 * np.pi) - dive.twists) < 1e-9
+    assert abs((somersault[-1] - somersault[0]) / (2 * np.pi) - dive.somersaults) < 1e-9
+    assert abs(dive.somersaults - (-1.5)) < COUNT_TOL and abs(abs(dive.twists) - 2.5) < COUNT_TOL
+    assert abs(dive.angles.tilt[-1]) < np.radians(3.0)    # head-first entry: the twist almost stopped
+    assert dive.momentum_drift < 1e-12
+
+
+def test_demo_diver_writes_the_figures_and_the_dive(tmp_path):
+    out = demo_diver(tmp_path)
+    for name in ("twisting_somersault", "twist_rule", "513xd"):
+        path = tmp_path / f"diver_{name}.png"
+        assert out[f"png_{name}"] == str(path) and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    saved = tumble.load(out["nc"])
+    assert saved.extras["joint_angles"].data.shape == (saved.t.size, len(HUMAN.dofs))
+    assert out["dive_twists"] == diver.orientation_angles(saved.q, [-1.0, 0.0, 0.0]).twists
+    assert out["rule_mean_tilt_max_relative_error"] < RULE_TOL
+    assert max(out["twisting_somersault_momentum_drift"], out["dive_momentum_drift"]) < 1e-12
 
 
 def test_bad_joint_angles_are_refused():

@@ -39,8 +39,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from tumble import attitude, simulate
+from tumble import analytic, attitude, simulate
 from tumble._validate import ValidationError, as_array
+from tumble.body import RigidBody
 from tumble.trajectory import Extra, Trajectory
 from tumble.variable.human import Human, Motion
 from tumble.variable.simulate import simulate_variable
@@ -186,35 +187,45 @@ def twist_rule_sweep(tilts, human: Human | None = None, *, posture: Mapping | No
     """Experiment (b): twists per somersault of a rigid posture against :func:`twist_rule`.
 
     For each initial tilt (rad) the rigid body of ``posture`` (default: layout,
-    arms at the sides) is simulated with :func:`tumble.simulate` for
-    ``duration`` s with ``L`` along inertial x; the measured ratio is
-    ``Δψ/Δφ`` over the run. Returns a dict of arrays: ``tilt``, ``simulated``,
-    ``rule`` (with ``I_s = I_x``), and the moments ``I_x, I_y, I_z``, and the
-    same ratio for the axisymmetric body ``diag(I_s, I_s, I_l)``
-    (``axisymmetric``), for which the rule is exact.
+    arms at the sides) is simulated with :func:`tumble.simulate` (dop853,
+    rtol = atol = 1e-11) with ``L`` along inertial x, over the whole number of
+    polhode periods (:func:`tumble.analytic.polhode_period`) that fits in
+    ``duration`` s (at least one), with ``n`` output times. Over whole periods
+    the measured ratio ``Δψ/Δφ`` is the long-run twists per somersault and the
+    trapezoidal mean of the tilt is its exact mean (a periodic function).
+    Returns a dict of arrays: ``tilt`` (initial), ``mean_tilt`` (rad),
+    ``simulated``, ``rule`` (:func:`twist_rule` at the initial tilt, with
+    ``I_s = I_x``), ``rule_mean_tilt`` (at the mean tilt), ``moments``
+    ``I_x, I_y, I_z``, and ``axisymmetric``: the simulated ratio of the body
+    ``diag(I_s, I_s, I_l)``, for which the rule is exact.
     """
     human = Human.de_leva() if human is None else human
     tilts = np.atleast_1d(as_array(tilts, "tilts"))
     inertia = human.inertia(posture)
-    t = np.linspace(0.0, duration, n)
     i_s, i_l = inertia[0, 0], inertia[2, 2]
     out = {"tilt": tilts, "rule": twist_rule(tilts, i_s, i_l), "moments": np.diag(inertia).copy()}
-    for key, body in (("simulated", inertia), ("axisymmetric", np.diag([i_s, i_s, i_l]))):
-        out[key] = _ratios(body, tilts, t)
+    out["simulated"], out["mean_tilt"] = _ratios(inertia, tilts, duration, n)
+    out["rule_mean_tilt"] = twist_rule(out["mean_tilt"], i_s, i_l)
+    out["axisymmetric"] = _ratios(np.diag([i_s, i_s, i_l]), tilts, duration, n)[0]
     return out
 
 
-def _ratios(inertia, tilts, t):
-    """Measured ``Δψ/Δφ`` of the rigid body ``inertia`` started at each tilt with ``L`` along inertial x."""
+def _ratios(inertia, tilts, duration, n):
+    """Measured ``Δψ/Δφ`` and mean tilt (rad) of the rigid body ``inertia`` started at each tilt with ``L``
+    along inertial x, over whole polhode periods."""
     momentum = np.array([MOMENTUM, 0.0, 0.0])
-    ratios = []
+    body = RigidBody(inertia)
+    ratios, means = [], []
     for tilt in tilts:   # one body per run: the compiled single-body path, no parallel start-up
         q0 = attitude.from_rotvec([0.0, tilt, 0.0])
         omega0 = np.linalg.solve(inertia, attitude.rotate_inverse(q0, momentum))
-        traj = simulate(inertia, omega0, q0=q0, t=t, method="dop853", rtol=1e-11, atol=1e-11)
+        period = analytic.polhode_period(body, omega0)
+        t = np.linspace(0.0, max(1, int(duration / period)) * period, n)
+        traj = simulate(body, omega0, q0=q0, t=t, method="dop853", rtol=1e-11, atol=1e-11)
         a = orientation_angles(traj.q, momentum)
         ratios.append(a.twists / a.somersaults)
-    return np.array(ratios)
+        means.append(np.mean(a.tilt[:-1]))   # trapezoid over whole periods of a periodic function
+    return np.array(ratios), np.array(means)
 
 
 def dive_513xd(human: Human | None = None, *, n: int = 681) -> Dive:
