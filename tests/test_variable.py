@@ -149,10 +149,18 @@ def test_bad_input_is_refused_naming_the_field_and_time():
     t = np.linspace(0.0, 1.0, 5)
     inertia = np.broadcast_to(np.eye(3), (5, 3, 3)).copy()
     inertia[3, 2, 2] = -1.0
-    with pytest.raises(tumble.ValidationError, match=r"inertia: must be positive definite .*t = 0\.75 s"):
+    with pytest.raises(tumble.ValidationError, match=r"inertia\[3\]: must be positive definite .*t = 0\.75 s"):
         VariableBody(t, inertia)
+    inertia[3, 2, 2] = 0.0   # a vanishing moment
+    with pytest.raises(tumble.ValidationError, match=r"inertia\[3\]: must be positive definite .*t = 0\.75 s"):
+        VariableBody(t, inertia)
+    inertia[3, 2, 2] = 2.5   # moments 1, 1, 2.5: no mass distribution has them
+    with pytest.raises(tumble.ValidationError, match=r"inertia\[3\]: principal moments break the triangle "
+                                                     r"inequality .*t = 0\.75 s"):
+        VariableBody(t, inertia)
+    assert VariableBody(t, inertia, check_triangle=False).inertia(0.75)[2, 2] == 2.5   # the opt-out, as RigidBody's
     inertia[3, 2, 2], inertia[2, 0, 1] = 1.0, 0.1
-    with pytest.raises(tumble.ValidationError, match=r"inertia: must be symmetric .*t = 0\.5 s"):
+    with pytest.raises(tumble.ValidationError, match=r"inertia\[2\]: must be symmetric .*t = 0\.5 s"):
         VariableBody(t, inertia)
     with pytest.raises(tumble.ValidationError, match="t: must be a 1-D array of at least 4"):
         VariableBody(t[:3], inertia[:3])

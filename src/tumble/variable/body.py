@@ -21,36 +21,37 @@ calling back into Python.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.body import _frozen
+from tumble.body import _frozen, principal_axes
 
 __all__ = ["VariableBody"]
 
 # I components in the spline channels: xx, yy, zz, xy, xz, yz; then A_x, A_y, A_z.
 _ROWS = np.array([0, 1, 2, 0, 0, 1])
 _COLS = np.array([0, 1, 2, 1, 2, 2])
-# Symmetry tolerance of a sampled tensor, relative to its largest entry (as RigidBody's 1e-12 rule).
-_SYMMETRY_RTOL = 1e-12
-# A sampled tensor is positive definite when its smallest eigenvalue exceeds this fraction of the largest.
-_DEFINITE_RTOL = 1e-14
 
 
 class VariableBody:
     """Inertia ``I(t)`` and shape momentum ``A(t)`` of a deformable body, interpolated from samples.
 
-    ``VariableBody(t, inertia, shape_momentum=None)``
+    ``VariableBody(t, inertia, shape_momentum=None, *, check_triangle=True)``
 
     t : (m,) strictly increasing sample times, s (m ≥ 4: a cubic needs four)
     inertia : (m, 3, 3) inertia tensors about the centre of mass, kg·m², body axes;
-        each symmetric and positive definite (refused otherwise, naming the time)
+        each symmetric, positive definite and obeying the triangle inequality
+        ``I₁ + I₂ ≥ I₃`` of its principal moments (the rules of :class:`tumble.RigidBody`;
+        refused otherwise, naming the sample and its time)
     shape_momentum : (m, 3) internal angular momentum ``A`` of the shape change,
         kg·m²/s, body axes; ``None`` for zero (a body whose parts do not move
         relative to B, e.g. a rigid body with a prescribed ``I(t)``)
+    check_triangle : False accepts samples whose moments break ``I₁ + I₂ ≥ I₃``
+        (published data that round across it), as in :class:`tumble.RigidBody`
 
     The body is defined on ``[t[0], t[-1]]`` only: simulations outside it are
     refused. Between samples ``I`` and ``A`` are cubic splines (error
@@ -60,7 +61,7 @@ class VariableBody:
 
     __slots__ = ("_t", "_inertia", "_shape_momentum", "_spline")
 
-    def __init__(self, t, inertia, shape_momentum=None):
+    def __init__(self, t, inertia, shape_momentum=None, *, check_triangle: bool = True):
         t = as_array(t, "t")
         if t.ndim != 1 or t.size < 4:
             raise ValidationError(f"t: must be a 1-D array of at least 4 sample times, got shape {t.shape}")
@@ -73,7 +74,7 @@ class VariableBody:
         if inertia.shape != (t.size, 3, 3):
             raise ValidationError(f"inertia: must have shape ({t.size}, 3, 3) (one tensor per sample time), "
                                   f"got {inertia.shape}")
-        inertia = _check_tensors(t, inertia)
+        inertia = _check_tensors(t, inertia, check_triangle)
         if shape_momentum is None:
             shape_momentum = np.zeros((t.size, 3))
         shape_momentum = as_array(shape_momentum, "shape_momentum", tail=(3,))
@@ -87,14 +88,15 @@ class VariableBody:
 
     @classmethod
     def from_functions(cls, inertia: Callable, shape_momentum: Callable | None = None, *,
-                       t_span, dt: float) -> VariableBody:
+                       t_span, dt: float, check_triangle: bool = True) -> VariableBody:
         """Sample ``inertia(t) -> (n, 3, 3)`` and ``shape_momentum(t) -> (n, 3)`` (vectorised in ``t``, s).
 
         The samples lie on a uniform grid of step ≤ ``dt`` (s) over ``t_span = (t0, t1)``;
         the interpolation error scales as ``dt⁴``.
         """
         t = cls.grid(t_span, dt)
-        return cls(t, inertia(t), None if shape_momentum is None else shape_momentum(t))
+        return cls(t, inertia(t), None if shape_momentum is None else shape_momentum(t),
+                   check_triangle=check_triangle)
 
     @staticmethod
     def grid(t_span, dt: float) -> np.ndarray:
@@ -166,21 +168,13 @@ class VariableBody:
         return f"VariableBody(t=[{t0:g}, {t1:g}] s, samples={self._t.size})"
 
 
-def _check_tensors(t, inertia):
-    """Symmetric (then symmetrised exactly) and positive definite at every sample, else refused naming the time."""
-    scale = np.abs(inertia).max(axis=(1, 2))
-    asym = np.abs(inertia - np.swapaxes(inertia, 1, 2)).max(axis=(1, 2))
-    bad = np.flatnonzero(asym > _SYMMETRY_RTOL * scale)
-    if bad.size:
-        k = int(bad[0])
-        raise ValidationError(f"inertia: must be symmetric at every sample (at t = {t[k]} s, |I - I^T| = "
-                              f"{asym[k]:.3g} > {_SYMMETRY_RTOL:g} |I|)")
-    inertia = 0.5 * (inertia + np.swapaxes(inertia, 1, 2))
-    eig = np.linalg.eigvalsh(inertia)
-    bad = np.flatnonzero(~(eig[:, 0] > _DEFINITE_RTOL * eig[:, 2]))
-    if bad.size:
-        k = int(bad[0])
-        raise ValidationError(f"inertia: must be positive definite at every sample (at t = {t[k]} s the "
-                              f"principal moments are {eig[k, 0]:.6g}, {eig[k, 1]:.6g}, {eig[k, 2]:.6g} kg m^2)")
-    return inertia
-
+def _check_tensors(t, inertia, check_triangle):
+    """The rules of :func:`tumble.body.principal_axes` (symmetric, then symmetrised exactly; positive definite;
+    the triangle inequality ``I₁ + I₂ ≥ I₃`` that every mass distribution obeys) at every sample; a broken
+    rule is refused naming the sample and its time."""
+    try:
+        return principal_axes(inertia, "inertia", check_triangle=check_triangle)[0]
+    except ValidationError as error:
+        found = re.match(r"inertia\[(\d+)\]", str(error))
+        at = f" (sample at t = {t[int(found.group(1))]} s)" if found else ""
+        raise ValidationError(f"{error}{at}") from None
