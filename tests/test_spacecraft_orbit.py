@@ -1,11 +1,14 @@
 """A spacecraft in orbit: gravity gradient and geomagnetic field from the orbit, momentum dumping."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from tumble import attitude
 from tumble.spacecraft import (DipoleField, Magnetorquers, MomentumDumping, Orbit, QuaternionPD, Spacecraft,
-                               pyramid_wheels, simulate)
+                               pyramid_wheels)
+from tumble.spacecraft.scenario import load_spacecraft_scenario
 
 # Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
 # on 2 shared cores, under 1 s warm).
@@ -17,13 +20,26 @@ FIELD = DipoleField()
 WHEEL_INERTIA = 0.05
 
 
+EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "momentum_dumping.toml"
+
+
 @pytest.fixture(scope="module")
 def dumping():
-    craft = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(WHEEL_INERTIA), magnetorquers=Magnetorquers(20.0),
-                       orbit=ORBIT, magnetic_field=FIELD, gravity_gradient=True,
-                       controller=[QuaternionPD(0.1, 0.9), MomentumDumping(2e-3)])
-    t = np.linspace(0.0, ORBIT.period, 1201)
-    return craft, simulate(craft, [0.0, 0.0, 0.0], t=t, wheel_speeds0=[60.0, -20.0, 30.0, 10.0], dt=0.5)
+    """examples/spacecraft/momentum_dumping.toml, run as ``tumble run`` runs it."""
+    scenario = load_spacecraft_scenario(EXAMPLE)
+    return scenario.spacecraft.build(str(EXAMPLE)), scenario.run()
+
+
+def test_dumping_example_is_the_spacecraft_described_here(dumping):
+    craft, traj = dumping
+    direct = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(WHEEL_INERTIA), magnetorquers=Magnetorquers(20.0),
+                        orbit=ORBIT, magnetic_field=FIELD, gravity_gradient=True,
+                        controller=[QuaternionPD(0.1, 0.9), MomentumDumping(2e-3)])
+    a, b = craft.model(), direct.model()   # the compiled parameters: every number and flag
+    np.testing.assert_array_equal(a.data, b.data)
+    assert a._replace(data=None) == b._replace(data=None)
+    np.testing.assert_array_equal(traj.t, np.linspace(0.0, ORBIT.period, 1201))
+    np.testing.assert_allclose(traj.extras["wheel_speed"].data[0], [60.0, -20.0, 30.0, 10.0], rtol=0, atol=1e-12)
 
 
 def test_environment_torques_are_those_of_the_orbit(dumping):
