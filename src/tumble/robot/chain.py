@@ -171,7 +171,8 @@ class SerialChain:
     algorithms are built once, here.
     """
 
-    __slots__ = ("_links", "_gravity", "_name", "_params", "_lower", "_upper", "_no_wrench", "_no_wrenches")
+    __slots__ = ("_links", "_gravity", "_name", "_params", "_lower", "_upper", "_no_wrench", "_no_wrenches",
+                 "_one_state")
 
     def __init__(self, links: Sequence[Link], *, gravity=DEFAULT_GRAVITY, name: str | None = None):
         links = tuple(links)
@@ -189,6 +190,7 @@ class SerialChain:
         set_(self, "_upper", _frozen([link.upper for link in links]))
         set_(self, "_no_wrench", np.zeros(6))
         set_(self, "_no_wrenches", np.zeros((1, 6)))
+        set_(self, "_one_state", (len(links),))  # the shape of one joint array, for the fast path of a call
 
     # -- constructors ---------------------------------------------------------
 
