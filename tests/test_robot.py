@@ -106,6 +106,24 @@ def test_prismatic_dh_joint(convention):
                                atol=TOL)
 
 
+@pytest.mark.parametrize("name", ["puma560.toml", "panda.toml"])
+def test_revolute_dh_offsets_shift_the_joint_variable(name):
+    """``theta`` of a revolute row is an offset, θ = q + theta: the table with offsets at q is the table
+    without them at q + theta (standard DH for the PUMA, modified for the Panda)."""
+    import tomllib
+
+    doc = tomllib.loads((ROBOTS / name).read_text())
+    offsets = np.linspace(-0.9, 1.2, len(doc["link"]))
+    shifted = [{**row, "theta": float(x)} for row, x in zip(doc["link"], offsets)]
+    kwargs = dict(convention=doc["convention"], check_triangle=doc.get("check_triangle", True))
+    plain, offset = robot.SerialChain.from_dh(doc["link"], **kwargs), robot.SerialChain.from_dh(shifted, **kwargs)
+    Q, QD, QDD = random_states(plain.dof, 4, seed=13)
+    np.testing.assert_allclose(robot.rnea(offset, Q, QD, QDD), robot.rnea(plain, Q + offsets, QD, QDD), rtol=0,
+                               atol=TOL)
+    np.testing.assert_allclose(robot.link_poses(offset, Q), robot.link_poses(plain, Q + offsets), rtol=0, atol=TOL)
+    assert np.abs(robot.rnea(offset, Q, QD, QDD) - robot.rnea(plain, Q, QD, QDD)).max() > 0.1  # offsets matter
+
+
 # -- identities on every example robot ---------------------------------------------
 
 

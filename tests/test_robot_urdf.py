@@ -125,7 +125,76 @@ def test_bad_urdf_is_refused_naming_the_element(text, message):
 
 
 def test_triangle_inequality_opt_out():
+    """Published inertias (here the PUMA's link 3) may break I1 + I2 >= I3: refused naming the URDF link,
+    unless opted out."""
     doc = urdf(link("base") + link("a", 1.0, inertia=(0.066, 0, 0, 0.086, 0, 0.0125)) + joint("j1", "base", "a"))
-    with pytest.raises(ValidationError, match=r"link 'j1'\.inertia: principal moments break the triangle"):
+    with pytest.raises(ValidationError, match=r"link 'a' <inertial> \(moved by joint 'j1'\): principal moments "
+                                              r"break the triangle inequality .* pass check_triangle=False"):
         robot.SerialChain.from_urdf(doc)
     assert robot.SerialChain.from_urdf(doc, check_triangle=False).links[0].mass == 1.0
+    # a fixed link merged into the moving one is named too
+    tool = link("tool", 1e-6, inertia=(1e-9, 0, 0, 1e-9, 0, 1e-9)) + joint("grip", "a", "tool", kind="fixed")
+    doc = urdf(link("base") + link("a", 1.0, inertia=(0.066, 0, 0, 0.086, 0, 0.0125)) + joint("j1", "base", "a") + tool)
+    with pytest.raises(ValidationError, match=r"link 'a' <inertial> with the fixed link\(s\) \['tool'\] merged"):
+        robot.SerialChain.from_urdf(doc)
+
+
+# -- every construct of the parser at once, against Pinocchio's own URDF parser ------------------
+#
+# A 4-joint arm written for this test: a massive pedestal on a fixed joint before the first moving
+# joint (it belongs to the base), a continuous joint about -z, a prismatic joint along an oblique
+# axis, a fixed bracket between two moving links, an unnormalised axis (0 1 1), a revolute joint
+# about -x, a tool on a fixed flange, origins with roll, pitch and yaw, products of inertia.
+LIMIT = '<limit lower="-2" upper="2" effort="10" velocity="1"/>'
+PEER_URDF = urdf(
+    link("base") + link("pedestal", 3.0, xyz="0 0 0.05")
+    + link("a", 1.2, xyz="0.02 -0.01 0.1", rpy="0.1 0.2 0.3", inertia=(0.02, 0.001, -0.002, 0.03, 0.003, 0.015))
+    + link("b", 2.0, xyz="0.05 0.0 -0.03", inertia=(0.01, 0.0, 0.001, 0.012, -0.002, 0.008))
+    + link("bracket", 0.4, xyz="0 0.02 0", rpy="0.5 0 0", inertia=(0.002, 0.0, 0.0, 0.003, 0.0, 0.004))
+    + link("c", 0.5, xyz="0.1 0 0", inertia=(0.001, 0.0, 0.0, 0.01, 0.0, 0.01))
+    + link("d", 0.7, xyz="0 0.03 0.04", inertia=(0.004, -0.0005, 0.0, 0.005, 0.0007, 0.003))
+    + link("tool", 0.3, xyz="0 0 0.05", inertia=(0.0006, 0.0, 0.0, 0.0006, 0.0, 0.0002))
+    + joint("mount", "base", "pedestal", kind="fixed", xyz="0 0 0.1", rpy="0 0 0.2")
+    + joint("j1", "pedestal", "a", kind="continuous", axis="0 0 -1", xyz="0 0 0.1")
+    + joint("j2", "a", "b", kind="prismatic", axis="0.6 0 -0.8", xyz="0.1 0 0.2", rpy="0.3 -0.2 0.1", extra=LIMIT)
+    + joint("bolt", "b", "bracket", kind="fixed", xyz="0 0.15 0", rpy="0.4 0 0")
+    + joint("j3", "bracket", "c", axis="0 1 1", xyz="0 0.2 0", rpy="0 0.5 -0.3", extra=LIMIT)
+    + joint("j4", "c", "d", axis="-1 0 0", xyz="0.3 0 0", extra=LIMIT)
+    + joint("flange", "d", "tool", kind="fixed", xyz="0 0 0.1", rpy="0 0.5 0"),
+    name="peer arm")
+# One state and a wrench (f, n) on the end link (URDF link "d", the child of the last moving joint).
+PEER_STATE = dict(q=[0.3, 0.2, -0.5, 0.7], qd=[0.4, -0.3, 0.9, -1.1], qdd=[1.0, -2.0, 0.5, 0.8],
+                  f_ext=[1.0, -2.0, 3.0, 0.1, -0.2, 0.3])
+# Computed once with Pinocchio 4.1.0 (pinocchio.buildModelFromXML(PEER_URDF), gravity (0, 0, -9.81);
+# rnea, crba, aba, the wrench as fext of the last joint) by benchmarks/robot_pinocchio_reference.py.
+PEER = {
+    "tau": [0.1464583093838328, -31.834398284450273, -0.9861596138538653, -0.35560984301502824],
+    "tau_wrench": [-0.9373036028276117, -30.394001504153316, -0.5934290339857555, -0.2556098430150282],
+    "M": [[0.6706461147181751, 0.08705432527447507, -0.14829446212887187, -0.03228979506079721],
+          [0.08705432527447507, 3.9000000000000004, 0.1952717119667885, 0.04672066712377287],
+          [-0.14829446212887187, 0.1952717119667885, 0.11345089810424294, 0.023049923030572045],
+          [-0.03228979506079721, 0.04672066712377287, 0.023049923030572045, 0.012468421511545296]],
+    "aba_wrench": [3.49574171412102, 4.99880740937451, -19.25017092356121, 102.21201905227483],
+}
+# Two parsers and two algorithms agree to rounding (measured <= 5e-14); the issue's criterion is 1e-10.
+PEER_TOL = 1e-10
+
+
+def test_urdf_arm_matches_pinocchio():
+    chain = robot.SerialChain.from_urdf(PEER_URDF)
+    assert chain.joint_types == ("revolute", "prismatic", "revolute", "revolute")
+    assert chain.joint_names == ("j1", "j2", "j3", "j4")
+    q, qd, qdd, wrench = (np.array(PEER_STATE[k]) for k in ("q", "qd", "qdd", "f_ext"))
+    np.testing.assert_allclose(robot.rnea(chain, q, qd, qdd), PEER["tau"], rtol=0, atol=PEER_TOL)
+    np.testing.assert_allclose(robot.rnea(chain, q, qd, qdd, f_ext=wrench), PEER["tau_wrench"], rtol=0,
+                               atol=PEER_TOL)
+    np.testing.assert_allclose(robot.mass_matrix(chain, q), PEER["M"], rtol=0, atol=PEER_TOL)
+    np.testing.assert_allclose(robot.forward_dynamics(chain, q, qd, qdd, f_ext=wrench), PEER["aba_wrench"], rtol=0,
+                               atol=PEER_TOL)
+    # batched, one wrench per sample: (no wrench, the wrench)
+    Q, QD, QDD = (np.stack([x, x]) for x in (q, qd, qdd))
+    W = np.stack([np.zeros(6), wrench])
+    np.testing.assert_allclose(robot.rnea(chain, Q, QD, QDD, f_ext=W), [PEER["tau"], PEER["tau_wrench"]], rtol=0,
+                               atol=PEER_TOL)
+    np.testing.assert_allclose(robot.forward_dynamics(chain, Q, QD, QDD, f_ext=W)[1], PEER["aba_wrench"], rtol=0,
+                               atol=PEER_TOL)

@@ -160,6 +160,7 @@ def links_from_urdf(source, *, check_triangle: bool = True) -> tuple[str | None,
     chain = []
     pending_R, pending_p = np.eye(3), np.zeros(3)  # current URDF link frame in the last moving link's frame
     parts: list = []  # (mass, com, inertia) of the current moving link, in its frame
+    members: list = []  # names of the URDF links that make it up: its own, then those merged into it
     current = roots[0]
     seen = {current}
     while True:
@@ -184,10 +185,11 @@ def links_from_urdf(source, *, check_triangle: bool = True) -> tuple[str | None,
         if kind == "fixed":
             pending_R, pending_p = R, p
             parts.append((mass, R @ com + p, R @ inertia @ R.T))
+            members.append(child)
         else:
             if chain:
-                chain[-1] = _merged(chain[-1], parts, check_triangle)
-            parts = [(mass, com, inertia)]
+                chain[-1] = _merged(chain[-1], parts, members, check_triangle)
+            parts, members = [(mass, com, inertia)], [child]
             pending_R, pending_p = np.eye(3), np.zeros(3)
             axis = _numbers(el.find("axis"), "xyz", 3, "1 0 0", f"{where} <axis>")
             limit = el.find("limit")
@@ -200,20 +202,24 @@ def links_from_urdf(source, *, check_triangle: bool = True) -> tuple[str | None,
         current = child
     if not chain:
         raise ValidationError(f"{label}: no revolute, continuous or prismatic joint: nothing moves")
-    chain[-1] = _merged(chain[-1], parts, check_triangle)
+    chain[-1] = _merged(chain[-1], parts, members, check_triangle)
     return root.get("name"), chain
 
 
-def _merged(spec: dict, parts, check_triangle: bool) -> Link:
+def _merged(spec: dict, parts, members: list[str], check_triangle: bool) -> Link:
     """The :class:`Link` of ``spec`` carrying the rigid union of ``parts`` (mass, com, inertia about com)::
 
         m = Σ mₖ,   c = Σ mₖ cₖ / m,   I = Σ [Iₖ + mₖ (|dₖ|² E − dₖ dₖᵀ)],   dₖ = cₖ − c
 
     (the rule of :meth:`tumble.body.RigidBody.composite`, which needs every mass > 0).
+    ``members`` names the URDF links of ``parts``; a broken inertia rule names them.
     """
     masses = np.array([m for m, _, _ in parts])
     coms = np.array([c for _, c, _ in parts])
     mass = masses.sum()
     com = masses @ coms / mass if mass > 0.0 else np.zeros(3)
     inertia = sum(i for _, _, i in parts) + _parallel_axis(masses, coms - com)
+    merged = f" with the fixed link(s) {members[1:]} merged into it" if len(members) > 1 else ""
+    principal_axes(inertia, f"link {members[0]!r} <inertial>{merged} (moved by joint {spec['name']!r})",
+                   definite=False, check_triangle=check_triangle)
     return Link(mass=mass, com=com, inertia=inertia, check_triangle=check_triangle, **spec)
