@@ -158,6 +158,21 @@ def test_torque_limit_is_respected(slew):
 
 
 @SLOW
+def test_pd_torque_limit_scales_the_command_keeping_its_direction():
+    # at rest (ω = 0) the unlimited law is u = C ω_c = −K q_e,v = −2ω_n² J_ω q_e,v (Wie, Weiss &
+    # Arapostathis 1989), computed here independently; max_torque scales it so that max |u_k| = limit
+    wn, limit = 0.3, 0.01
+    target = attitude.from_rotvec([0.4, -0.3, 0.8])
+    craft = _craft(controller=QuaternionPD(wn, 0.8, target=target, max_torque=limit))
+    traj = simulate(craft, [0.0, 0.0, 0.0], t=np.linspace(0.0, 5.0, 11), dt=0.01)
+    u = traj.extras["torque_command"].data
+    error = attitude.multiply(attitude.conjugate(target), attitude.identity())
+    unlimited = -2.0 * wn**2 * craft.rate_inertia @ (np.sign(error[0]) * error[1:])
+    np.testing.assert_allclose(u[0], limit * unlimited / np.abs(unlimited).max(), rtol=1e-14, atol=0)
+    assert np.abs(u).max() <= limit * (1.0 + 1e-15)
+
+
+@SLOW
 def test_zero_order_hold_holds_the_command_between_samples():
     period = 0.5
     craft = _craft(control_period=period)
