@@ -416,3 +416,20 @@ def test_quaternion_stays_unit(method):
     traj = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, q0=Q0, t=np.linspace(0.0, 20.0, 2001), method=method,
                            dt=1e-2, rtol=1e-8, atol=1e-8, torque=torques.ConstantInertial(TAU))
     assert np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0).max() <= TOL_UNIT
+
+
+def test_models_of_the_extension_packages_are_sent_to_their_own_simulate():
+    import importlib
+
+    from tumble.variable import Human
+
+    simulate_module = importlib.import_module("tumble.simulate")  # the module (tumble.simulate is the function)
+    for qualified, advice in simulate_module._OWN_SIMULATE.items():
+        module, name = qualified.rsplit(".", 1)
+        cls = getattr(importlib.import_module(module), name)  # the table names real classes
+        assert f"{cls.__module__}.{cls.__qualname__}" == qualified
+        entry = advice.rsplit(" ", 1)[-1]
+        package, function = entry.rsplit(".", 1)
+        assert callable(getattr(importlib.import_module(package), function))  # and real entry points
+    with pytest.raises(ValidationError, match=r"body: a Human is not a rigid body; .*simulate_variable"):
+        tumble.simulate(Human.de_leva(), [0.0, 0.0, 1.0], t=[0.0, 1.0])

@@ -147,6 +147,19 @@ def _output_times(t) -> np.ndarray:
     return times
 
 
+# Models of the extension packages that have their own entry point (named here, not
+# imported: those packages are built on this module).
+_OWN_SIMULATE = {
+    "tumble.variable.body.VariableBody": "integrate it with tumble.variable.simulate_variable",
+    "tumble.variable.human.Human": ("make its VariableBody with Human.variable_body(...) and integrate that with "
+                                    "tumble.variable.simulate_variable"),
+    "tumble.flexible.FlexibleBody": "integrate it with tumble.flexible.simulate",
+    "tumble.slosh.SloshBody": "integrate it with tumble.slosh.simulate",
+    "tumble.spacecraft.model.Spacecraft": "integrate it with tumble.spacecraft.simulate",
+    "tumble.robot.chain.SerialChain": "integrate it with tumble.robot.simulate",
+}
+
+
 def _bodies(body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | float | None]:
     """Principal moments (B, 3), axes R_BP (B, 3, 3), the inertia to report and the mass (kg, or None
     when unknown), B = 1 or one per member.
@@ -160,6 +173,9 @@ def _bodies(body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | floa
         masses = [b.mass for b in body]
         return (np.stack([b.moments for b in body]), np.stack([b.axes for b in body]),
                 np.stack([b.inertia for b in body]), None if None in masses else np.array(masses))
+    own = _OWN_SIMULATE.get(f"{type(body).__module__}.{type(body).__qualname__}")
+    if own is not None:
+        raise ValidationError(f"body: a {type(body).__name__} is not a rigid body; {own}")
     inertia = as_array(body, "inertia", tail=(3, 3))
     if inertia.ndim not in (2, 3):
         raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
