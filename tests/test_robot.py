@@ -247,6 +247,20 @@ def test_bad_dh_rows_are_refused_naming_the_field(row, message):
         robot.SerialChain.from_dh([row])
 
 
+@pytest.mark.parametrize("text, message", [
+    ('check_triangle = "false"\n[[link]]\nmass = 1.0', r"arm\.toml: check_triangle must be true or false, got 'false'"),
+    ('convention = "craig"\n[[link]]\nmass = 1.0', r"convention: must be 'standard' or 'modified'"),
+    ('colour = "red"\n[[link]]\nmass = 1.0', r"arm\.toml: unknown key\(s\) \['colour'\]"),
+    ('name = "empty"', r"arm\.toml: needs at least one \[\[link\]\] table"),
+    ('[[link]\nmass = 1.0', r"arm\.toml: malformed TOML"),
+])
+def test_bad_robot_files_are_refused_naming_the_key(tmp_path, text, message):
+    path = tmp_path / "arm.toml"
+    path.write_text(text)
+    with pytest.raises(ValidationError, match=message):
+        robot.load(path)
+
+
 def test_bad_states_are_refused_naming_the_input(chains):
     chain = chains["puma560.toml"]
     q = np.zeros(6)

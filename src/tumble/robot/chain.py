@@ -336,6 +336,9 @@ def load(path) -> SerialChain:
         raise ValidationError(f"{path.name}: unknown key(s) {unknown}; allowed: {sorted(_TOML_KEYS)}")
     if "link" not in doc:
         raise ValidationError(f"{path.name}: needs at least one [[link]] table")
+    check_triangle = doc.get("check_triangle", True)
+    if not isinstance(check_triangle, bool):
+        raise ValidationError(f"{path.name}: check_triangle must be true or false, got {check_triangle!r}")
     return SerialChain.from_dh(doc["link"], convention=doc.get("convention", "standard"),
                                gravity=doc.get("gravity", DEFAULT_GRAVITY), name=doc.get("name", path.stem),
-                               check_triangle=bool(doc.get("check_triangle", True)))
+                               check_triangle=check_triangle)
