@@ -74,6 +74,31 @@ def test_coning_drift_follows_its_law(algorithm):
         assert abs(-measured / predicted - 1.0) < CONING_RTOL, (x, measured, predicted)
 
 
+@pytest.mark.parametrize("alpha, rtol", [(0.01, 1e-5), (0.3, 1e-2)])
+def test_uncompensated_drift_with_sin2_alpha(alpha, rtol):
+    # The uncompensated law ½ α² Ω (1 − sin x/x) is exact in x = ΩT; its α² is the leading term of
+    # sin²α (derivation in docs/ins.md). With sin²α the law holds to O(α² x²): measured 3.0e-6
+    # (α = 0.01, x ≤ 1) and 7.5e-3 (α = 0.3, x = 2), while α² or 1 − cos α would be off by α²/3
+    # or α²/4 (3.3e-5, 2.5e-5 at α = 0.01; 3 %, 2.2 % at α = 0.3). At α = 0.3, x = 2 the error
+    # reaches 20 rad over the 400 updates: measure_drift must not wrap it at π.
+    coning = Coning(alpha, OMEGA)
+    for x in (0.05, 0.3, 1.0, 2.0 if alpha > 0.1 else 1.0):
+        T = x / OMEGA
+        law = drift_law("none", alpha, OMEGA, T) * (math.sin(alpha) / alpha) ** 2
+        assert -measure_drift(coning, "none", T, updates=400) == pytest.approx(law, rel=rtol), x
+
+
+def test_uncompensated_law_keeps_its_digits_at_high_update_rates():
+    # ½ α² Ω (1 − sin x/x) = α² Ω x²/12 (1 − x²/20 + x⁴/840 − …): at x = 1e-6 the closed form would
+    # lose 12 digits to cancellation (and return 0 below x ≈ 1e-8)
+    for x in (1e-9, 1e-6, 1e-3, 0.5):
+        series = ALPHA**2 * OMEGA * x**2 / 12 * (1 - x**2 / 20 + x**4 / 840 - x**6 / 60480)
+        assert drift_law("none", ALPHA, OMEGA, x / OMEGA) == pytest.approx(series, rel=2e-9 if x == 0.5 else 1e-15)
+    # above the series' range the closed form is used: x = 2 by hand
+    assert drift_law("none", ALPHA, OMEGA, 2 / OMEGA) == pytest.approx(
+        0.5 * ALPHA**2 * OMEGA * (1 - math.sin(2.0) / 2.0), rel=1e-15)
+
+
 def test_coning_laws_numbers():
     # α²Ω (ΩT)⁴/960 and α²Ω (ΩT)⁶/204120 at α = 0.01, Ω = 2π, ΩT = 0.5 (by hand)
     assert drift_law("two-sample", ALPHA, OMEGA, 0.5 / OMEGA) == pytest.approx(1e-4 * OMEGA * 0.0625 / 960, rel=1e-14)

@@ -26,7 +26,9 @@ algorithm        n    coning term ``δφ``                                      
 ``three-sample`` 3    (9/20) Δθ₁ × Δθ₃ + (27/40) Δθ₂ × (Δθ₃ − Δθ₁)                    α² Ω (ΩT)⁶ / 204120
 ===============  ===  ==============================================================  =========================
 
-(Δθ = Δθ₁ + … + Δθ_n; the two- and three-sample
+(Δθ = Δθ₁ + … + Δθ_n. ``none`` is uncompensated, ``φ = Δθ``: its drift is
+≈ α² Ω (ΩT)²/12 at small ΩT, second order in T; ``one-sample`` compensates
+with the previous update's increment. The two- and three-sample
 coefficients are those of R. B. Miller, "A new strapdown attitude
 algorithm", J. Guidance 6(4), 1983; the one-sample-plus-previous form and the
 drift laws: M. B. Ignagni, "Optimal strapdown attitude integration
