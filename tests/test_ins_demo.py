@@ -14,6 +14,8 @@ def test_demo_gyroscope(tmp_path):
     # 100 samples, the period itself off by 3ε²); nutation period −3ε² = −1.6e-6 (measured)
     assert s["precession_rate_measured"] == pytest.approx(s["precession_rate"], rel=1e-5)
     assert s["nutation_period_s_measured"] == pytest.approx(s["nutation_period_s"], rel=5 * 7.4e-4**2)
+    # against the exact heavy top (elliptic functions): measured 1.6e-14, as in test_ins_gyroscope
+    assert s["nutation_period_s_measured"] == pytest.approx(s["nutation_period_s_exact"], rel=1e-9)
     assert s["imbalance_drift_error_rad"] < 1e-9       # measured 5.7e-12 rad
     assert s["spin_drag_drift_error_rad"] < 1e-6       # measured 3.8e-7 rad of 2.2 rad
     assert s["pivot_tilt_error_rad"] < 1e-6            # of a 1e-3 rad tilt; measured 3.8e-7 rad

@@ -119,6 +119,9 @@ def test_imu_samples_a_trajectory():
     perfect = Imu().sample(truth, oversample=4, seed=0)
     np.testing.assert_array_equal(perfect.delta_theta, from_trajectory(truth, oversample=4).delta_theta)
     assert perfect.dt == pytest.approx(0.01, rel=1e-12) and len(perfect) == 100
+    # measured rates are the mean rates over the sample intervals: Δθ/dt
+    np.testing.assert_array_equal(perfect.rate, perfect.delta_theta / perfect.dt)
+    np.testing.assert_allclose(perfect.t, 0.01 * np.arange(1, 101), rtol=1e-12)
 
 
 def test_from_trajectory_checks_its_grid():
