@@ -113,7 +113,8 @@ _register(
         ("precession", f"{s['precession_rate_measured']:.9g} rad/s (simulated), "
                        f"{s['precession_rate']:.9g} rad/s (torque/(I_s w_s))"),
         ("nutation", f"period {s['nutation_period_s_measured']:.9g} s (simulated), "
-                     f"{s['nutation_period_s']:.9g} s (exact heavy top)"),
+                     f"{s['nutation_period_s_exact']:.9g} s (exact heavy top), "
+                     f"{s['nutation_period_s']:.9g} s (2 pi I_t/(I_s w_s))"),
         ("drift", f"against the laws: imbalance {s['imbalance_drift_error_rad']:.2g} rad, spin drag "
                   f"{s['spin_drag_drift_error_rad']:.2g} rad, pivot friction {s['pivot_tilt_error_rad']:.2g} rad"),
     ],
@@ -124,8 +125,9 @@ _register(
     """The classic coning test of strapdown attitude algorithms (alpha = 0.01 rad, Omega = 2 pi rad/s).
 
     Drift rate about the cone axis of the uncompensated, one-, two- and three-sample
-    algorithms against the laws alpha^2 Omega (Omega T)^4/960 and alpha^2 Omega (Omega T)^6/204120
-    (docs/ins.md). Writes ins_coning.png in the directory.
+    algorithms against their laws (docs/ins.md): 1/2 sin^2(alpha) Omega (1 - sin(Omega T)/(Omega T))
+    uncompensated, alpha^2 Omega (Omega T)^4/60 one-sample, alpha^2 Omega (Omega T)^4/960 two-sample and
+    alpha^2 Omega (Omega T)^6/204120 three-sample. Writes ins_coning.png in the directory.
     """,
     lambda s: [(algorithm, f"measured drift within {s[algorithm]['max_relative_deviation']:.1%} of its law")
                for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
