@@ -7,6 +7,8 @@ orbit in degrees)::
 
     [spacecraft]
     inertia = [[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]]   # total, wheels included
+    # or a [spacecraft.hub] table (inertia or moments, mass, com): the hub WITHOUT the wheels,
+    # each wheel then with mass, position and transverse_inertia (Spacecraft(hub=...))
 
     [spacecraft.wheel_pyramid]          # or [[spacecraft.wheels]] tables: axis, inertia, ...
     inertia = 0.02
@@ -47,6 +49,7 @@ import numpy as np
 import pydantic
 from pydantic import Field, PrivateAttr, field_validator
 
+from tumble.body import RigidBody
 from tumble.scenario import (EulerAngles, Initial, ScenarioError, Solver, Time, _blame, _Bool, _describe, _Matrix,
                              _Number, _Positive, _Quaternion, _Table, _toml_problem, _Vector)
 from tumble.spacecraft import actuators, control
@@ -68,13 +71,17 @@ class Wheel(_Table):
     viscous: _Number = 0.0
     coulomb: _Number = 0.0
     coulomb_speed: _Positive = 1.0
+    mass: _Positive | None = None
+    position: _Vector | None = None
+    transverse_inertia: _Positive | None = None
 
     def build(self):
         return actuators.ReactionWheel(**self.model_dump())
 
 
 class WheelPyramid(_Table):
-    """Four identical wheels in a pyramid (:func:`tumble.spacecraft.pyramid_wheels`)."""
+    """Four identical wheels in a pyramid (:func:`tumble.spacecraft.pyramid_wheels`); ``mass``,
+    ``position`` and ``transverse_inertia``, as every other key, apply to each of the four."""
 
     inertia: _Positive
     skew: _Positive = math.degrees(math.atan(math.sqrt(2.0)))
@@ -83,9 +90,35 @@ class WheelPyramid(_Table):
     viscous: _Number = 0.0
     coulomb: _Number = 0.0
     coulomb_speed: _Positive = 1.0
+    mass: _Positive | None = None
+    position: _Vector | None = None
+    transverse_inertia: _Positive | None = None
 
     def build(self):
         return actuators.pyramid_wheels(**self.model_dump())
+
+
+class HubTable(_Table):
+    """``[spacecraft.hub]``: the hub **without** its wheels (``Spacecraft(hub=RigidBody(...))``):
+    ``inertia`` (3×3, kg m², about the hub's centre of mass, body axes) or ``moments`` (its diagonal),
+    ``mass`` (kg) and ``com`` (m, body axes; default the origin)."""
+
+    inertia: _Matrix | None = None
+    moments: _Vector | None = None
+    mass: _Positive
+    com: _Vector | None = None
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        if self.inertia is None:
+            keys["inertia"] = f"{prefix}.moments"
+        return keys
+
+    def build(self) -> RigidBody:
+        if (self.inertia is None) == (self.moments is None):
+            raise ScenarioError("", [("spacecraft.hub", "give exactly one of inertia or moments")])
+        inertia = self.inertia if self.inertia is not None else np.diag(self.moments)
+        return RigidBody(inertia, mass=self.mass, com=self.com)
 
 
 class CMGPyramid(_Table):
@@ -214,11 +247,13 @@ _Controller = Annotated[Union[PDTable, RateDampingTable, ConstantTorqueTable, BD
 
 
 class SpacecraftTable(_Table):
-    """``[spacecraft]``: mass properties (``inertia`` or ``moments``: the total, wheels included),
-    actuators, environment and controllers."""
+    """``[spacecraft]``: mass properties (``inertia`` or ``moments``: the total, wheels included; or a
+    ``hub`` table: the hub without the wheels, which then need mass properties), actuators, environment
+    and controllers."""
 
     inertia: _Matrix | None = None
     moments: _Vector | None = None
+    hub: HubTable | None = None
     wheels: list[Wheel] = []
     wheel_pyramid: WheelPyramid | None = None
     cmgs: CMGPyramid | None = None
@@ -232,8 +267,11 @@ class SpacecraftTable(_Table):
     control_period: _Positive | None = None
 
     def build(self, source: str) -> Spacecraft:
-        if (self.inertia is None) == (self.moments is None):
-            raise ScenarioError(source, [("spacecraft", "give exactly one of inertia or moments")])
+        given = [key for key in ("inertia", "moments", "hub") if getattr(self, key) is not None]
+        if len(given) != 1:
+            rule = ("give exactly one of inertia, moments (the total, wheels included) or hub (a [spacecraft.hub] "
+                    "table: the hub without the wheels)" + (f"; got {' and '.join(given)}" if given else ""))
+            raise ScenarioError(source, [("spacecraft", rule)])
         if self.wheels and self.wheel_pyramid is not None:
             raise ScenarioError(source, [("spacecraft", "give wheels or wheel_pyramid, not both")])
         parts = {}
@@ -243,7 +281,7 @@ class SpacecraftTable(_Table):
                 with _blame(source, f"spacecraft.{key}[{i}]", entry.argument_keys(f"spacecraft.{key}[{i}]")):
                     items.append(entry.build())
             parts[key] = items
-        for key in ("wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "orbit", "magnetic_field"):
+        for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "orbit", "magnetic_field"):
             entry = getattr(self, key)
             try:
                 with _blame(source, f"spacecraft.{key}", entry.argument_keys(f"spacecraft.{key}") if entry else {}):
@@ -252,12 +290,27 @@ class SpacecraftTable(_Table):
                 raise ScenarioError(source, list(exc.problems)) from None
         if parts.pop("wheel_pyramid") is not None:
             parts["wheels"] = actuators.pyramid_wheels(**self.wheel_pyramid.model_dump())
-        inertia = self.inertia if self.inertia is not None else np.diag(self.moments)
+        if self.hub is not None:
+            self._check_wheel_mass_properties(source)
+        inertia = (self.inertia if self.inertia is not None
+                   else np.diag(self.moments) if self.moments is not None else None)
         keys = {"inertia": "spacecraft.inertia" if self.inertia is not None else "spacecraft.moments",
+                "hub": "spacecraft.hub",
                 "control_period": "spacecraft.control_period", "gravity_gradient": "spacecraft.gravity_gradient"}
         with _blame(source, "spacecraft", keys):
             return Spacecraft(inertia=inertia, gravity_gradient=self.gravity_gradient,
                               control_period=self.control_period, **parts)
+
+    def _check_wheel_mass_properties(self, source: str):
+        """With a ``hub``, every wheel needs ``mass``, ``position`` and ``transverse_inertia`` (the rule of
+        :meth:`tumble.spacecraft.ReactionWheel.part`, reported here against each wheel's key)."""
+        tables = ([("spacecraft.wheel_pyramid", self.wheel_pyramid)] if self.wheel_pyramid is not None
+                  else [(f"spacecraft.wheels[{i}]", wheel) for i, wheel in enumerate(self.wheels)])
+        rule = ("missing required key: with a [spacecraft.hub] (the hub without its wheels) every wheel needs "
+                "mass, position and transverse_inertia")
+        problems = [(f"{where}.mass", rule) for where, wheel in tables if wheel.mass is None]
+        if problems:
+            raise ScenarioError(source, problems)
 
 
 class SpacecraftInitial(Initial):
