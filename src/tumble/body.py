@@ -88,14 +88,17 @@ def _check_inertia(value, name: str, *, definite: bool, check_triangle: bool):
     return principal_axes(_as_shape(value, name, (3, 3)), name, definite=definite, check_triangle=check_triangle)
 
 
-def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, check_triangle: bool = True):
+def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, check_triangle: bool = True,
+                   member_note=None):
     """Validate inertia tensors (…, 3, 3) (kg·m², body axes); return them symmetrized, moments, axes.
 
     Rules: finite; symmetric to ``_SYMMETRY_RTOL`` relative to the largest
     |entry| (then symmetrized exactly, ``(I + Iᵀ)/2``); positive definite
     (``definite``) or semi-definite (parts: a thin rod, a point mass); with
     ``check_triangle``, ``I₁ + I₂ ≥ I₃ (1 − _TRIANGLE_RTOL)``. A broken rule
-    raises :class:`ValidationError` naming ``name`` (and the batch index).
+    raises :class:`ValidationError` naming ``name`` (and the batch index);
+    ``member_note(k)``, if given, adds a word on member ``k`` (an index tuple),
+    e.g. its sample time.
     ``moments`` (…, 3) ascend; ``axes`` (…, 3, 3) = R_BP, columns the principal
     axes in body axes, made deterministic: each eigenvector's largest-magnitude
     component is positive, then the third is flipped if needed for det +1.
@@ -107,6 +110,9 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
         k = np.argwhere(bad)[0] if inertia.ndim > 2 else ()
         return name + "".join(f"[{int(i)}]" for i in k), tuple(int(i) for i in k)
 
+    def note(k):
+        return f" ({member_note(k)})" if member_note is not None and k else ""
+
     scale = np.abs(inertia).max(axis=(-2, -1))
     asym = np.abs(inertia - np.swapaxes(inertia, -1, -2)).max(axis=(-2, -1))
     bad = asym > _SYMMETRY_RTOL * scale
@@ -114,7 +120,7 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
         field, k = where(bad)
         raise ValidationError(
             f"{field}: must be symmetric (max |I - I^T| = {asym[k]:.3g} > "
-            f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale[k]:.3g})"
+            f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale[k]:.3g}){note(k)}"
         )
     inertia = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
     moments, axes = np.linalg.eigh(inertia)
@@ -125,14 +131,14 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
         rule = (f"must be positive definite (principal moments {moments[k].tolist()} kg m^2; "
                 f"the smallest must exceed {_DEFINITE_RTOL:g} x the largest)") if definite else (
                 f"must be positive semi-definite (principal moments {moments[k].tolist()} kg m^2)")
-        raise ValidationError(f"{field}: {rule}")
+        raise ValidationError(f"{field}: {rule}{note(k)}")
     bad = m1 + m2 < m3 * (1.0 - _TRIANGLE_RTOL)
     if check_triangle and bad.any():
         field, k = where(bad)
         raise ValidationError(
             f"{field}: principal moments break the triangle inequality "
             f"I1 + I2 >= I3 (1 - {_TRIANGLE_RTOL:g}): {m1[k]:.6g} + {m2[k]:.6g} "
-            f"< {m3[k]:.6g}; pass check_triangle=False to accept such data"
+            f"< {m3[k]:.6g}; pass check_triangle=False to accept such data{note(k)}"
         )
     largest = np.abs(axes).argmax(axis=-2)[..., None, :]
     axes = axes * np.sign(np.take_along_axis(axes, largest, axis=-2))

@@ -21,7 +21,6 @@ calling back into Python.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 
 import numpy as np
@@ -172,9 +171,5 @@ def _check_tensors(t, inertia, check_triangle):
     """The rules of :func:`tumble.body.principal_axes` (symmetric, then symmetrised exactly; positive definite;
     the triangle inequality ``I₁ + I₂ ≥ I₃`` that every mass distribution obeys) at every sample; a broken
     rule is refused naming the sample and its time."""
-    try:
-        return principal_axes(inertia, "inertia", check_triangle=check_triangle)[0]
-    except ValidationError as error:
-        found = re.match(r"inertia\[(\d+)\]", str(error))
-        at = f" (sample at t = {t[int(found.group(1))]} s)" if found else ""
-        raise ValidationError(f"{error}{at}") from None
+    return principal_axes(inertia, "inertia", check_triangle=check_triangle,
+                          member_note=lambda k: f"sample at t = {t[k[0]]} s")[0]
