@@ -24,7 +24,7 @@ from scipy.integrate import solve_ivp
 
 import tumble
 from _timing import best_of
-from tumble import _rigid
+from tumble.kernels import rigid as _rigid
 from tumble.integrate import _fixed, _rk4
 
 MOMENTS = np.array([1.0, 2.0, 3.0])          # kg m², principal axes = body axes

@@ -29,7 +29,8 @@ import numpy as np
 
 import tumble
 from _timing import best_of
-from tumble import _rigid, dynamics
+from tumble import dynamics
+from tumble.kernels import rigid as _rigid
 from tumble.integrate import _fixed, _splitting
 
 MOMENTS = np.array([1.0, 2.0, 3.0])           # kg m², principal axes = body axes

@@ -25,7 +25,8 @@ from numba.core import config
 
 import tumble
 from _timing import best_of
-from tumble import _rigid, attitude, integrate
+from tumble import attitude, integrate
+from tumble.kernels import rigid as _rigid
 from tumble.dynamics import euler_coefficients
 from tumble.integrate import _cuda
 
@@ -94,7 +95,7 @@ def main():
           f"{_cuda.THREADS_PER_BLOCK} threads per block\n")
 
     def gpu_run(coefficients, y0):
-        return _cuda.solve_cuda(coefficients, np.zeros((y0.shape[0], 0)), None, y0, t, DT)[0]
+        return _cuda.solve_cuda(cpu_model(coefficients, np.ones((y0.shape[0], 3))), y0, t, DT)[0]
 
     small, _, small_y0 = batch(2 * _cuda.THREADS_PER_BLOCK)
     gpu_run(small, small_y0)                              # compile the kernel / load it from the cache
@@ -108,7 +109,7 @@ def main():
     n_cpu = min(CPU_BODIES, sizes[-1])
     model = cpu_model(coefficients[:n_cpu], moments[:n_cpu])
     integrate.solve(model, y0[:2], t, method="rk4", dt=DT)    # compile / load from cache
-    seconds, (cpu, _) = wall_seconds(lambda: integrate.solve(model, y0[:n_cpu], t, method="rk4", dt=DT))
+    seconds, cpu = wall_seconds(lambda: integrate.solve(model, y0[:n_cpu], t, method="rk4", dt=DT).states)
     print(f"\n   CPU, tumble rk4 on all {cores} cores, N = {n_cpu:,d}: {n_cpu * steps / seconds:.3g} body-steps/s")
     print(f"   max |GPU - CPU| over those bodies at t = {t[-1]:g} s: {np.abs(gpu[:, :n_cpu] - cpu).max():.2e}")
 

@@ -46,7 +46,7 @@ def random_chain(n: int, seed: int = 0) -> robot.SerialChain:
 
 
 def pinocchio_model(chain: robot.SerialChain):
-    """The same chain as a pinocchio.Model, from its canonical frames (tumble.robot._kernels layout)."""
+    """The same chain as a pinocchio.Model, from its canonical frames (tumble.kernels.featherstone layout)."""
     P = chain.params
     model = pin.Model()
     parent = 0

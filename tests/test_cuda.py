@@ -19,7 +19,8 @@ import pytest
 from numba.core import config
 
 import tumble
-from tumble import _rigid, attitude, integrate, torques
+from tumble import attitude, integrate, torques
+from tumble.kernels import rigid as _rigid
 from tumble._validate import ValidationError
 from tumble.integrate import _cuda
 
@@ -76,14 +77,15 @@ _CHILD = """
 import sys
 import numpy as np
 from tumble.integrate import _cuda
+from tumble.kernels.rigid import RigidModel
 assert _cuda.cuda_available()
 cases = np.load(sys.argv[1])
 out = {}
 for i in range(int(cases["n"])):
     codes = cases[f"codes{i}"] if f"codes{i}" in cases else None
-    out[f"out{i}"], stats = _cuda.solve_cuda(cases[f"coefficients{i}"], cases[f"params{i}"], codes,
-                                             cases[f"y0_{i}"], cases["t"], float(cases["dt"]))
-    out[f"stats{i}"] = [stats["n_steps"], stats["n_rejected"], stats["n_rhs"]]
+    model = RigidModel(cases[f"coefficients{i}"], cases[f"params{i}"], codes, np.ones((1, 3)))
+    out[f"out{i}"], n_steps = _cuda.solve_cuda(model, cases[f"y0_{i}"], cases["t"], float(cases["dt"]))
+    out[f"stats{i}"] = [n_steps, 0, 4 * n_steps]
 np.savez(sys.argv[2], **out)
 """
 
@@ -115,7 +117,8 @@ def runs(tmp_path_factory):
     simulated = _run_simulated(models, y0s, tmp_path_factory.mktemp("cuda"))
     out = {}
     for name, m, y0, gpu in zip(CASES, models, y0s, simulated):
-        out[name] = (y0, integrate.solve(m, y0, T_OUT, method="rk4", dt=DT), gpu)
+        cpu = integrate.solve(m, y0, T_OUT, method="rk4", dt=DT)
+        out[name] = (y0, (cpu.states, cpu.statistics()), gpu)
     return out
 
 
@@ -147,14 +150,14 @@ def test_step_counts(runs, name):
 def test_python_torque_refused():
     model = _rigid.build(_bodies(1, 0), torques.ConstantBody([0, 0, 1]) + torques.PythonTorque(lambda t, q, w: w))
     with pytest.raises(ValidationError, match="torque: a Python function cannot run on the GPU"):
-        _cuda.solve_cuda(model.coefficients, model.params, model.codes, _states(2, 0), T_OUT, DT)
+        _cuda.solve_cuda(model, _states(2, 0), T_OUT, DT)
 
 
 @pytest.mark.skipif(_cuda.cuda_available(), reason="a GPU (or the simulator) is present")
 def test_no_gpu_is_a_clear_error():
     model = _rigid.build(_bodies(1, 0), None)
     with pytest.raises(ValidationError, match="device: 'cuda' needs an NVIDIA GPU"):
-        _cuda.solve_cuda(model.coefficients, model.params, model.codes, _states(2, 0), T_OUT, DT)
+        _cuda.solve_cuda(model, _states(2, 0), T_OUT, DT)
 
 
 def _nvvm_available():
@@ -194,8 +197,8 @@ def test_compiles_for_a_gpu(monkeypatch, torque):
 def test_gpu_equals_cpu():
     model = _rigid.build(_bodies(4, 4), PROGRAM)
     y0 = _states(4, 0)
-    cpu, _ = integrate.solve(model, y0, T_OUT, method="rk4", dt=DT)
-    gpu, _ = _cuda.solve_cuda(model.coefficients, model.params, model.codes, y0, T_OUT, DT)
+    cpu = integrate.solve(model, y0, T_OUT, method="rk4", dt=DT).states
+    gpu, _ = _cuda.solve_cuda(model, y0, T_OUT, DT)
     np.testing.assert_allclose(gpu, cpu, rtol=0, atol=TOL_GPU)
 
 

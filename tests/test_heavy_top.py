@@ -95,7 +95,7 @@ def test_roots_are_zeros_of_f_and_turning_points_of_the_effective_potential(name
 def test_conserved_quantities_from_the_euler_state_equal_those_of_the_simulation_state():
     top = TOPS["general"]
     inputs = top.simulation_inputs(phi0=0.4, psi0=-1.1)
-    inertia, omega0, q0 = inputs["body"], inputs["omega0"], inputs["q0"]
+    inertia, omega0, q0 = inputs["model"], inputs["omega0"], inputs["q0"]
     height = attitude.rotate(q0, [0.0, 0.0, top.length])[2]
     energy = dynamics.kinetic_energy(inertia, omega0) + top.mass * top.g * height
     p_phi = dynamics.angular_momentum_inertial(inertia, omega0, q0)[2]
@@ -115,7 +115,7 @@ def rotated_setup(top, random_rotation):
     inputs = top.simulation_inputs(phi0=0.3, psi0=0.7)
     q_sb, q_nn = attitude.from_matrix(r_body), attitude.from_matrix(r_inertial)
     return {
-        "body": r_body.T @ inputs["body"] @ r_body,
+        "body": r_body.T @ inputs["model"] @ r_body,
         "com": r_body.T @ [0.0, 0.0, top.length],
         "g": r_inertial @ [0.0, 0.0, -top.g],
         "omega0": r_body.T @ inputs["omega0"],

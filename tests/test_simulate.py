@@ -7,6 +7,7 @@ import tumble
 from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError
 from tumble.integrate import SolverError, _fixed
+from helpers import read_by
 
 EPS = np.finfo(np.float64).eps
 
@@ -93,8 +94,8 @@ def test_torque_free_motion_conserves_energy_and_momentum(inertia):
 def test_sphere_keeps_its_rate_and_turns_uniformly(method):
     # I = k E: ω̇ = 0, so ω is constant and R(t) = R₀ Rot(ω̂, |ω| t).
     t = np.linspace(0.0, 50.0, 51)
-    traj = tumble.simulate(tumble.RigidBody(2.0 * np.eye(3)), OMEGA0, q0=Q0, t=t, method=method, dt=1e-2,
-                           rtol=1e-12, atol=1e-12)
+    traj = tumble.simulate(tumble.RigidBody(2.0 * np.eye(3)), OMEGA0, q0=Q0, t=t,
+                           **read_by(method, dt=1e-2, rtol=1e-12, atol=1e-12))
     assert np.abs(traj.omega - OMEGA0).max() <= TOL_SPHERE_RATE
     if method == "dop853":
         rate = np.linalg.norm(OMEGA0)
@@ -237,7 +238,7 @@ def test_batch_equals_single_runs(method, torque, random_batch):
     n = 5
     inertia, omega0, q0 = random_batch(n)
     torque = BATCH_TORQUES[torque]
-    kwargs = dict(t=np.linspace(0.0, 3.0, 7), method=method, dt=1e-2, rtol=1e-10, atol=1e-12, torque=torque)
+    kwargs = dict(t=np.linspace(0.0, 3.0, 7), **read_by(method, dt=1e-2, rtol=1e-10, atol=1e-12), torque=torque)
     batch = tumble.simulate(inertia, omega0, q0=q0, **kwargs)
     assert batch.q.shape == (7, n, 4) and batch.omega.shape == (7, n, 3) and batch.inertia.shape == (n, 3, 3)
     for k in range(n):
@@ -264,7 +265,7 @@ def test_rk4_batch_across_blocks_equals_single_runs(torque, extra, random_batch)
 def test_batch_of_one_body_broadcasts_omega0_or_q0(method, random_batch):
     n = 5
     _, omega0, q0 = random_batch(n)
-    kwargs = dict(t=np.linspace(0.0, 3.0, 4), method=method, dt=1e-2, torque=torques.ConstantInertial(TAU))
+    kwargs = dict(t=np.linspace(0.0, 3.0, 4), **read_by(method, dt=1e-2), torque=torques.ConstantInertial(TAU))
     body = tumble.RigidBody(FULL)
     by_rate = tumble.simulate(body, omega0, q0=Q0, **kwargs)
     by_attitude = tumble.simulate([body] * n, OMEGA0, q0=q0, **kwargs)
@@ -310,14 +311,14 @@ def test_run_starts_at_the_first_output_time(method):
     # quadratic in t, which both methods integrate exactly.
     t = np.linspace(5.0, 8.0, 7)
     ramp = torques.Tabulated([0.0, 100.0], [[0.0, 0.0, 0.0], [0.0, 0.0, 30.0]])
-    traj = tumble.simulate(tumble.RigidBody(DIAG), [0.0, 0.0, 0.7], t=t, method=method, dt=0.1, rtol=1e-12,
-                           atol=1e-12, torque=ramp)
+    traj = tumble.simulate(tumble.RigidBody(DIAG), [0.0, 0.0, 0.7], t=t, **read_by(method, dt=0.1, rtol=1e-12,
+                           atol=1e-12), torque=ramp)
     np.testing.assert_allclose(traj.omega[:, 2], 0.7 + 0.3 * (t**2 - 25.0) / 6.0, rtol=0, atol=TOL_POLYNOMIAL_RATE)
 
 
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
 def test_single_output_time_returns_the_initial_state(method):
-    traj = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, q0=3.0 * Q0, t=[2.0], method=method, dt=0.1)
+    traj = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, q0=3.0 * Q0, t=[2.0], **read_by(method, dt=0.1))
     np.testing.assert_array_equal(traj.t, [2.0])
     np.testing.assert_allclose(traj.q, [Q0], rtol=0, atol=TOL_ROUNDTRIP)
     np.testing.assert_allclose(traj.omega, [OMEGA0], rtol=0, atol=TOL_ROUNDTRIP)
@@ -327,7 +328,7 @@ def test_single_output_time_returns_the_initial_state(method):
 def test_progress_reports_and_does_not_change_the_result(method):
     calls = []
     t = np.linspace(0.0, 10.0, 201)
-    kwargs = dict(q0=Q0, t=t, method=method, dt=1e-2, rtol=1e-12, atol=1e-12)
+    kwargs = dict(q0=Q0, t=t, **read_by(method, dt=1e-2, rtol=1e-12, atol=1e-12))
     quiet = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, **kwargs)
     loud = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, progress=lambda done, total: calls.append((done, total)),
                            **kwargs)
@@ -413,23 +414,11 @@ def test_exhausted_max_steps_is_a_solver_error():
 
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
 def test_quaternion_stays_unit(method):
-    traj = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, q0=Q0, t=np.linspace(0.0, 20.0, 2001), method=method,
-                           dt=1e-2, rtol=1e-8, atol=1e-8, torque=torques.ConstantInertial(TAU))
+    traj = tumble.simulate(tumble.RigidBody(FULL), OMEGA0, q0=Q0, t=np.linspace(0.0, 20.0, 2001),
+                           **read_by(method, dt=1e-2, rtol=1e-8, atol=1e-8), torque=torques.ConstantInertial(TAU))
     assert np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0).max() <= TOL_UNIT
 
 
-def test_models_of_the_extension_packages_are_sent_to_their_own_simulate():
-    import importlib
-
-    from tumble.variable import Human
-
-    simulate_module = importlib.import_module("tumble.simulate")  # the module (tumble.simulate is the function)
-    for qualified, advice in simulate_module._OWN_SIMULATE.items():
-        module, name = qualified.rsplit(".", 1)
-        cls = getattr(importlib.import_module(module), name)  # the table names real classes
-        assert f"{cls.__module__}.{cls.__qualname__}" == qualified
-        entry = advice.rsplit(" ", 1)[-1]
-        package, function = entry.rsplit(".", 1)
-        assert callable(getattr(importlib.import_module(package), function))  # and real entry points
-    with pytest.raises(ValidationError, match=r"body: a Human is not a rigid body; .*simulate_variable"):
-        tumble.simulate(Human.de_leva(), [0.0, 0.0, 1.0], t=[0.0, 1.0])
+def test_an_object_that_is_not_a_model_is_refused_naming_its_type():
+    with pytest.raises(ValidationError, match=r"^model: must be a tumble model .* got dict"):
+        tumble.simulate({"inertia": DIAG}, [0.0, 0.0, 1.0], t=[0.0, 1.0])

@@ -6,6 +6,7 @@ import pytest
 import tumble
 from tumble import attitude, torques
 from tumble._validate import ValidationError
+from helpers import read_by
 
 EPS = np.finfo(np.float64).eps
 # Hand values: exact binary fractions and cos/sin 45°, through one quaternion
@@ -167,8 +168,8 @@ def test_constant_body_torque_about_a_principal_spin_axis_is_exact(axis, method)
     omega0, torque = np.zeros(3), np.zeros(3)
     omega0[axis], torque[axis] = w0, tau
     t = np.linspace(0.0, 10.0, 11)
-    traj = tumble.simulate(tumble.RigidBody(DIAG), omega0, t=t, method=method, dt=5e-3, rtol=1e-12,
-                           atol=1e-12, torque=torques.ConstantBody(torque))
+    traj = tumble.simulate(tumble.RigidBody(DIAG), omega0, t=t, **read_by(method, dt=5e-3, rtol=1e-12,
+                           atol=1e-12), torque=torques.ConstantBody(torque))
     expected = np.zeros((t.size, 3))
     expected[:, axis] = w0 + tau / moments[axis] * t
     assert np.abs(traj.omega - expected).max() / np.abs(expected).max() <= TOL_LINEAR_RATE
@@ -187,7 +188,7 @@ def test_python_callable_equals_the_compiled_model(method):
     # The callable computes τ_B = R(q)ᵀ τ_N with R the rotation of q/|q| (attitude.rotate_inverse),
     # as the compiled model does also at Runge–Kutta stages, where |q| = 1 + O(h²).
     t = np.linspace(0.0, 5.0, 6)
-    kwargs = dict(q0=Q0, t=t, method=method, dt=1e-2, rtol=1e-12, atol=1e-12)
+    kwargs = dict(q0=Q0, t=t, **read_by(method, dt=1e-2, rtol=1e-12, atol=1e-12))
     body = tumble.RigidBody(FULL)
     compiled = tumble.simulate(body, OMEGA0, torque=torques.ConstantInertial(TAU), **kwargs)
     python = tumble.simulate(body, OMEGA0, torque=lambda t, q, omega: attitude.rotate_inverse(q, TAU), **kwargs)
@@ -278,7 +279,7 @@ def test_tabulated_equals_the_same_interpolation_in_python(method, interpolation
     t_table = np.sort(rng.uniform(0.5, 2.5, 9))
     tau_table = rng.standard_normal((9, 3))
     t = np.union1d(np.linspace(0.0, 3.0, 7), t_table)
-    kwargs = dict(q0=Q0, t=t, method=method, dt=1e-2, rtol=1e-12, atol=1e-12)
+    kwargs = dict(q0=Q0, t=t, **read_by(method, dt=1e-2, rtol=1e-12, atol=1e-12))
     body = tumble.RigidBody(FULL)
     table = torques.Tabulated(t_table, tau_table, frame=frame, interpolation=interpolation)
     compiled = tumble.simulate(body, OMEGA0, torque=table, **kwargs)

@@ -49,7 +49,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from tumble import _elliptic, _quat
 
@@ -363,39 +363,3 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     )
     _, _, _, pw, px, py, pz, bracket0 = _frame(mo, mo.tau0)
     return _Motion(*mo[:-2], bracket0, _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))
-
-
-# Output times per task of the parallel loop: one task sets a body up (about a
-# microsecond) and evaluates up to this many times, so that a single body with
-# many times also runs on every core.
-# Output times per task of the parallel loop: one task sets a body up (about a
-# microsecond) and evaluates up to this many times, so that a single body with
-# many times also runs on every core.
-_CHUNK = 512
-
-
-@njit(cache=True)
-def exact_task(moments, y, t, out, task):
-    """One task of :func:`exact_batch`: body ``task // n_chunks``, output times of chunk ``task % n_chunks``."""
-    n_chunks = (t.shape[0] + _CHUNK - 1) // _CHUNK
-    b, chunk = task // n_chunks, task % n_chunks
-    r = 0 if moments.shape[0] == 1 else b
-    mo = _setup(moments[r, 0], moments[r, 1], moments[r, 2],
-                y[b, 4], y[b, 5], y[b, 6], y[b, 0], y[b, 1], y[b, 2], y[b, 3])
-    for i in range(chunk * _CHUNK, min(t.shape[0], (chunk + 1) * _CHUNK)):
-        w1, w2, w3, qw, qx, qy, qz = _evaluate(mo, t[i] - t[0])
-        out[i, b, 0], out[i, b, 1], out[i, b, 2], out[i, b, 3] = qw, qx, qy, qz
-        out[i, b, 4], out[i, b, 5], out[i, b, 6] = w1, w2, w3
-
-
-@njit(cache=True, parallel=True)
-def exact_batch(moments, y, t, out):
-    """``out[i, b] = [q_NP, ω_P]`` at ``t[i]`` for each body ``b`` from ``y[b] = [q_NP, ω_P]`` at ``t[0]``.
-
-    Principal axes throughout (the state layout of :class:`tumble._rigid.RigidModel`);
-    ``moments`` has one row per body, or one shared row. Tasks (a body and a
-    chunk of its output times) run in parallel over the cores.
-    """
-    n_chunks = (t.shape[0] + _CHUNK - 1) // _CHUNK
-    for task in prange(y.shape[0] * n_chunks):
-        exact_task(moments, y, t, out, task)

@@ -23,44 +23,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tumble import _quat
+from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes
 from tumble._validate import ValidationError, as_array, require_positive
+from tumble.rigid import RigidMotion
 
 __all__ = ["RigidBody", "Part"]
-
-# Inertia symmetric when max |I − Iᵀ| ≤ _SYMMETRY_RTOL · max |I|.
-_SYMMETRY_RTOL = 1e-12
-# Positive definite when the smallest principal moment > _DEFINITE_RTOL × the
-# largest: below that a moment is indistinguishable from zero at the float64
-# rounding of the eigen-decomposition (~1e-16 × the largest moment).
-_DEFINITE_RTOL = 1e-14
-# Triangle inequality I₁ + I₂ ≥ I₃ (1 − _TRIANGLE_RTOL) on the moments.
-_TRIANGLE_RTOL = 1e-9
-# A rotation matrix must satisfy max |RᵀR − E| ≤ _ROTATION_TOL; a quaternion
-# must satisfy | |q| − 1 | ≤ _ROTATION_TOL.
-_ROTATION_TOL = 1e-10
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 
 
-def _frozen(arr: np.ndarray) -> np.ndarray:
-    """A read-only float64 copy of ``arr``."""
-    arr = np.array(arr, dtype=np.float64)
-    arr.flags.writeable = False
-    return arr
-
-
-def _as_shape(value, name: str, shape: tuple[int, ...]) -> np.ndarray:
-    """``value`` as a finite float64 array of exactly ``shape``."""
-    arr = as_array(value, name, tail=shape)
-    if arr.shape != shape:
-        raise ValidationError(f"{name}: must have shape {shape}, got {arr.shape}")
-    return arr
-
-
 def _positive_vector(value, name: str) -> np.ndarray:
     """``value`` as a (3,) array whose entries are all > 0."""
-    arr = _as_shape(value, name, (3,))
+    arr = as_shape(value, name, (3,))
     if (arr <= 0.0).any():
         raise ValidationError(f"{name}: each entry must be > 0, got {arr.tolist()}")
     return arr
@@ -80,111 +54,6 @@ def _axisymmetric(axial: float, transverse: float, axis: str) -> np.ndarray:
     return np.diag(moments)
 
 
-def _check_inertia(value, name: str, *, definite: bool, check_triangle: bool):
-    """Validate an inertia tensor of shape (3, 3); return it symmetrized, its moments (ascending) and axes.
-
-    The rules are those of :func:`principal_axes`.
-    """
-    return principal_axes(_as_shape(value, name, (3, 3)), name, definite=definite, check_triangle=check_triangle)
-
-
-def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, check_triangle: bool = True,
-                   member_note=None):
-    """Validate inertia tensors (…, 3, 3) (kg·m², body axes); return them symmetrized, moments, axes.
-
-    Rules: finite; symmetric to ``_SYMMETRY_RTOL`` relative to the largest
-    |entry| (then symmetrized exactly, ``(I + Iᵀ)/2``); positive definite
-    (``definite``) or semi-definite (parts: a thin rod, a point mass); with
-    ``check_triangle``, ``I₁ + I₂ ≥ I₃ (1 − _TRIANGLE_RTOL)``. A broken rule
-    raises :class:`ValidationError` naming ``name`` (and the batch index);
-    ``member_note(k)``, if given, adds a word on member ``k`` (an index tuple),
-    e.g. its sample time.
-    ``moments`` (…, 3) ascend; ``axes`` (…, 3, 3) = R_BP, columns the principal
-    axes in body axes, made deterministic: each eigenvector's largest-magnitude
-    component is positive, then the third is flipped if needed for det +1.
-    Batched, so that a batch of N bodies is validated in one call.
-    """
-    inertia = as_array(inertia, name, tail=(3, 3))
-
-    def where(bad):
-        k = np.argwhere(bad)[0] if inertia.ndim > 2 else ()
-        return name + "".join(f"[{int(i)}]" for i in k), tuple(int(i) for i in k)
-
-    def note(k):
-        return f" ({member_note(k)})" if member_note is not None and k else ""
-
-    scale = np.abs(inertia).max(axis=(-2, -1))
-    asym = np.abs(inertia - np.swapaxes(inertia, -1, -2)).max(axis=(-2, -1))
-    bad = asym > _SYMMETRY_RTOL * scale
-    if bad.any():
-        field, k = where(bad)
-        raise ValidationError(
-            f"{field}: must be symmetric (max |I - I^T| = {asym[k]:.3g} > "
-            f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale[k]:.3g}){note(k)}"
-        )
-    inertia = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
-    moments, axes = np.linalg.eigh(inertia)
-    m1, m2, m3 = moments[..., 0], moments[..., 1], moments[..., 2]
-    bad = ~(m1 > _DEFINITE_RTOL * m3) if definite else m1 < -_DEFINITE_RTOL * m3
-    if bad.any():
-        field, k = where(bad)
-        rule = (f"must be positive definite (principal moments {moments[k].tolist()} kg m^2; "
-                f"the smallest must exceed {_DEFINITE_RTOL:g} x the largest)") if definite else (
-                f"must be positive semi-definite (principal moments {moments[k].tolist()} kg m^2)")
-        raise ValidationError(f"{field}: {rule}{note(k)}")
-    bad = m1 + m2 < m3 * (1.0 - _TRIANGLE_RTOL)
-    if check_triangle and bad.any():
-        field, k = where(bad)
-        raise ValidationError(
-            f"{field}: principal moments break the triangle inequality "
-            f"I1 + I2 >= I3 (1 - {_TRIANGLE_RTOL:g}): {m1[k]:.6g} + {m2[k]:.6g} "
-            f"< {m3[k]:.6g}; pass check_triangle=False to accept such data{note(k)}"
-        )
-    largest = np.abs(axes).argmax(axis=-2)[..., None, :]
-    axes = axes * np.sign(np.take_along_axis(axes, largest, axis=-2))
-    axes[..., :, 2] *= np.sign(np.linalg.det(axes))[..., None]
-    return inertia, moments, axes
-
-
-def _as_rotation(rotation, name: str) -> np.ndarray:
-    """A 3×3 proper rotation from ``None`` (identity), a matrix or a unit quaternion [w, x, y, z]."""
-    if rotation is None:
-        return np.eye(3)
-    r = as_array(rotation, name)
-    if r.shape == (4,):
-        norm = float(np.linalg.norm(r))
-        if abs(norm - 1.0) > _ROTATION_TOL:
-            raise ValidationError(
-                f"{name}: a quaternion [w, x, y, z] must have unit norm "
-                f"(|q| = {norm!r}, tolerance {_ROTATION_TOL:g})"
-            )
-        matrix = np.empty((3, 3))
-        _quat.qto_matrix(*r.tolist(), matrix)
-        return matrix
-    if r.shape == (3, 3):
-        err = np.abs(r.T @ r - np.eye(3)).max()
-        if err > _ROTATION_TOL:
-            raise ValidationError(
-                f"{name}: must be orthonormal (max |R^T R - E| = {err:.3g} > {_ROTATION_TOL:g})"
-            )
-        if np.linalg.det(r) < 0.0:
-            raise ValidationError(f"{name}: must be a proper rotation (det R = -1 is a reflection)")
-        return r
-    raise ValidationError(
-        f"{name}: must be a 3x3 rotation matrix or a unit quaternion [w, x, y, z], got shape {r.shape}"
-    )
-
-
-def _parallel_axis(masses, offsets) -> np.ndarray:
-    """Inertia of point masses about the origin: ``Σₖ mₖ (|dₖ|² E − dₖ dₖᵀ)`` (kg·m²).
-
-    ``masses`` (kg) of shape () or (n,), ``offsets`` ``dₖ`` (m) of shape (3,) or (n, 3).
-    """
-    masses = np.atleast_1d(masses)
-    offsets = np.atleast_2d(offsets)
-    return (masses @ (offsets * offsets).sum(axis=1)) * np.eye(3) - (masses[:, None] * offsets).T @ offsets
-
-
 @dataclass(frozen=True, slots=True, eq=False, kw_only=True)
 class Part:
     """A mass element expressed in its parent's axes, ready to be summed by :meth:`RigidBody.composite`.
@@ -202,9 +71,9 @@ class Part:
 
     def __post_init__(self):
         object.__setattr__(self, "mass", require_positive(self.mass, "mass"))
-        inertia, _, _ = _check_inertia(self.inertia, "inertia", definite=False, check_triangle=False)
-        object.__setattr__(self, "com", _frozen(_as_shape(self.com, "com", (3,))))
-        object.__setattr__(self, "inertia", _frozen(inertia))
+        inertia, _, _ = check_inertia(self.inertia, "inertia", definite=False, check_triangle=False)
+        object.__setattr__(self, "com", frozen(as_shape(self.com, "com", (3,))))
+        object.__setattr__(self, "inertia", frozen(inertia))
 
     def placed(self, position=(0.0, 0.0, 0.0), *, rotation=None) -> Part:
         """This part placed in a new parent: ``com' = p + R com``, ``inertia' = R inertia Rᵀ``.
@@ -214,12 +83,12 @@ class Part:
         (``v_parent = R v_part``): a 3×3 matrix, a unit quaternion
         ``[w, x, y, z]``, or ``None`` for the identity.
         """
-        p = _as_shape(position, "position", (3,))
-        r = _as_rotation(rotation, "rotation")
+        p = as_shape(position, "position", (3,))
+        r = as_rotation(rotation, "rotation")
         return Part(mass=self.mass, com=p + r @ self.com, inertia=r @ self.inertia @ r.T)
 
 
-class RigidBody:
+class RigidBody(RigidMotion):
     """Immutable, validated mass properties of a rigid body.
 
     ``RigidBody(inertia, *, mass=None, com=None, check_triangle=True, name=None)``
@@ -242,13 +111,13 @@ class RigidBody:
     __slots__ = ("_inertia", "_moments", "_axes", "_mass", "_com", "_check_triangle", "_name")
 
     def __init__(self, inertia, *, mass=None, com=None, check_triangle: bool = True, name: str | None = None):
-        inertia, moments, axes = _check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)
+        inertia, moments, axes = check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)
         set_ = object.__setattr__
-        set_(self, "_inertia", _frozen(inertia))
-        set_(self, "_moments", _frozen(moments))
-        set_(self, "_axes", _frozen(axes))
+        set_(self, "_inertia", frozen(inertia))
+        set_(self, "_moments", frozen(moments))
+        set_(self, "_axes", frozen(axes))
         set_(self, "_mass", None if mass is None else require_positive(mass, "mass"))
-        set_(self, "_com", None if com is None else _frozen(_as_shape(com, "com", (3,))))
+        set_(self, "_com", None if com is None else frozen(as_shape(com, "com", (3,))))
         set_(self, "_check_triangle", bool(check_triangle))
         set_(self, "_name", name)
 
@@ -323,7 +192,7 @@ class RigidBody:
         so ``I_new = Rᵀ I_old R`` and ``com_new = Rᵀ com_old``. ``rotation``
         is a 3×3 proper rotation matrix or a unit quaternion ``[w, x, y, z]``.
         """
-        r = _as_rotation(rotation, "rotation")
+        r = as_rotation(rotation, "rotation")
         com = None if self._com is None else r.T @ self._com
         return RigidBody(
             r.T @ self._inertia @ r, mass=self._mass, com=com, check_triangle=self._check_triangle, name=self._name
@@ -339,8 +208,8 @@ class RigidBody:
             raise ValidationError(
                 f"inertia_about: needs the body's mass and com (mass={self._mass}, com={self._com})"
             )
-        point = _as_shape(point, "point", (3,))
-        return self._inertia + _parallel_axis(self._mass, self._com - point)
+        point = as_shape(point, "point", (3,))
+        return self._inertia + parallel_axis(self._mass, self._com - point)
 
     # -- composites ---------------------------------------------------------
 
@@ -382,7 +251,7 @@ class RigidBody:
         coms = np.array([p.com for p in parts])
         mass = masses.sum()
         com = masses @ coms / mass
-        inertia = sum(p.inertia for p in parts) + _parallel_axis(masses, coms - com)
+        inertia = sum(p.inertia for p in parts) + parallel_axis(masses, coms - com)
         return cls(inertia, mass=mass, com=com, check_triangle=check_triangle, name=name)
 
     # -- shapes ---------------------------------------------------------------
@@ -420,7 +289,7 @@ class RigidBody:
         """
         m, L = require_positive(mass, "mass"), require_positive(length, "length")
         r2 = require_positive(outer_radius, "outer_radius")
-        r1 = float(_as_shape(inner_radius, "inner_radius", ()))
+        r1 = float(as_shape(inner_radius, "inner_radius", ()))
         if not 0.0 <= r1 <= r2:
             raise ValidationError(f"inner_radius: must satisfy 0 <= inner_radius <= outer_radius = {r2}, got {r1}")
         s = r1 * r1 + r2 * r2
@@ -477,7 +346,7 @@ class RigidBody:
             raise ValidationError(f"masses: each must be > 0, got {masses.tolist()}")
         mass = masses.sum()
         com = masses @ positions / mass
-        return cls(_parallel_axis(masses, positions - com), mass=mass, com=com, check_triangle=check_triangle)
+        return cls(parallel_axis(masses, positions - com), mass=mass, com=com, check_triangle=check_triangle)
 
     @classmethod
     def t_handle(
@@ -516,6 +385,17 @@ class RigidBody:
 
     def __delattr__(self, name):
         raise AttributeError(f"RigidBody is immutable: cannot delete {name!r}")
+
+    # -- the model interface (tumble.rigid.RigidMotion) -----------------------
+
+    def _principal(self):
+        return self._moments[None], self._axes[None]
+
+    def _reported_inertia(self):
+        return self._inertia
+
+    def _masses(self):
+        return self._mass
 
     def __reduce__(self):
         return (_rebuild, (self._inertia, self._mass, self._com, self._check_triangle, self._name))

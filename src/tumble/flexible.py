@@ -54,10 +54,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tumble import _flexible, attitude, integrate, torques
+from tumble import attitude, integrate, torques
+from tumble.kernels import flexible as _flexible
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
-from tumble.simulate import _output_times
+from tumble._validate import output_times as _output_times
 from tumble.simulate import simulate as simulate_rigid
 from tumble.trajectory import Extra, Trajectory, write_atomic
 
@@ -157,7 +158,7 @@ class FlexibleBody:
         return np.sqrt(eigh(np.diag(self.frequencies**2), modal_mass, eigvals_only=True))
 
     def model(self, torque=None) -> _flexible.FlexibleModel:
-        """The compiled model (:class:`tumble._flexible.FlexibleModel`) under a torque model (body axes)."""
+        """The compiled model (:class:`tumble.kernels.flexible.FlexibleModel`) under a torque model (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         w = self.frequencies
         return _flexible.FlexibleModel(
@@ -206,9 +207,8 @@ def integrate_model(model, y0, times, *, method, rtol, atol, dt, max_steps, torq
     if np.any(np.linalg.norm(q0, axis=-1) == 0.0):
         raise ValidationError("q0: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
     y0[:, :4] = attitude.normalize(q0)
-    with torques.registered(torque):
-        states, stats = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
-                                        max_steps=max_steps, serial=torque is not None and torque.needs_python)
+    solution = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+    states, stats = solution.states, solution.statistics()
     info = {"torque": repr(torque) if torque is not None else "none", **stats}
     info.update(dict(rtol=float(rtol), atol=float(atol)) if m.adaptive else dict(dt=float(dt)))
     return states, info

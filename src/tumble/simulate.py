@@ -1,198 +1,315 @@
-"""``simulate``: integrate Euler's equations and the attitude of one body or a batch.
+"""The front door: ``simulate(model, ...)`` runs every model, and :class:`Model` is what a model implements.
 
-The integrators work in each body's principal axes, where Euler's equations
-are cheapest (``I₁ω̇₁ = τ₁ + (I₂ − I₃)ω₂ω₃`` and cyclic). ``simulate`` moves
-the initial state into those axes and the results back::
+One function integrates every model of the package: a rigid body (or a batch
+of them), a hub with flexible appendages, a sloshing hub, a body whose inertia
+changes, a spacecraft with actuators and controllers, a robot arm, a
+gyroscope. Everything common to them is written here once, as
+``scipy.integrate``'s ``check_arguments`` is: the output times, the solver
+options (refused when the method does not read them), the initial state by
+name (unknown names refused, quaternions checked and normalised, batches
+broadcast), which method applies to which model (:func:`tumble.integrate.check_method`),
+progress reporting, the device, and the one result type :class:`~tumble.Trajectory`.
 
-    q_NP = q_NB ⊗ q_BP,   ω_P = R_BPᵀ ω_B        (in)
-    q_NB = q_NP ⊗ q_BP*,  ω_B = R_BP ω_P         (out)
+A model is an immutable, validated description (MuJoCo's ``MjModel``,
+Pinocchio's ``Model``) that implements :class:`Model` once:
 
-with ``R_BP = body.axes`` (columns: the principal axes in body axes). The
-change of axes is exact for a diagonal inertia and costs a few rounding errors
-otherwise; the motion does not depend on the body axes chosen (tested).
+* :meth:`Model.state_fields`: the named parts of its initial state (the
+  keywords of :func:`simulate`, e.g. ``omega0``, ``q0``, ``wheel_speeds0``);
+* :meth:`Model.compile`: its compiled kernel (:mod:`tumble.kernels`) under a
+  torque, which says which methods it provides for (``provides``);
+* :meth:`Model.initial_states`: the state vectors from the named values;
+* :meth:`Model.outputs`: the :class:`~tumble.Trajectory` fields from the
+  integrated states (attitude, body rate, named extras, the system's totals);
+* :meth:`Model.invariants`: what its exact motion keeps constant on a run.
+
+Sweeps, the viewer, scenario files and the command line work on any model
+through this interface.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import abc
+import difflib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from tumble import _rigid, attitude, integrate, limits, torques
-from tumble._validate import ValidationError, as_array
-from tumble.body import RigidBody, principal_axes
-from tumble.trajectory import Trajectory
+from tumble import _callback, attitude, integrate
+from tumble._validate import ValidationError, as_array, output_times
+from tumble.trajectory import Extra, Trajectory
 
-__all__ = ["simulate"]
+__all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
+
+#: Solver options when not given (those the method reads).
+DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": 10**9}
+
+
+@dataclass(frozen=True)
+class StateField:
+    """One named part of a model's initial state: a keyword of :func:`simulate`.
+
+    name        : the keyword, e.g. ``"omega0"``
+    size        : number of components; a value has shape (size,) or (N, size) (a batch)
+    description : what it is, with units and frame (used in messages and the docs)
+    default     : array_like, a function of the values of the fields before it
+                  (``dict`` name → (N, size) array) returning one, or None for a required field
+    quaternion  : a unit quaternion ``[w, x, y, z]``: refused when zero, normalised here
+    """
+
+    name: str
+    size: int
+    description: str
+    default: Any = None
+    quaternion: bool = False
+
+
+class Outputs(NamedTuple):
+    """What a model makes of its integrated states (see :meth:`Model.outputs`); every sampled array has
+    the leading axes (time, member) of the states, which :func:`simulate` removes for a single run.
+
+    q, omega : (n, N, 4), (n, N, 3) attitude (body → inertial) and body rate (rad/s, body axes), or None
+    inertia  : (3, 3) or (N, 3, 3), kg·m², body axes, or None
+    extras   : name → :class:`~tumble.trajectory.Extra` with data (n, N, ...)
+    totals   : ``"energy"`` (n, N) J and ``"momentum_body"`` (n, N, 3) N·m·s of the whole system
+    info     : model entries for ``Trajectory.info``
+    """
+
+    q: np.ndarray | None
+    omega: np.ndarray | None
+    inertia: np.ndarray | None
+    extras: dict
+    totals: dict
+    info: dict
+
+
+class Model(abc.ABC):
+    """The interface every model implements once (see the module docstring).
+
+    Class attribute ``torque``: what the ``torque=`` argument of :func:`simulate`
+    means for this model (in words, with units and frame), or ``None`` when the
+    model takes none.
+    """
+
+    __slots__ = ()
+
+    torque: str | None = "external torque on the body, body axes (N·m): a tumble.torques model or f(t, q, omega)"
+
+    @property
+    def batch_size(self) -> int | None:
+        """Members of a batch carried by the model itself (one inertia per body), or None."""
+        return None
+
+    @abc.abstractmethod
+    def state_fields(self) -> tuple[StateField, ...]:
+        """The named parts of the initial state, in the order their defaults may depend on."""
+
+    @abc.abstractmethod
+    def compile(self, torque, t0: float):
+        """The compiled kernel (a NamedTuple of :mod:`tumble.kernels`) under ``torque`` (None: none), clock at ``t0`` (s).
+
+        The kernel's ``provides`` says which methods apply; its ``calls_python``
+        whether the run must stay on one core.
+        """
+
+    @abc.abstractmethod
+    def initial_states(self, kernel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
+        """The state vectors (N, n) from the validated initial values (name → (N, size))."""
+
+    @abc.abstractmethod
+    def outputs(self, kernel, t: np.ndarray, states: np.ndarray) -> Outputs:
+        """The trajectory's fields from the states (len(t), N, n) at the output times ``t`` (s)."""
+
+    def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:  # noqa: B027
+        """Refuse a run this model cannot make (e.g. output times outside its data); nothing by default."""
+
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
+        """What the exact motion keeps constant on the run ``traj`` (name → samples (n, [N,] ...)).
+
+        By default: the total energy and the inertial angular momentum of the
+        system when the run had no torque. Models with internal work or
+        dissipation say what remains.
+        """
+        if traj.info.get("torque") != "none":
+            return {}
+        return {"energy": traj.energy, "momentum_inertial": traj.momentum_inertial}
+
+
+def as_model(model) -> Model:
+    """``model`` itself when it is a :class:`Model`; a rigid body, a sequence of them or an inertia array
+    (3, 3) or (N, 3, 3) (kg·m², body axes) as the rigid-body model."""
+    if isinstance(model, Model):
+        return model
+    from tumble.rigid import RigidBodies  # the rigid model builds on this module
+
+    return RigidBodies.of(model)
 
 
 def simulate(
-    body,
-    omega0,
+    model,
+    omega0=None,
     *,
     t,
-    q0=None,
     method: str = "dop853",
-    rtol: float = 1e-10,
-    atol: float = 1e-12,
     dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
     torque=None,
-    max_steps: int = 10**9,
     progress: Callable[[int, int], None] | None = None,
     device: str = "cpu",
+    **initial_state,
 ) -> Trajectory:
-    """Integrate the rotation of a rigid body (or a batch of bodies) through the times ``t``.
+    """Integrate any model through the output times ``t``: the one front door.
 
-    Solves Euler's equations ``I ω̇ + ω × (I ω) = τ`` (body axes) together with
-    the attitude kinematics ``q̇ = ½ q ⊗ [0, ω]``.
+    For a rigid body it solves Euler's equations ``I ω̇ + ω × (I ω) = τ``
+    (body axes) with the attitude kinematics ``q̇ = ½ q ⊗ [0, ω]``; every
+    other model adds its own states (see its class).
 
     Parameters
     ----------
-    body : RigidBody, (3, 3) or (N, 3, 3) inertia array (kg·m², body axes), or a sequence of RigidBody
-        The body, or one body per batch member.
-    omega0 : (3,) or (N, 3) array_like
-        Initial body rate, rad/s, in body axes. A leading axis of length N
-        integrates N bodies at once, in parallel over the cores.
+    model : Model, RigidBody, a sequence of RigidBody, or an inertia array (3, 3) or (N, 3, 3)
+        What to simulate (kg·m², body axes for an inertia array).
+    omega0 : (3,) or (N, 3) array_like, optional
+        Initial body rate, rad/s, body axes (the models with an attitude): the
+        same as ``omega0=...``.
     t : (n,) array_like
         Output times, s, strictly increasing; ``t[0]`` is the start.
-    q0 : (4,) or (N, 4) array_like, optional
-        Initial attitude, unit quaternion ``[w, x, y, z]`` mapping body →
-        inertial axes (normalised here; default: identity).
     method : str, one of ``tumble.integrate.METHODS``
-        ``"dop853"``: adaptive 8th-order Dormand–Prince (``rtol``, ``atol``);
-        ``"rk4"``, ``"cf4"`` (Lie group), ``"splitting2"``/``"splitting4"``
-        (Lie–Poisson, torque-free), ``"exact_split2"``/``"exact_split4"``
-        (exact free flow + torque kicks): fixed step ``dt`` (s); ``"exact"``:
-        the closed-form torque-free motion (no step). See
-        :mod:`tumble.integrate` and ``docs/integrators.md``.
-    torque : TorqueModel, callable ``f(t, q, omega) -> (3,)``, or None
-        External torque in body axes (N·m); see :mod:`tumble.torques`. Python
-        callables run at Python speed and on one core.
-    max_steps : int
-        Adaptive steps allowed per body before :class:`~tumble.integrate.SolverError`.
+        ``"dop853"`` (default): adaptive 8th-order Dormand–Prince (``rtol``,
+        default 1e-10; ``atol``, default 1e-12; ``max_steps`` per body, default
+        1e9); ``"rk4"``, ``"cf4"`` (Lie group), ``"splitting2"``/``"splitting4"``
+        (Lie–Poisson, torque-free rigid bodies), ``"exact_split2"``/``"exact_split4"``
+        (exact free flow + torque kicks): fixed step ``dt`` (s); ``"exact"``: the
+        closed-form torque-free motion. A method the model does not provide for
+        is refused, naming those that work; so is an option the method does not
+        read. See ``docs/integrators.md``.
+    torque
+        What ``model.torque`` says: for the bodies and spacecraft an external
+        torque in body axes (N·m), a :mod:`tumble.torques` model or a Python
+        callable ``f(t, q, omega)`` (at Python speed, on one core); for a robot
+        the joint torques.
     progress : callable ``progress(done, total)``, optional
         Called as output samples are completed (the CLI draws a progress bar).
-        Not available with ``device="cuda"``.
     device : {"cpu", "cuda"}
-        ``"cuda"`` runs ``method="rk4"`` batches on an NVIDIA GPU, one thread
-        per body (compiled torque models only; see ``docs/gpu.md``).
+        ``"cuda"``: ``method="rk4"`` batches of rigid bodies on an NVIDIA GPU,
+        one thread per body (compiled torque models only; ``docs/gpu.md``).
+    **initial_state
+        The model's initial state by name (:meth:`Model.state_fields`), e.g.
+        ``q0`` (unit quaternion ``[w, x, y, z]``, body → inertial, default
+        identity), ``wheel_speeds0``, ``eta0``; a leading axis of length N runs
+        N initial states at once, in parallel over the cores.
 
     Returns
     -------
     Trajectory
-        ``t`` (n,), ``q`` (n, [N,] 4), ``omega`` (n, [N,] 3) and the inertia, with
-        energy, angular momentum and their drifts.
+        ``t`` (n,), ``q`` (n, [N,] 4), ``omega`` (n, [N,] 3), the model's named
+        extras, the energy and angular momentum of the whole system, and
+        ``info`` (method, options, statistics).
     """
-    method = str(method)
+    model = as_model(model)
+    times = output_times(t)
+    if omega0 is not None:
+        initial_state["omega0"] = omega0
+    m, options = _solver_options(model, method, dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if device not in ("cpu", "cuda"):
         raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
-    if device == "cuda" and (method != "rk4" or progress is not None):
-        raise ValidationError(f"device: 'cuda' runs method='rk4' without progress reporting, got method={method!r}"
-                              + (" and a progress callback" if progress is not None else ""))
-    m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque)
-    times = _output_times(t)
-    moments, axes, batch_inertia, mass = _bodies(body)
-    omega0 = as_array(omega0, "omega0", tail=(3,))
-    q0 = attitude.identity() if q0 is None else as_array(q0, "q0", tail=(4,))
-    n = _batch_size(batch_inertia, omega0, q0)
-    if np.any(np.linalg.norm(q0, axis=-1) == 0.0):
-        raise ValidationError("q0: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
-    q0 = attitude.normalize(np.broadcast_to(q0, (n or 1, 4)))
-    omega0 = np.broadcast_to(omega0, (n or 1, 3))
-    model = torques.as_torque_model(torque)
-
-    # Into principal axes, one set of axes per distinct body: R_BP (B, 3, 3), B = 1 or N.
-    q_bp = attitude.from_matrix(axes)                              # (B, 4)
-    y0 = np.empty((n or 1, _rigid.STATE_SIZE))
-    y0[:, :4] = attitude.multiply(q0, q_bp)
-    y0[:, 4:] = np.einsum("bji,bj->bi", axes, omega0)
-    rigid = _rigid.from_principal(moments, axes, model)
-    limits.check_rigid_motion(moments, y0[:, 4:], mass, stacklevel=3)
-
-    if device == "cuda":
-        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
-
-        states, stats = _cuda.solve_cuda(rigid.coefficients, rigid.params, rigid.codes, y0, times, dt)
-    else:
-        with torques.registered(model):
-            states, stats = integrate.solve(
-                rigid, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
-                max_steps=max_steps, serial=model is not None and model.needs_python, progress=progress,
-            )
-
-    if model is not None:  # a torque may have spun the body up: check where it ended
-        limits.check_rigid_motion(moments, states[-1, :, 4:], mass, stacklevel=3)
-    q = attitude.multiply(states[..., :4], attitude.conjugate(q_bp))
-    omega = np.einsum("bij,tbj->tbi", axes, states[..., 4:])
-    if n is None:
-        q, omega = q[:, 0], omega[:, 0]
-    info = {"torque": repr(model) if model is not None else "none", **stats}
-    if m.adaptive:
-        info.update(rtol=float(rtol), atol=float(atol))
-    elif m.stepper:
-        info.update(dt=float(dt))
-    return Trajectory(t=times, q=q, omega=omega, inertia=batch_inertia, method=method, info=info)
+    if torque is not None and model.torque is None:
+        raise ValidationError(f"torque: a {type(model).__name__} takes no torque argument")
+    values, n = _initial_values(model, initial_state)
+    model.check_run(m, times, options.get("dt"))
+    with _callback.keep_alive():  # Python functions wrapped while compiling live through the run
+        kernel = model.compile(torque, float(times[0]))
+        who = f"a {type(model).__name__}" + (f" under torque={torque!r}" if torque is not None else "")
+        integrate.check_method(m.name, kernel.provides, who)
+        if device == "cuda" and (m.name != "rk4" or progress is not None or "cuda" not in kernel.provides):
+            raise ValidationError(f"device: 'cuda' runs method='rk4' on rigid bodies with compiled torques, without "
+                                  f"progress reporting; got method={m.name!r} on {who}"
+                                  + (" and a progress callback" if progress is not None else ""))
+        y0 = model.initial_states(kernel, values, float(times[0]))
+        solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device, **options)
+    out = model.outputs(kernel, times, solution.states)
+    info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
+    info.pop("max_steps", None)
+    return _trajectory(model, m.name, times, out, info, single=n is None)
 
 
-def _output_times(t) -> np.ndarray:
-    times = as_array(t, "t")
-    if times.ndim != 1 or times.size < 1:
-        raise ValidationError(f"t: must be a 1-D array of output times, got shape {times.shape}")
-    steps = np.diff(times)
-    if np.any(steps <= 0.0):
-        k = int(np.flatnonzero(steps <= 0.0)[0])
-        raise ValidationError(
-            f"t: output times must be strictly increasing (t[{k + 1}] = {times[k + 1]} <= t[{k}] = {times[k]})"
-        )
-    return times
+def _describe(torque) -> str:
+    """``Trajectory.info["torque"]``: "none", a torque model's repr, or the name of a Python function."""
+    if torque is None:
+        return "none"
+    if callable(torque) and hasattr(torque, "__name__"):
+        return f"Python function {torque.__name__}"
+    return repr(torque)
 
 
-# Models of the extension packages that have their own entry point (named here, not
-# imported: those packages are built on this module).
-_OWN_SIMULATE = {
-    "tumble.variable.body.VariableBody": "integrate it with tumble.variable.simulate_variable",
-    "tumble.variable.human.Human": ("make its VariableBody with Human.variable_body(...) and integrate that with "
-                                    "tumble.variable.simulate_variable"),
-    "tumble.flexible.FlexibleBody": "integrate it with tumble.flexible.simulate",
-    "tumble.slosh.SloshBody": "integrate it with tumble.slosh.simulate",
-    "tumble.spacecraft.model.Spacecraft": "integrate it with tumble.spacecraft.simulate",
-    "tumble.robot.chain.SerialChain": "integrate it with tumble.robot.simulate",
-}
+def _solver_options(model: Model, method, given: dict) -> tuple[integrate.Method, dict]:
+    """The :class:`~tumble.integrate.Method` and the options it reads (defaults filled in); an option given
+    that the method does not read is refused."""
+    method = str(method)
+    if method not in integrate.METHODS:
+        raise ValidationError(f"method: must be one of {sorted(integrate.METHODS)}, got {method!r}")
+    m = integrate.METHODS[method]
+    for name, value in given.items():
+        if value is not None and name not in m.options:
+            reads = f"it reads {', '.join(m.options)}" if m.options else "it has no options"
+            raise ValidationError(f"{name}: method {method!r} does not use {name} ({reads})")
+    options = {name: DEFAULTS[name] if given[name] is None and name in DEFAULTS else given[name]
+               for name in m.options}
+    integrate.check_options(method, dt=options.get("dt"), rtol=options.get("rtol"), atol=options.get("atol"),
+                            max_steps=options.get("max_steps"))
+    return m, {name: (int(v) if name == "max_steps" else float(v)) for name, v in options.items()}
 
 
-def _bodies(body) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | float | None]:
-    """Principal moments (B, 3), axes R_BP (B, 3, 3), the inertia to report and the mass (kg, or None
-    when unknown), B = 1 or one per member.
-
-    An (N, 3, 3) inertia array is validated in one vectorised call
-    (:func:`tumble.body.principal_axes`), with the rules of :class:`RigidBody`.
-    """
-    if isinstance(body, RigidBody):
-        return body.moments[None], body.axes[None], np.array(body.inertia), body.mass
-    if isinstance(body, Sequence) and body and all(isinstance(b, RigidBody) for b in body):
-        masses = [b.mass for b in body]
-        return (np.stack([b.moments for b in body]), np.stack([b.axes for b in body]),
-                np.stack([b.inertia for b in body]), None if None in masses else np.array(masses))
-    own = _OWN_SIMULATE.get(f"{type(body).__module__}.{type(body).__qualname__}")
-    if own is not None:
-        raise ValidationError(f"body: a {type(body).__name__} is not a rigid body; {own}")
-    inertia = as_array(body, "inertia", tail=(3, 3))
-    if inertia.ndim not in (2, 3):
-        raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
-    inertia, moments, axes = principal_axes(inertia, "inertia")
-    if inertia.ndim == 2:
-        return moments[None], axes[None], inertia, None
-    return moments, axes, inertia, None
-
-
-def _batch_size(inertia, omega0, q0) -> int | None:
-    """N for a batch, None for a single body; refuses inconsistent batch sizes."""
-    sizes = {}
-    for name, arr, single_ndim in (("omega0", omega0, 1), ("q0", q0, 1), ("body", inertia, 2)):
-        if arr.ndim > single_ndim + 1:
-            raise ValidationError(f"{name}: a batch has one leading axis, got shape {arr.shape}")
-        if arr.ndim == single_ndim + 1:
-            sizes[name] = arr.shape[0]
+def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray], int | None]:
+    """Validate the initial state by name: each value (size,) or (N, size), one N for all (and the model's
+    own batch); returns the values broadcast to (N, size) and N (None for a single run)."""
+    fields = model.state_fields()
+    names = [f.name for f in fields]
+    for name in given:
+        if name not in names:
+            close = difflib.get_close_matches(name, names, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ValidationError(f"{name}: a {type(model).__name__} has no initial state {name!r}{hint}; it takes "
+                                  + ", ".join(f"{f.name} ({f.description})" for f in fields))
+    arrays, sizes = {}, {}
+    for f in fields:
+        value = given.get(f.name)
+        if value is None:
+            if f.default is None:
+                raise ValidationError(f"{f.name}: a {type(model).__name__} needs it: {f.description}")
+            value = f.default(_broadcast(arrays, sizes)) if callable(f.default) else f.default
+        arr = as_array(value, f.name, tail=(f.size,))
+        if arr.ndim > 2:
+            raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
+        if f.quaternion and np.any(np.linalg.norm(arr, axis=-1) == 0.0):
+            raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
+        if arr.ndim == 2 and f.name in given:
+            sizes[f.name] = arr.shape[0]
+        arrays[f.name] = attitude.normalize(arr) if f.quaternion else arr
+    if model.batch_size is not None:
+        sizes["body"] = model.batch_size
     if len(set(sizes.values())) > 1:
         raise ValidationError(f"batch sizes disagree: {sizes}")
-    return next(iter(sizes.values()), None)
+    n = next(iter(sizes.values()), None)
+    return _broadcast(arrays, sizes), n
+
+
+def _broadcast(arrays: dict, sizes: dict) -> dict[str, np.ndarray]:
+    n = max(sizes.values(), default=1)
+    return {name: np.broadcast_to(a, (n, a.shape[-1])) for name, a in arrays.items()}
+
+
+def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool) -> Trajectory:
+    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run."""
+    def pick(a):
+        return a[:, 0] if single and a is not None else a
+
+    inertia = out.inertia
+    if single and inertia is not None and inertia.ndim == 3:
+        inertia = inertia[0]
+    extras = {name: Extra(pick(e.data), e.dims, e.units, e.description) for name, e in out.extras.items()}
+    totals = {name: pick(value) for name, value in out.totals.items()}
+    return Trajectory(t=t, q=pick(out.q), omega=pick(out.omega), inertia=inertia, method=method, info=info,
+                      extras=extras, totals=totals, model=type(model).__name__)

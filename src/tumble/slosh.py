@@ -32,7 +32,7 @@ acceleration of ``r``) and the hinge friction torque ``−μ l² d ν`` (``d`` i
 
 Solving the first for ``ν̇`` and substituting leaves a 3×3 system for ``ω̇``
 with the matrix ``I_B + μ (r × s)(r × s)ᵀ`` (the pendulum adds inertia only
-through the motion of its mass along the rod): :mod:`tumble._slosh`. The
+through the motion of its mass along the rod): :mod:`tumble.kernels.slosh`. The
 inertial momentum ``R(q) H`` is conserved without torque (the friction torque
 is internal), and ``Ṫ = ω·τ − μ l² d |ν|²``: with damping the energy
 decreases monotonically while ``|H|`` stays constant, which drives a spinner
@@ -59,11 +59,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tumble import _slosh, attitude, torques
+from tumble import attitude, torques
+from tumble.kernels import slosh as _slosh
 from tumble._validate import ValidationError, as_array, require_non_negative, require_positive
 from tumble.body import RigidBody
 from tumble.flexible import initial_states, integrate_model
-from tumble.simulate import _output_times
+from tumble._validate import output_times as _output_times
 from tumble.trajectory import Extra, Trajectory, write_atomic
 
 __all__ = ["Pendulum", "SloshBody", "simulate", "energy", "momentum_body", "nutation_angle",
@@ -119,7 +120,7 @@ class SloshBody:
         return m * M / (m + M)
 
     def model(self, torque=None) -> _slosh.SloshModel:
-        """The compiled model (:class:`tumble._slosh.SloshModel`) under a torque model (body axes)."""
+        """The compiled model (:class:`tumble.kernels.slosh.SloshModel`) under a torque model (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         p = self.pendulum
         return _slosh.SloshModel(

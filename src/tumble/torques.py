@@ -33,18 +33,16 @@ principal axes, where the integrators work; :func:`evaluate` runs a program.
 
 from __future__ import annotations
 
-import itertools
 import math
-from contextlib import contextmanager
 
 import numpy as np
 from numba import njit, objmode
 from numba.extending import register_jitable
 
-from tumble import _gravity, _quat
+from tumble import _callback, _gravity, _quat
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.attitude import rotate_inverse
-from tumble.body import RigidBody, principal_axes
+from tumble._inertia import principal_axes
 
 __all__ = [
     "TorqueModel",
@@ -99,9 +97,7 @@ class TorqueModel:
         if q.ndim != 1 or omega.ndim != 1:
             raise ValidationError("q, omega: evaluate a torque model one state at a time")
         codes, params = compile_program(self, np.eye(3), offset=0)
-        with registered(self):
-            tau = evaluate(float(t), *q, *omega, params[None, :], 0, codes)
-        return np.array(tau)
+        return np.array(evaluate(float(t), *q, *omega, params[None, :], 0, codes))
 
 
 class Sum(TorqueModel):
@@ -237,8 +233,7 @@ class GravityGradient(TorqueModel):
             raise ValidationError(f"orbit: must be a tumble.spacecraft.orbit.Orbit, got {type(orbit).__name__}")
         self.orbit = orbit
         self.elements = as_array(orbit.elements(), "orbit.elements()", tail=(7,))
-        if isinstance(inertia, RigidBody):
-            inertia = inertia.inertia
+        inertia = getattr(inertia, "inertia", inertia)  # a RigidBody, or the tensor itself
         self.inertia = principal_axes(as_array(inertia, "inertia", tail=(3, 3)), "inertia", check_triangle=False)[0]
         if self.inertia.ndim != 2:
             raise ValidationError(f"inertia: must have shape (3, 3), got {self.inertia.shape}")
@@ -262,13 +257,13 @@ class PythonTorque(TorqueModel):
     """
 
     needs_python = True
-    _ids = itertools.count()
 
     def __init__(self, function):
         if not callable(function):
             raise ValidationError(f"torque: must be a torque model or a callable f(t, q, omega), got {function!r}")
         self.function = function
-        self.slot = next(self._ids)
+        self.slot = _callback.register(self, function, field="torque", signature="(t, q, omega)",
+                                       returns="3 finite numbers (body torque, N·m)")
 
     def _params(self, axes):
         q_bp = np.array(_quat.qfrom_matrix(axes))
@@ -309,6 +304,11 @@ def as_torque_model(torque) -> TorqueModel | None:
     return PythonTorque(torque)
 
 
+def calls_python(codes: np.ndarray | None) -> bool:
+    """True when the torque program ``codes`` (of :func:`compile_program`) calls a Python function."""
+    return codes is not None and bool(np.any(np.asarray(codes)[0::2] == _PYTHON))
+
+
 def compile_program(model: TorqueModel | None, axes: np.ndarray, offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Compile a model to a torque program in the principal axes ``axes`` (R_BP).
 
@@ -325,37 +325,6 @@ def compile_program(model: TorqueModel | None, axes: np.ndarray, offset: int) ->
         start += blocks[-1].size
     params = np.concatenate(blocks) if blocks else np.zeros(0)
     return np.array(codes, dtype=np.int64), params
-
-
-# --- Python callbacks ---------------------------------------------------------
-# A PythonTorque is reachable from compiled code only by its slot number while
-# a run that uses it is in progress (see `registered`).
-_CALLBACKS: dict[int, object] = {}
-
-
-@contextmanager
-def registered(model: TorqueModel | None):
-    """Make the Python callables of ``model`` reachable from compiled code during a run."""
-    terms = [m for m in (() if model is None else model.terms()) if isinstance(m, PythonTorque)]
-    for m in terms:
-        _CALLBACKS[m.slot] = m.function
-    try:
-        yield
-    finally:
-        for m in terms:
-            _CALLBACKS.pop(m.slot, None)
-
-
-def _call_python(slot, t, q, omega, out):
-    function = _CALLBACKS[slot]
-    tau = np.asarray(function(float(t), q.copy(), omega.copy()), dtype=np.float64)
-    if tau.shape != (3,) or not np.all(np.isfinite(tau)):
-        name = getattr(function, "__name__", repr(function))
-        raise ValidationError(
-            f"torque: the function {name}(t, q, omega) must return 3 finite numbers "
-            f"(body torque, N·m); at t={t} it returned {tau!r}"
-        )
-    out[:] = tau
 
 
 @njit(cache=True)
@@ -376,7 +345,7 @@ def _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, o):
     )
     tau = np.empty(3)
     with objmode():
-        _call_python(slot, t, q_body, omega_body, tau)
+        _callback.invoke(slot, t, (q_body, omega_body), tau)
     return (
         r[0] * tau[0] + r[3] * tau[1] + r[6] * tau[2],
         r[1] * tau[0] + r[4] * tau[1] + r[7] * tau[2],

@@ -1,7 +1,8 @@
-"""The result of a simulation: sampled attitude and body rate, and their invariants.
+"""The result of a simulation, for every model: sampled attitude and body rate, named extras, invariants.
 
-A :class:`Trajectory` holds one rigid body, or a batch of ``N`` bodies, at the
-output times ``t`` (``n`` samples):
+A :class:`Trajectory` holds one run, or a batch of ``N`` runs, at the output
+times ``t`` (``n`` samples); every model of :func:`tumble.simulate` returns
+one:
 
 ==========  ================  ====================================================
 field       shape             meaning
@@ -16,11 +17,17 @@ field       shape             meaning
                               body axes (one tensor may serve a whole batch)
 ==========  ================  ====================================================
 
-The invariants of torque-free motion (kinetic energy ``T = ½ ω·Iω``, angular
-momentum ``L = I ω``) and their drifts are derived on demand with
-:mod:`tumble.dynamics`. A trajectory converts to an :class:`xarray.Dataset`,
-saves to NetCDF-4 atomically and plots with matplotlib's object-oriented API.
-The layout is described in ``docs/trajectory.md``.
+A model larger than a rigid body adds its own sampled states as named
+*extras* (wheel speeds, modal coordinates, joint angles, ...), readable as
+attributes (``traj.wheel_speed``), and gives the *totals* of the whole system:
+its energy and its angular momentum (hub and wheels, appendages, slosh mass,
+damper, limbs). A model with no single attitude (a robot arm on a fixed base)
+has ``q``, ``omega`` and ``inertia`` set to ``None``. Without totals the
+invariants are those of a rigid body (kinetic energy ``T = ½ ω·Iω``, angular
+momentum ``L = I ω``), derived on demand with :mod:`tumble.dynamics`. A
+trajectory converts to an :class:`xarray.Dataset`, saves to NetCDF-4
+atomically and plots with matplotlib's object-oriented API. The layout is
+described in ``docs/trajectory.md``.
 """
 
 from __future__ import annotations
@@ -38,7 +45,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from ._validate import ValidationError, as_array
-from .dynamics import angular_momentum, angular_momentum_inertial, kinetic_energy
+from .attitude import rotate
+from .dynamics import angular_momentum, kinetic_energy
 
 if TYPE_CHECKING:
     import xarray
@@ -52,6 +60,8 @@ CONVENTIONS = (
 _ENGINE = "h5netcdf"  # NetCDF-4 (HDF5) reader and writer used by save() and load()
 _INFO_PREFIX = "solver_"  # global attributes of the NetCDF file that hold Trajectory.info
 _EXTRA_ATTR = "tumble_extra"  # variable attribute that marks a Trajectory.extras entry in a dataset
+_TOTAL_ATTR = "tumble_total"  # variable attribute that marks a model's total (energy, momentum_body)
+_TOTALS = {"energy": 0, "momentum_body": 1}  # the totals a model may give, and their trailing axes
 _AXES = ["x", "y", "z"]
 _COMPONENTS = ["w", "x", "y", "z"]
 # Panel (b) of plot() shows |drift| on a symlog scale, linear below this value
@@ -131,6 +141,22 @@ def _check_extras(extras: Any, lead: tuple[int, ...]) -> dict:
     return out
 
 
+def _check_totals(totals: Any, lead: tuple[int, ...]) -> dict:
+    """Validate a model's ``totals`` (``energy`` (n, [N]), ``momentum_body`` (n, [N,] 3)); copy read-only."""
+    if not isinstance(totals, Mapping):
+        raise ValidationError(f"totals: must be a dict of name -> array, got {type(totals).__name__}")
+    out = {}
+    for name, value in totals.items():
+        if name not in _TOTALS:
+            raise ValidationError(f"totals: names must be among {sorted(_TOTALS)}, got {name!r}")
+        data = as_array(value, f"totals[{name!r}]")
+        want = lead + (3,) * _TOTALS[name]
+        if data.shape != want:
+            raise ValidationError(f"totals[{name!r}]: must have shape {want}, got {data.shape}")
+        out[name] = _readonly(np.array(data, dtype=np.float64))
+    return out
+
+
 @dataclass(frozen=True, eq=False, repr=False)
 class Trajectory:
     """Samples of the rotational state of one rigid body or a batch of bodies.
@@ -139,13 +165,15 @@ class Trajectory:
     ----------
     t : array_like, shape (n,)
         Output times, s, strictly monotonic (``t[0]`` is the start).
-    q : array_like, shape (n, 4) or (n, N, 4)
+    q : array_like, shape (n, 4) or (n, N, 4), or None
         Attitude, unit Hamilton quaternion, scalar first ``[w, x, y, z]``,
-        mapping body to inertial axes: ``v_I = q ⊗ v_B ⊗ q*``.
-    omega : array_like, shape (n, 3) or (n, N, 3)
+        mapping body to inertial axes: ``v_I = q ⊗ v_B ⊗ q*``. ``None`` for a
+        model with no single attitude (a robot arm), with ``omega`` and
+        ``inertia`` None too and the totals given.
+    omega : array_like, shape (n, 3) or (n, N, 3), or None
         Angular velocity of the body relative to inertial space, rad/s, in
         body axes.
-    inertia : array_like, shape (3, 3) or (N, 3, 3)
+    inertia : array_like, shape (3, 3) or (N, 3, 3), or None
         Inertia tensor about the centre of mass, kg m², in body axes. A single
         (3, 3) tensor is shared by every body of a batch.
     method : str
@@ -155,21 +183,30 @@ class Trajectory:
         ``n_steps``, ...); values are floats, ints or strings.
     extras : dict of str to :class:`Extra`
         States of models larger than a rigid body (wheel speeds, modal
-        coordinates, ...), sampled at ``t``. The invariants below
-        (``energy``, ``momentum_*``) are those of ``omega`` and ``inertia``
-        alone: a model with internal momentum reports its totals itself.
+        coordinates, ...), sampled at ``t``; ``traj.NAME`` reads
+        ``traj.extras[NAME].data``.
+    totals : dict of str to array_like
+        The model's own invariants of the whole system: ``"energy"`` (n, [N])
+        in J and ``"momentum_body"`` (n, [N,] 3) in N·m·s, body axes (angular
+        momentum about the centre of mass, or the fixed point). Without them
+        :attr:`energy` and :attr:`momentum_body` are those of ``omega`` and
+        ``inertia`` (a rigid body).
+    model : str
+        The kind of model that made the samples (``"RigidBody"``, ``"Spacecraft"``, ...).
 
     The arrays are copied as float64 and stored read-only. Invalid input
     raises :class:`tumble.ValidationError` naming the field.
     """
 
     t: np.ndarray
-    q: np.ndarray
-    omega: np.ndarray
-    inertia: np.ndarray
+    q: np.ndarray | None
+    omega: np.ndarray | None
+    inertia: np.ndarray | None
     method: str = ""
     info: dict = field(default_factory=dict)
     extras: dict = field(default_factory=dict)
+    totals: dict = field(default_factory=dict)
+    model: str = ""
 
     def __post_init__(self) -> None:
         t = as_array(self.t, "t")
@@ -179,27 +216,51 @@ class Trajectory:
         if not (np.all(step > 0) or np.all(step < 0)):
             raise ValidationError("t: must be strictly increasing or strictly decreasing")
         n = t.size
-        q = as_array(self.q, "q", tail=(4,))
-        if q.ndim not in (2, 3) or q.shape[0] != n:
-            raise ValidationError(
-                f"q: must have shape (n, 4) or (n, N, 4) with n = len(t) = {n}, got {q.shape}"
-            )
-        omega = as_array(self.omega, "omega", tail=(3,))
-        if omega.shape[:-1] != q.shape[:-1]:
-            raise ValidationError(
-                f"omega: must have shape {q.shape[:-1] + (3,)} to match q, got {omega.shape}"
-            )
-        inertia = as_array(self.inertia, "inertia", tail=(3, 3))
-        batch = q.shape[1:-1]
-        if inertia.shape[:-2] not in ((), batch):
-            allowed = "(3, 3)" + (f" or ({batch[0]}, 3, 3)" if batch else "")
-            raise ValidationError(f"inertia: must have shape {allowed}, got {inertia.shape}")
+        if self.q is None:
+            q = omega = inertia = None
+            if self.omega is not None or self.inertia is not None:
+                raise ValidationError("omega, inertia: must be None when q is None (a model with no single attitude)")
+            if "energy" not in (self.totals if isinstance(self.totals, Mapping) else {}):
+                raise ValidationError("totals: a trajectory without an attitude (q = None) must give "
+                                      "totals['energy']")
+            lead = np.shape(self.totals["energy"])
+            if len(lead) not in (1, 2) or lead[0] != n:
+                raise ValidationError(f"totals['energy']: must have shape (n,) or (n, N) with n = len(t) = {n}, "
+                                      f"got {lead}")
+        else:
+            q = as_array(self.q, "q", tail=(4,))
+            if q.ndim not in (2, 3) or q.shape[0] != n:
+                raise ValidationError(
+                    f"q: must have shape (n, 4) or (n, N, 4) with n = len(t) = {n}, got {q.shape}"
+                )
+            omega = as_array(self.omega, "omega", tail=(3,))
+            if omega.shape[:-1] != q.shape[:-1]:
+                raise ValidationError(
+                    f"omega: must have shape {q.shape[:-1] + (3,)} to match q, got {omega.shape}"
+                )
+            inertia = as_array(self.inertia, "inertia", tail=(3, 3))
+            batch = q.shape[1:-1]
+            if inertia.shape[:-2] not in ((), batch):
+                allowed = "(3, 3)" + (f" or ({batch[0]}, 3, 3)" if batch else "")
+                raise ValidationError(f"inertia: must have shape {allowed}, got {inertia.shape}")
+            lead = q.shape[:-1]
         if not isinstance(self.method, str):
             raise ValidationError(f"method: must be a string, got {type(self.method).__name__}")
+        if not isinstance(self.model, str):
+            raise ValidationError(f"model: must be a string, got {type(self.model).__name__}")
         for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
-            object.__setattr__(self, name, _readonly(np.array(value, dtype=np.float64)))
+            object.__setattr__(self, name, None if value is None else _readonly(np.array(value, dtype=np.float64)))
         object.__setattr__(self, "info", _check_info(self.info))
-        object.__setattr__(self, "extras", _check_extras(self.extras, q.shape[:-1]))
+        object.__setattr__(self, "extras", _check_extras(self.extras, lead))
+        object.__setattr__(self, "totals", _check_totals(self.totals, lead))
+
+    def __getattr__(self, name: str):
+        """``traj.NAME`` is ``traj.extras[NAME].data`` for the model's named outputs (e.g. ``traj.wheel_speed``)."""
+        extras = self.__dict__.get("extras", {})
+        if name in extras:
+            return extras[name].data
+        raise AttributeError(f"{type(self).__name__!r} has no attribute {name!r}"
+                             + (f" (extras: {', '.join(extras)})" if extras else ""))
 
     def __len__(self) -> int:
         """Number of output times ``n``."""
@@ -215,7 +276,13 @@ class Trajectory:
     @property
     def batch_size(self) -> int | None:
         """Number ``N`` of bodies in a batch, or ``None`` for a single body."""
-        return None if self.q.ndim == 2 else self.q.shape[1]
+        lead = self._lead
+        return None if len(lead) == 1 else lead[1]
+
+    @property
+    def _lead(self) -> tuple[int, ...]:
+        """The leading shape ``(n,)`` or ``(n, N)`` of every sampled array."""
+        return self.q.shape[:-1] if self.q is not None else self.totals["energy"].shape
 
     def body(self, i: int) -> Trajectory:
         """The trajectory of body ``i`` of a batch (negative ``i`` counts from the end)."""
@@ -225,29 +292,51 @@ class Trajectory:
         i = operator.index(i)
         if not -n_bodies <= i < n_bodies:
             raise IndexError(f"i: body {i} is out of range for a batch of {n_bodies}")
-        inertia = self.inertia if self.inertia.ndim == 2 else self.inertia[i]
+        def pick(a):
+            return None if a is None else a[:, i]
+
+        inertia = self.inertia if self.inertia is None or self.inertia.ndim == 2 else self.inertia[i]
         extras = {name: e._replace(data=e.data[:, i]) for name, e in self.extras.items()}
-        return Trajectory(self.t, self.q[:, i], self.omega[:, i], inertia, self.method, self.info, extras)
+        totals = {name: value[:, i] for name, value in self.totals.items()}
+        return Trajectory(self.t, pick(self.q), pick(self.omega), inertia, self.method, self.info, extras, totals,
+                          self.model)
 
     # -- invariants ------------------------------------------------------------------
 
     @cached_property
     def energy(self) -> np.ndarray:
-        """Rotational kinetic energy ``T = ½ ω·Iω``, J, shape (n, [N])."""
+        """Energy of the whole system, J, shape (n, [N]).
+
+        The model's total where it gives one (``totals["energy"]``: hub and wheels,
+        appendages, slosh, damper, limbs; kinetic plus potential for a robot),
+        otherwise the rotational kinetic energy ``T = ½ ω·Iω`` of the rigid body.
+        """
+        if "energy" in self.totals:
+            return self.totals["energy"]
         return _readonly(kinetic_energy(self.inertia, self.omega))
 
     @cached_property
     def momentum_body(self) -> np.ndarray:
-        """Angular momentum ``L = I ω`` about the centre of mass, N m s, body axes, (n, [N,] 3)."""
+        """Angular momentum of the whole system about the centre of mass, N m s, body axes, (n, [N,] 3).
+
+        The model's total where it gives one (``totals["momentum_body"]``),
+        otherwise ``L = I ω`` of the rigid body.
+        """
+        if "momentum_body" in self.totals:
+            return self.totals["momentum_body"]
+        if self.q is None:
+            raise ValidationError(f"momentum_body: this {self.model or 'model'} trajectory has no angular momentum "
+                                  "(no single attitude; see its extras and energy)")
         return _readonly(angular_momentum(self.inertia, self.omega))
 
     @cached_property
     def momentum_inertial(self) -> np.ndarray:
-        """Angular momentum ``L_I = R(q) I ω``, N m s, inertial axes, shape (n, [N,] 3).
+        """Angular momentum ``L_I = R(q) L_B``, N m s, inertial axes, shape (n, [N,] 3).
 
-        Constant in torque-free motion.
+        Constant when no external torque acts.
         """
-        return _readonly(angular_momentum_inertial(self.inertia, self.omega, self.q))
+        body = self.momentum_body
+        return _readonly(rotate(self.q, body))
 
     @cached_property
     def momentum_norm(self) -> np.ndarray:
@@ -298,29 +387,37 @@ class Trajectory:
         import xarray as xr
 
         lead = ("time",) if self.batch_size is None else ("time", "body")
-        inertia_dims = ("axis", "axis2") if self.inertia.ndim == 2 else ("body", "axis", "axis2")
 
-        def variable(dims, data, units, description, frame=None):
-            attrs = {"units": units, "description": description}
+        def variable(dims, data, units, description, frame=None, **marks):
+            attrs = {"units": units, "description": description, **marks}
             if frame is not None:
                 attrs["frame"] = frame
             return xr.Variable(dims, data, attrs)
 
-        data_vars = {
-            "omega": variable(lead + ("axis",), self.omega, "rad/s",
-                              "angular velocity of the body relative to inertial space", "body"),
-            "q": variable(lead + ("component",), self.q, "1",
-                          "attitude: unit Hamilton quaternion, scalar first, v_I = q v_B q*",
-                          "body->inertial"),
-            "inertia": variable(inertia_dims, self.inertia, "kg m2",
-                                "inertia tensor about the centre of mass", "body"),
-            "energy": variable(lead, self.energy, "J",
-                               "rotational kinetic energy T = 1/2 omega.I omega"),
-            "momentum_body": variable(lead + ("axis",), self.momentum_body, "N m s",
-                                      "angular momentum L = I omega", "body"),
-            "momentum_inertial": variable(lead + ("axis",), self.momentum_inertial, "N m s",
-                                          "angular momentum L_I = R(q) I omega", "inertial"),
-        }
+        data_vars = {}
+        if self.q is not None:
+            inertia_dims = ("axis", "axis2") if self.inertia.ndim == 2 else ("body", "axis", "axis2")
+            data_vars.update(
+                omega=variable(lead + ("axis",), self.omega, "rad/s",
+                               "angular velocity of the body relative to inertial space", "body"),
+                q=variable(lead + ("component",), self.q, "1",
+                           "attitude: unit Hamilton quaternion, scalar first, v_I = q v_B q*", "body->inertial"),
+                inertia=variable(inertia_dims, self.inertia, "kg m2", "inertia tensor about the centre of mass",
+                                 "body"),
+            )
+        totals = {_TOTAL_ATTR: 1} if "energy" in self.totals else {}
+        data_vars["energy"] = variable(
+            lead, self.energy, "J",
+            "energy of the whole system" if totals else "rotational kinetic energy T = 1/2 omega.I omega", **totals)
+        if self.q is not None or "momentum_body" in self.totals:
+            totals = {_TOTAL_ATTR: 1} if "momentum_body" in self.totals else {}
+            data_vars["momentum_body"] = variable(
+                lead + ("axis",), self.momentum_body, "N m s",
+                "angular momentum of the whole system" if totals else "angular momentum L = I omega", "body",
+                **totals)
+        if self.q is not None:
+            data_vars["momentum_inertial"] = variable(lead + ("axis",), self.momentum_inertial, "N m s",
+                                                      "angular momentum L_I = R(q) L_B", "inertial")
         for name, extra in self.extras.items():
             if name in data_vars:
                 raise ValidationError(f"extras[{name!r}]: the name is taken by a trajectory variable")
@@ -337,6 +434,7 @@ class Trajectory:
         attrs = {
             "conventions": CONVENTIONS,
             "method": self.method,
+            "model": self.model,
             **{_INFO_PREFIX + key: value for key, value in self.info.items()},
             "tumble_version": _tumble_version(),
             "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
@@ -347,12 +445,13 @@ class Trajectory:
     def from_xarray(cls, ds: xarray.Dataset) -> Trajectory:
         """Rebuild a trajectory from a dataset made by :meth:`to_xarray`.
 
-        Reads ``time``, ``q``, ``omega`` and ``inertia`` exactly (derived
-        variables are recomputed), ``method``, the ``solver_*`` attributes
-        (into ``info``) and the extras.
+        Reads ``time``, ``q``, ``omega`` and ``inertia`` exactly (the rigid-body
+        invariants are recomputed), the model's totals, ``method``, ``model``,
+        the ``solver_*`` attributes (into ``info``) and the extras.
         """
-        missing = [name for name in ("time", "q", "omega", "inertia") if name not in ds.variables]
-        if missing:
+        attitude = [name for name in ("q", "omega", "inertia") if name in ds.variables]
+        if "time" not in ds.variables or (len(attitude) < 3 and (attitude or "energy" not in ds.variables)):
+            missing = [name for name in ("time", "q", "omega", "inertia") if name not in ds.variables]
             raise ValidationError(f"ds: not a tumble trajectory (missing {', '.join(missing)})")
         ds = ds.sel(axis=_AXES, axis2=_AXES, component=_COMPONENTS)
         info = {
@@ -360,11 +459,15 @@ class Trajectory:
             for key, value in ds.attrs.items()
             if key.startswith(_INFO_PREFIX)
         }
+
+        def values(name, *tail):
+            return ds[name].transpose("time", ..., *tail).values if name in ds.variables else None
+
         return cls(
             t=ds["time"].values,
-            q=ds["q"].transpose("time", ..., "component").values,
-            omega=ds["omega"].transpose("time", ..., "axis").values,
-            inertia=ds["inertia"].transpose(..., "axis", "axis2").values,
+            q=values("q", "component"),
+            omega=values("omega", "axis"),
+            inertia=ds["inertia"].transpose(..., "axis", "axis2").values if attitude else None,
             method=str(ds.attrs.get("method", "")),
             info=info,
             extras={
@@ -373,6 +476,9 @@ class Trajectory:
                 for name, var in ds.data_vars.items()
                 if var.attrs.get(_EXTRA_ATTR) == 1
             },
+            totals={name: values(name, *(("axis",) * _TOTALS[name])) for name in _TOTALS
+                    if name in ds.variables and ds[name].attrs.get(_TOTAL_ATTR) == 1},
+            model=str(ds.attrs.get("model", "")),
         )
 
     def save(self, path: str | os.PathLike) -> None:
@@ -392,9 +498,11 @@ class Trajectory:
         """Return a matplotlib figure of the trajectory (nothing is shown or saved).
 
         Panels, against time (s): (a) body rates ω_x, ω_y, ω_z (rad/s, body
-        axes); (b) absolute values of the relative drifts of T and |L|
-        (symlog scale, linear below 1e-16, so exact zeros show); (c) direction
-        of the inertial angular momentum, ``L_I / |L_I|`` (inertial axes).
+        axes); (b) absolute values of the relative drifts of the energy and
+        |L| (symlog scale, linear below 1e-16, so exact zeros show); (c)
+        direction of the inertial angular momentum, ``L_I / |L_I|`` (inertial
+        axes). A model without an attitude (a robot) shows its first two
+        vector extras in (a) and (c) (joint coordinates and rates).
         For a batch, body 0 is plotted and the title says so.
         Save the figure with ``fig.savefig(path)``, or atomically with
         :func:`write_atomic`.
@@ -409,27 +517,35 @@ class Trajectory:
 
         fig = Figure(figsize=(8.0, 9.0), layout="constrained")
         ax_rate, ax_drift, ax_direction = fig.subplots(3, 1, sharex=True)
-        for k, name in enumerate(_AXES):
-            ax_rate.plot(traj.t, traj.omega[:, k], label=rf"$\omega_{name}$")
-        ax_rate.set_title("(a) body rates", loc="left")
-        ax_rate.set_ylabel("ω, body axes (rad/s)")
+        vectors = [(name, e) for name, e in traj.extras.items() if len(e.dims) == 1]
+        if traj.omega is not None:
+            for k, name in enumerate(_AXES):
+                ax_rate.plot(traj.t, traj.omega[:, k], label=rf"$\omega_{name}$")
+            ax_rate.set_title("(a) body rates", loc="left")
+            ax_rate.set_ylabel("ω, body axes (rad/s)")
+        else:  # no attitude (a robot): its first sampled vector, e.g. the joint coordinates
+            _plot_extra(ax_rate, traj.t, *vectors[0], "(a)")
 
-        ax_drift.plot(traj.t, np.abs(traj.energy_drift), label=r"$|T - T_0|/T_0$")
-        ax_drift.plot(traj.t, np.abs(traj.momentum_norm_drift), label=r"$||L| - |L_0||/|L_0|$")
+        ax_drift.plot(traj.t, np.abs(traj.energy_drift), label=r"$|E - E_0|/E_0$")
+        if traj.q is not None or "momentum_body" in traj.totals:
+            ax_drift.plot(traj.t, np.abs(traj.momentum_norm_drift), label=r"$||L| - |L_0||/|L_0|$")
         ax_drift.set_yscale("symlog", linthresh=_DRIFT_LINTHRESH)
         ax_drift.set_ylim(bottom=0.0)
         ax_drift.set_title(
-            f"(b) drift of the invariants (symlog scale, linear below {_DRIFT_LINTHRESH:g})", loc="left"
+            f"(b) drift of energy and momentum (symlog scale, linear below {_DRIFT_LINTHRESH:g})", loc="left"
         )
         ax_drift.set_ylabel("|relative drift| (1)")
 
-        momentum = traj.momentum_inertial
-        norm = np.linalg.norm(momentum, axis=-1, keepdims=True)
-        direction = np.divide(momentum, norm, out=np.zeros_like(momentum), where=norm > 0)
-        for k, name in enumerate(_AXES):
-            ax_direction.plot(traj.t, direction[:, k], label=rf"$L_{name}/|L|$")
-        ax_direction.set_title("(c) direction of the angular momentum", loc="left")
-        ax_direction.set_ylabel("$L_I/|L_I|$, inertial axes (1)")
+        if traj.q is not None:
+            momentum = traj.momentum_inertial
+            norm = np.linalg.norm(momentum, axis=-1, keepdims=True)
+            direction = np.divide(momentum, norm, out=np.zeros_like(momentum), where=norm > 0)
+            for k, name in enumerate(_AXES):
+                ax_direction.plot(traj.t, direction[:, k], label=rf"$L_{name}/|L|$")
+            ax_direction.set_title("(c) direction of the angular momentum", loc="left")
+            ax_direction.set_ylabel("$L_I/|L_I|$, inertial axes (1)")
+        else:
+            _plot_extra(ax_direction, traj.t, *vectors[1], "(c)")
         ax_direction.set_xlabel("time t (s)")
 
         for ax in (ax_rate, ax_drift, ax_direction):
@@ -437,6 +553,15 @@ class Trajectory:
             ax.legend(loc="best", fontsize="small")
         fig.suptitle(title)
         return fig
+
+
+def _plot_extra(ax, t, name: str, extra: Extra, panel: str) -> None:
+    """One line per component of a vector extra (n, m) against time, labelled with its dimension."""
+    dim = extra.dims[0]
+    for k in range(extra.data.shape[-1]):
+        ax.plot(t, extra.data[:, k], label=f"{dim} {k}")
+    ax.set_title(f"{panel} {name.replace('_', ' ')}", loc="left")
+    ax.set_ylabel(f"{name} ({extra.units})")
 
 
 def _tumble_version() -> str:

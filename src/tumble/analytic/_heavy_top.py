@@ -155,7 +155,7 @@ class HeavyTop:
     def simulation_inputs(self, *, phi0: float = 0.0, psi0: float = 0.0) -> dict:
         """Keyword arguments of ``tumble.simulate`` that start this top at Euler angles ``(phi0, theta0, psi0)``.
 
-        ``{"body": diag(I₁, I₁, I₃), "omega0", "q0", "torque": Gravity(mass, (0, 0, l), (0, 0, −g))}``:
+        ``{"model": diag(I₁, I₁, I₃), "omega0", "q0", "torque": Gravity(mass, (0, 0, l), (0, 0, −g))}``:
         body z is the symmetry axis, inertial z is up; ``q0 = from_euler("ZXZ",
         [phi0, theta0, psi0])`` and ``omega0`` from the body-rate formulas of
         the module docstring. Use as ``tumble.simulate(**top.simulation_inputs(), t=t)``.
@@ -170,7 +170,7 @@ class HeavyTop:
             self.spin,
         ])
         return {
-            "body": np.diag([self.I1, self.I1, self.I3]),
+            "model": np.diag([self.I1, self.I1, self.I3]),
             "omega0": omega0,
             "q0": attitude.from_euler("ZXZ", [float(phi0), theta, psi]),
             "torque": Gravity(self.mass, [0.0, 0.0, self.length], [0.0, 0.0, -self.g]),

@@ -33,7 +33,7 @@ gimbal inertia notwithstanding; linearised about it, the nutation frequency is
 
     ω_n = I_s ω₃ / √(P Q(π/2)) = I_s ω₃ / √((A + I_t)(J + B + I_t)).
 
-State for the integrators (:mod:`tumble._model`): ``[q_G (4), φ̇, θ̇, ω₃, ψ]``,
+State for the integrators (:mod:`tumble._protocol`): ``[q_G (4), φ̇, θ̇, ω₃, ψ]``,
 ``q_G`` the attitude of the inner gimbal (``q̇_G = ½ q_G ⊗ ω_G``), from
 which ``sin θ = R_G[2, 1]``, ``cos θ = R_G[2, 2]``, ``φ = atan2(R_G[1, 0], R_G[0, 0])``.
 """
@@ -48,7 +48,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from tumble import _model, _quat, attitude, integrate
+from tumble import _protocol, _quat, attitude, integrate
 from tumble._validate import ValidationError, require_non_negative, require_positive
 from tumble.trajectory import Trajectory
 
@@ -65,7 +65,13 @@ class GimbalModel(NamedTuple):
     params: np.ndarray
 
     @property
-    def torque_free(self) -> bool:
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side."""
+        return frozenset({"rhs"})
+
+    @property
+    def calls_python(self) -> bool:
+        """False: the gimbal equations run compiled."""
         return False
 
 
@@ -89,9 +95,9 @@ def _derivative(p, qw, qx, qy, qz, phi_dot, theta_dot, spin):
     return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], phi_ddot, theta_ddot, spin_dot, psi_dot
 
 
-@overload(_model.rhs, inline="always", jit_options={"cache": True})
+@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
 def _gimbal_rhs(model, b0, t, Y, OUT):
-    if not _model.is_type(model, GimbalModel):
+    if not _protocol.is_type(model, GimbalModel):
         return None
     if Y.ndim == 1:
 
@@ -109,16 +115,16 @@ def _gimbal_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_model.project, inline="always", jit_options={"cache": True})
+@overload(_protocol.project, inline="always", jit_options={"cache": True})
 def _gimbal_project(model, b0, t, Y):
-    if not _model.is_type(model, GimbalModel):
+    if not _protocol.is_type(model, GimbalModel):
         return None
-    return _model.quaternion_projection(Y)
+    return _protocol.quaternion_projection(Y)
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _gimbal_state_size(model):
-    if not _model.is_type(model, GimbalModel):
+    if not _protocol.is_type(model, GimbalModel):
         return None
     return lambda model: STATE_SIZE
 
@@ -207,8 +213,9 @@ class GimbaledGyro:
         y0 = np.zeros((1, STATE_SIZE))
         y0[0, :4] = attitude.from_euler("ZXZ", [0.0, float(theta0), 0.0])
         y0[0, 4:7] = phi_dot0, theta_dot0, spin
-        states, stats = integrate.solve(GimbalModel(params), y0, times, method=method, dt=dt, rtol=rtol,
+        solution = integrate.solve(GimbalModel(params), y0, times, method=method, dt=dt, rtol=rtol,
                                         atol=atol)
+        states, stats = solution.states, solution.statistics()
         y = states[:, 0]
         R = attitude.to_matrix(y[:, :4])
         phi = np.unwrap(np.arctan2(R[:, 1, 0], R[:, 0, 0]))

@@ -66,6 +66,7 @@ import numpy as np
 from numba import njit
 
 from tumble import _quat, attitude
+from tumble._vec import cross
 from tumble._validate import ValidationError, as_array
 from tumble.ins.increments import Increments
 from tumble.trajectory import Trajectory
@@ -166,11 +167,6 @@ def strapdown(increments: Increments, *, q0=None, algorithm: str = "three-sample
 
 
 @njit(cache=True)
-def _cross(a0, a1, a2, b0, b1, b2):
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-
-
-@njit(cache=True)
 def _update_terms(a, b, k, n, code):
     """Sum of the increments of ``a`` over update ``k`` (rows ``k n … k n + n − 1``) and the
     compensation term ``Σ c_ij a_i × b_j`` of algorithm ``code`` (coning when ``b`` is ``a``)."""
@@ -183,15 +179,15 @@ def _update_terms(a, b, k, n, code):
     if code == 1:  # (1/12) a_{k-1} × b_k, none at the first update
         if k == 0:
             return s0, s1, s2, 0.0, 0.0, 0.0
-        c = _cross(a[i0 - 1, 0], a[i0 - 1, 1], a[i0 - 1, 2], b[i0, 0], b[i0, 1], b[i0, 2])
+        c = cross(a[i0 - 1, 0], a[i0 - 1, 1], a[i0 - 1, 2], b[i0, 0], b[i0, 1], b[i0, 2])
         return s0, s1, s2, c[0] / 12.0, c[1] / 12.0, c[2] / 12.0
     if code == 2:  # (2/3) a1 × b2
-        c = _cross(a[i0, 0], a[i0, 1], a[i0, 2], b[i0 + 1, 0], b[i0 + 1, 1], b[i0 + 1, 2])
+        c = cross(a[i0, 0], a[i0, 1], a[i0, 2], b[i0 + 1, 0], b[i0 + 1, 1], b[i0 + 1, 2])
         return s0, s1, s2, 2.0 / 3.0 * c[0], 2.0 / 3.0 * c[1], 2.0 / 3.0 * c[2]
     if code == 3:  # (9/20) a1 × b3 + (27/40) (a1 × b2 + a2 × b3)
-        c13 = _cross(a[i0, 0], a[i0, 1], a[i0, 2], b[i0 + 2, 0], b[i0 + 2, 1], b[i0 + 2, 2])
-        c12 = _cross(a[i0, 0], a[i0, 1], a[i0, 2], b[i0 + 1, 0], b[i0 + 1, 1], b[i0 + 1, 2])
-        c23 = _cross(a[i0 + 1, 0], a[i0 + 1, 1], a[i0 + 1, 2], b[i0 + 2, 0], b[i0 + 2, 1], b[i0 + 2, 2])
+        c13 = cross(a[i0, 0], a[i0, 1], a[i0, 2], b[i0 + 2, 0], b[i0 + 2, 1], b[i0 + 2, 2])
+        c12 = cross(a[i0, 0], a[i0, 1], a[i0, 2], b[i0 + 1, 0], b[i0 + 1, 1], b[i0 + 1, 2])
+        c23 = cross(a[i0 + 1, 0], a[i0 + 1, 1], a[i0 + 1, 2], b[i0 + 2, 0], b[i0 + 2, 1], b[i0 + 2, 2])
         return (s0, s1, s2,
                 0.45 * c13[0] + 0.675 * (c12[0] + c23[0]),
                 0.45 * c13[1] + 0.675 * (c12[1] + c23[1]),
@@ -217,8 +213,8 @@ def _velocity_loop(dtheta, dv, n, code, q, g_step, v):
     for k in range(v.shape[0] - 1):
         a0, a1, a2, p0, p1, p2 = _update_terms(dtheta, dv, k, n, code)  # Δθ and Σ c_ij Δθ_i × Δv_j
         u0, u1, u2, m0, m1, m2 = _update_terms(dv, dtheta, k, n, code)  # Δv and Σ c_ij Δv_i × Δθ_j
-        r0, r1, r2 = _cross(a0, a1, a2, u0, u1, u2)      # Δθ × Δv
-        s0, s1, s2 = _cross(a0, a1, a2, r0, r1, r2)      # Δθ × (Δθ × Δv)
+        r0, r1, r2 = cross(a0, a1, a2, u0, u1, u2)      # Δθ × Δv
+        s0, s1, s2 = cross(a0, a1, a2, r0, r1, r2)      # Δθ × (Δθ × Δv)
         b0 = u0 + 0.5 * r0 + s0 / 6.0 + p0 + m0
         b1 = u1 + 0.5 * r1 + s1 / 6.0 + p1 + m1
         b2 = u2 + 0.5 * r2 + s2 / 6.0 + p2 + m2

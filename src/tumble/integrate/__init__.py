@@ -25,8 +25,15 @@ times (the fixed-step ones land on them, see :mod:`._fixed`), and runs a
 batch of bodies in parallel over the cores (``numba.prange``) unless the
 model calls back into Python.
 
-:func:`solve` is the one entry point used by :func:`tumble.simulate` and by
-every model built on it.
+Each method declares what it needs from the compiled model (``Method.needs``,
+capability names of :data:`tumble._protocol.CAPABILITIES`), as diffrax solvers
+declare the terms they accept; each compiled model says what it provides
+(its ``provides`` property). :func:`check_method` is the one check, with one
+message naming the method, what it misses and the methods that would work.
+The engine imports no particular model.
+
+:func:`solve` is the one entry point used by :func:`tumble.simulate`, which
+runs every model.
 """
 
 from __future__ import annotations
@@ -35,11 +42,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tumble._protocol import CAPABILITIES
 from tumble._validate import ValidationError, require_positive
-from tumble import _free_flow
-from tumble.integrate import _dop853, _exactsplit, _fixed, _liegroup, _rk4, _splitting
+from tumble.integrate import _dop853, _exact, _exactsplit, _fixed, _liegroup, _rk4, _splitting
 
-__all__ = ["METHODS", "Method", "SolverError", "solve"]
+__all__ = ["METHODS", "Method", "Solution", "SolverError", "check_method", "check_options", "solve"]
 
 
 class SolverError(RuntimeError):
@@ -48,10 +55,10 @@ class SolverError(RuntimeError):
 
 @dataclass(frozen=True)
 class Method:
-    """An integration method: its name, order, step policy, what it keeps and which torques it takes.
+    """An integration method: its name, order, step policy, what it keeps and what it needs.
 
     conserves : what the method keeps exactly, up to rounding (in words)
-    torque    : False for a method that integrates torque-free bodies only
+    needs     : the capabilities it needs from the compiled model (:data:`tumble._protocol.CAPABILITIES`)
     stepper   : False for a closed form that needs no step (``"exact"``)
     """
 
@@ -60,8 +67,15 @@ class Method:
     adaptive: bool
     description: str
     conserves: str = "|q| = 1 by projection"
-    torque: bool = True
+    needs: frozenset = frozenset({"rhs"})
     stepper: bool = True
+
+    @property
+    def options(self) -> tuple[str, ...]:
+        """The solver options this method reads (the others are refused by :func:`tumble.simulate`)."""
+        if self.adaptive:
+            return ("rtol", "atol", "max_steps")
+        return ("dt",) if self.stepper else ()
 
 
 _FREE_INVARIANTS = "|L|, L_N and |q| = 1 (exact rotations; energy error bounded, symplectic)"
@@ -74,21 +88,22 @@ METHODS = {
     "dop853": Method("dop853", _dop853.ORDER, True, "Dormand–Prince 8(5,3), adaptive rtol/atol"),
     "cf4": Method("cf4", _liegroup.ORDER, False,
                   "commutator-free Lie-group method CF4 (Celledoni–Marthinsen–Owren 2003), fixed step dt",
-                  conserves="|q| = 1 without projection (exact rotations)"),
+                  conserves="|q| = 1 without projection (exact rotations)", needs=frozenset({"rhs", "body_rate"})),
     "splitting2": Method("splitting2", _splitting.ORDERS["splitting2"], False,
                          "Lie–Poisson splitting of the free body into exact rotations, Strang, fixed step dt",
-                         conserves=_FREE_INVARIANTS, torque=False),
+                         conserves=_FREE_INVARIANTS, needs=frozenset({"torque_free"})),
     "splitting4": Method("splitting4", _splitting.ORDERS["splitting4"], False,
                          "Lie–Poisson splitting of the free body into exact rotations, Blanes–Moan S6, "
-                         "fixed step dt", conserves=_FREE_INVARIANTS, torque=False),
+                         "fixed step dt", conserves=_FREE_INVARIANTS, needs=frozenset({"torque_free"})),
     "exact_split2": Method("exact_split2", _exactsplit.ORDERS["exact_split2"], False,
                            "exact free flow composed with torque kicks, Strang, fixed step dt",
-                           conserves=_SPLIT_INVARIANTS),
+                           conserves=_SPLIT_INVARIANTS, needs=frozenset({"free_flow"})),
     "exact_split4": Method("exact_split4", _exactsplit.ORDERS["exact_split4"], False,
                            "exact free flow composed with torque kicks, Blanes–Moan S6, fixed step dt",
-                           conserves=_SPLIT_INVARIANTS),
+                           conserves=_SPLIT_INVARIANTS, needs=frozenset({"free_flow"})),
     "exact": Method("exact", 0, False, "closed-form torque-free motion (tumble.analytic.torque_free), no steps",
-                    conserves="T, |L|, L_N and |q| = 1 to rounding (the exact flow)", torque=False, stepper=False),
+                    conserves="T, |L|, L_N and |q| = 1 to rounding (the exact flow)",
+                    needs=frozenset({"free_flow", "torque_free"}), stepper=False),
 }
 
 # Fixed-step methods: (compiled scheme, right-hand-side evaluations per step).
@@ -105,8 +120,12 @@ _SCHEMES = {
 _CHUNKS = 100
 
 
-def check_options(method: str, *, dt, rtol, atol, max_steps, torque=None) -> Method:
-    """Validate the solver options for a run under ``torque`` (a torque model, or None); returns the :class:`Method`."""
+def check_options(method: str, *, dt, rtol, atol, max_steps) -> Method:
+    """Validate the options that ``method`` reads; returns the :class:`Method`.
+
+    Options the method does not read are not looked at here (:func:`tumble.simulate`
+    refuses them when they are given).
+    """
     if method not in METHODS:
         raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
     m = METHODS[method]
@@ -121,32 +140,66 @@ def check_options(method: str, *, dt, rtol, atol, max_steps, torque=None) -> Met
         if dt is None:
             raise ValidationError(f"dt: method {method!r} has a fixed step: give dt > 0 (s)")
         require_positive(dt, "dt")
-    if torque is not None and not m.torque:
-        _refuse_torque(method, f"torque={torque!r} given")
     return m
 
 
-def _refuse_torque(method, what):
-    others = ", ".join(repr(name) for name, m in METHODS.items() if m.torque)
-    raise ValidationError(f"torque: method {method!r} integrates torque-free bodies only (it is built from the "
-                          f"exact motion of the free rigid body), but {what}; use one of {others}")
+def check_method(method: str, provides, who: str) -> Method:
+    """Refuse ``method`` unless the model provides every capability it needs; returns the :class:`Method`.
 
-
-def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
-          max_steps=10**9, serial=False, progress=None):
-    """Integrate ``model`` (see :mod:`tumble._model`) for a batch of states ``y0`` (N, n) through ``t``.
-
-    Returns ``(states, stats)``: states
-    of shape (len(t), N, n) and a dict of statistics summed over the batch.
-    ``serial=True`` runs body after body on one core (needed when the model
-    calls back into Python). ``progress(done, total)`` is called after each
-    chunk of output samples.
+    ``provides`` is the set of capabilities of the compiled model and ``who``
+    names the model in the message (e.g. ``"a SloshBody"``), which lists what
+    the method misses and the methods that would work.
     """
-    m = check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
-    if not m.torque and not getattr(model, "torque_free", False):
-        _refuse_torque(method, f"this {type(model).__name__} has a torque")
+    if method not in METHODS:
+        raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
+    m = METHODS[method]
+    missing = m.needs - set(provides)
+    if missing:
+        needs = " and ".join(CAPABILITIES[c] for c in sorted(missing))
+        working = ", ".join(repr(name) for name, other in METHODS.items() if other.needs <= set(provides))
+        raise ValidationError(f"method: {method!r} needs {needs}, which {who} is not; "
+                              f"methods for it: {working}")
+    return m
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The result of :func:`solve`.
+
+    states     : (len(t), N, n) the states at the output times
+    n_steps    : steps taken, summed over the batch (0 for ``"exact"``)
+    n_rejected : adaptive steps rejected, summed over the batch
+    n_rhs      : right-hand-side (or torque) evaluations, summed over the batch
+    """
+
+    states: np.ndarray
+    n_steps: int
+    n_rejected: int
+    n_rhs: int
+
+    def statistics(self) -> dict[str, int]:
+        """``n_steps``, ``n_rejected`` and ``n_rhs`` as a dict (for ``Trajectory.info``)."""
+        return {"n_steps": self.n_steps, "n_rejected": self.n_rejected, "n_rhs": self.n_rhs}
+
+
+def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=10**9, progress=None,
+          device="cpu") -> Solution:
+    """Integrate the compiled ``model`` (:mod:`tumble._protocol`) for a batch of states ``y0`` (N, n) through ``t``.
+
+    ``t`` (s) must be strictly increasing (:func:`tumble._validate.output_times`).
+    A model whose ``calls_python`` is true runs body after body on one core.
+    ``progress(done, total)`` is called after each chunk of output samples.
+    ``device="cuda"`` runs ``rk4`` on an NVIDIA GPU (models that provide ``"cuda"``).
+    """
+    m = check_method(method, model.provides, f"a {type(model).__name__}")
+    check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
     y = np.array(y0, dtype=np.float64, order="C")
     n_out = t.shape[0]
+    if device == "cuda":
+        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
+
+        states, n_steps = _cuda.solve_cuda(model, y, t, dt)
+        return Solution(states, n_steps, 0, 4 * n_steps)
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     stats = np.zeros((y.shape[0], 5))
     bounds = [0, n_out - 1]
@@ -154,17 +207,13 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None,
         bounds = np.unique(np.linspace(0, n_out - 1, min(_CHUNKS, n_out - 1) + 1).astype(int)).tolist()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
-                   dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, serial=serial)
+                   dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, serial=model.calls_python)
         _raise_on_failure(stats, t)
         if progress is not None:
             progress(hi + 1, n_out)
     if n_out == 1:
         out[0] = y
-    return out, {
-        "n_steps": int(stats[:, 0].sum()),
-        "n_rejected": int(stats[:, 1].sum()),
-        "n_rhs": int(stats[:, 2].sum()),
-    }
+    return Solution(out, int(stats[:, 0].sum()), int(stats[:, 1].sum()), int(stats[:, 2].sum()))
 
 
 def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, serial):
@@ -172,11 +221,7 @@ def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, se
     # (its start-up costs more than a short run, and callbacks need the GIL).
     serial = serial or y.shape[0] == 1
     if method == "exact":
-        tasks = y.shape[0] * -(-t.shape[0] // _free_flow._CHUNK)
-        if tasks == 1:  # a short run of one body: no parallel region (its start-up dominates)
-            _free_flow.exact_task(model.moments, y, t, out, 0)
-        else:
-            _free_flow.exact_batch(model.moments, y, t, out)
+        _exact.run(model, y, t, out)
     elif method in _SCHEMES:
         scheme, evaluations = _SCHEMES[method]
         if serial:

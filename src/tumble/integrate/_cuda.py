@@ -1,6 +1,6 @@
 """Classical RK4 for a batch of rigid bodies on an NVIDIA GPU (``numba.cuda``): one thread per body.
 
-This is :mod:`tumble.integrate._rk4` applied to the :class:`tumble._rigid.RigidModel`,
+This is :mod:`tumble.integrate._rk4` applied to the :class:`tumble.kernels.rigid.RigidModel`,
 run as a CUDA kernel. Each thread keeps one body's state in registers,
 ``y = [q_w, q_x, q_y, q_z, ω₁, ω₂, ω₃]`` (attitude of the principal axes P,
 P → inertial; body rate in P, rad/s), and advances it with the same
@@ -43,10 +43,11 @@ from numba import cuda, njit, types
 from numba.extending import overload, register_jitable
 
 from tumble import _quat, torques
-from tumble._model import quaternion_scale
+from tumble._protocol import quaternion_scale
 from tumble._validate import ValidationError
 from tumble.dynamics import euler_principal
 from tumble.integrate._fixed import landing_steps
+from tumble.integrate._rk4 import weighted_sum
 
 #: Threads per block, a multiple of the warp (32). The kernel uses no shared
 #: memory, so what limits the warps resident on a multiprocessor is registers:
@@ -107,11 +108,13 @@ def _rk4_step(c, P, row, codes, t, h, y):
     k2 = _derivative(c, P, row, codes, t + 0.5 * h, _axpy(y, 0.5 * h, k1))
     k3 = _derivative(c, P, row, codes, t + 0.5 * h, _axpy(y, 0.5 * h, k2))
     k4 = _derivative(c, P, row, codes, t + h, _axpy(y, h, k3))
-    slope = (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0], k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1],
-             k1[2] + 2.0 * k2[2] + 2.0 * k3[2] + k4[2], k1[3] + 2.0 * k2[3] + 2.0 * k3[3] + k4[3],
-             k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4], k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5],
-             k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6])
-    qw, qx, qy, qz, w1, w2, w3 = _axpy(y, h / 6.0, slope)
+    qw, qx, qy, qz, w1, w2, w3 = (y[0] + weighted_sum(h, k1[0], k2[0], k3[0], k4[0]),
+                                  y[1] + weighted_sum(h, k1[1], k2[1], k3[1], k4[1]),
+                                  y[2] + weighted_sum(h, k1[2], k2[2], k3[2], k4[2]),
+                                  y[3] + weighted_sum(h, k1[3], k2[3], k3[3], k4[3]),
+                                  y[4] + weighted_sum(h, k1[4], k2[4], k3[4], k4[4]),
+                                  y[5] + weighted_sum(h, k1[5], k2[5], k3[5], k4[5]),
+                                  y[6] + weighted_sum(h, k1[6], k2[6], k3[6], k4[6]))
     s = quaternion_scale(qw, qx, qy, qz)
     return qw * s, qx * s, qy * s, qz * s, w1, w2, w3
 
@@ -150,21 +153,21 @@ def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
         out[k, b, 0], out[k, b, 1], out[k, b, 2], out[k, b, 3], out[k, b, 4], out[k, b, 5], out[k, b, 6] = y
 
 
-def solve_cuda(coefficients, params, codes, y0, t_out, dt) -> tuple[np.ndarray, dict]:
+def solve_cuda(model, y0, t_out, dt) -> tuple[np.ndarray, int]:
     """Integrate a batch of rigid bodies with RK4 on the GPU.
 
-    Returns ``(states, stats)`` as :func:`tumble.integrate.solve` does: the
-    states (len(t_out), N, 7) at the output times and the statistics summed
-    over the batch (``n_steps``, ``n_rejected`` = 0, ``n_rhs`` = 4 ``n_steps``).
+    Returns the states (len(t_out), N, 7) at the output times and the number
+    of steps summed over the batch.
 
-    The arguments are the fields of a :class:`tumble._rigid.RigidModel`
-    (:func:`tumble._rigid.build`) and the initial states:
+    ``model`` is a :class:`tumble.kernels.rigid.RigidModel` (the ``"cuda"``
+    capability), whose fields the kernel reads:
 
     coefficients : (N or 1, 6) Euler coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``,
                    one row per body or one shared
     params : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes : int64 torque-program codes, or None for torque-free bodies
-    y0 : (N, 7) initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s)
+
+    and ``y0`` (N, 7) the initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s)
     t_out : (n,) output times (s), strictly increasing; ``t_out[0]`` is the start
     dt : the longest step (s)
 
@@ -173,7 +176,8 @@ def solve_cuda(coefficients, params, codes, y0, t_out, dt) -> tuple[np.ndarray, 
     Raises :class:`~tumble._validate.ValidationError` for a Python torque
     function, and when no GPU is found.
     """
-    if codes is not None and np.any(np.asarray(codes)[0::2] == torques._PYTHON):
+    coefficients, params, codes = model.coefficients, model.params, model.codes
+    if torques.calls_python(codes):
         raise ValidationError(
             "torque: a Python function cannot run on the GPU (device='cuda'); use the compiled models "
             "(ConstantBody, ConstantInertial, Tabulated, Gravity) or device='cpu'"
@@ -196,5 +200,4 @@ def solve_cuda(coefficients, params, codes, y0, t_out, dt) -> tuple[np.ndarray, 
         cuda.to_device(h),
         out,
     )
-    n_steps = y0.shape[0] * int(m.sum())
-    return out.copy_to_host(), {"n_steps": n_steps, "n_rejected": 0, "n_rhs": 4 * n_steps}
+    return out.copy_to_host(), y0.shape[0] * int(m.sum())

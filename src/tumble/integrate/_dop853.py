@@ -21,7 +21,7 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-from tumble._model import project, rhs, state_size
+from tumble._protocol import project, rhs, state_size
 
 ORDER = 8
 _STAGES = 12

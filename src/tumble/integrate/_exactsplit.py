@@ -5,7 +5,7 @@ The equations of a rigid body under a torque, in principal axes P,
     I ω̇ + ω × (I ω) = τ(t, q, ω),      q̇ = ½ q ⊗ [0, ω],
 
 are split into the free body ``F`` (``τ = 0``; its flow is known in closed
-form, :mod:`tumble._free_flow`, and advances the time ``t``) and the kick
+form, :func:`tumble._protocol.free_evaluate`, and advances the time ``t``) and the kick
 ``K``: ``q`` and ``t`` held fixed, ``ω̇ = I⁻¹ τ(t, q, ω)``. For a torque that
 does not depend on ``ω`` (every compiled torque of :mod:`tumble.torques`:
 constant, tabulated, gravity) the kick is exact: ``ω ← ω + c h I⁻¹ τ(t, q)``.
@@ -52,13 +52,13 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
-from numba.core.errors import TypingError
+from numba import njit
 from numba.extending import overload
 
-from tumble import _free_flow, _model, torques
-from tumble._rigid import RigidModel
+from tumble import _protocol
+from tumble._protocol import free_evaluate, free_setup, torque_acceleration, torque_free
 from tumble.integrate import _fixed
+from tumble.integrate._rk4 import weighted_sum
 from tumble.integrate._splitting import BLANES_MOAN as _S6
 
 
@@ -80,19 +80,13 @@ ORDERS = {"exact_split2": 2, "exact_split4": 4}
 
 
 def _is_exact_split(scheme):
-    return _model.is_type(scheme, ExactSplit)
-
-
-def _check_rigid(model):
-    if not _model.is_type(model, RigidModel):
-        raise TypingError(f"the exact-flow splitting integrates rigid bodies (RigidModel) only, got {model}")
+    return _protocol.is_type(scheme, ExactSplit)
 
 
 @overload(_fixed.workspace, jit_options={"cache": True})
 def _exact_split_workspace(scheme, model, Y):
     if not _is_exact_split(scheme):
         return None
-    _check_rigid(model)
     return lambda scheme, model, Y: ()  # every lane runs on scalars
 
 
@@ -100,20 +94,13 @@ def _exact_split_workspace(scheme, model, Y):
 def _exact_split_advance(scheme, model, b0, t0, h, m, Y, work):
     if not _is_exact_split(scheme):
         return None
-    _check_rigid(model)
-
-    if isinstance(model.types[2], types.NoneType):  # torque-free: F(b₁h) … F(b_sh) = F(h), m times
-
-        def impl(scheme, model, b0, t0, h, m, Y, work):
-            y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))  # one body: a block of one lane
-            for j in range(y.shape[1]):
-                x = _free(model, b0 + j, m * h, _load(y, j))
-                _store(y, j, x)
-
-        return impl
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
-        y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))
+        y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))  # one body: a block of one lane
+        if torque_free(model):  # F(b₁h) … F(b_sh) = F(h), m times: one flow over the interval
+            for j in range(y.shape[1]):
+                _store(y, j, _free(model, b0 + j, m * h, _load(y, j)))
+            return
         a, b = scheme.kicks, scheme.flows
         for j in range(y.shape[1]):
             x = _load(y, j)
@@ -143,21 +130,7 @@ def _store(y, j, x):
 @njit(cache=True)
 def _free(model, b, tau, x):
     """The exact torque-free motion of body ``b`` over ``tau`` (s, any sign) from ``x = [q_NP, ω_P]``."""
-    r = b * (model.moments.shape[0] > 1)
-    mo = _free_flow._setup(model.moments[r, 0], model.moments[r, 1], model.moments[r, 2],
-                           x[4], x[5], x[6], x[0], x[1], x[2], x[3])
-    w1, w2, w3, qw, qx, qy, qz = _free_flow._evaluate(mo, tau)
-    return qw, qx, qy, qz, w1, w2, w3
-
-
-@njit(cache=True, inline="always")
-def _acceleration(model, b, t, x, w1, w2, w3):
-    """``I⁻¹ τ(t, q, ω)`` (rad/s², principal axes) of body ``b`` at the attitude of ``x`` and the rate ``ω``."""
-    r = b * (model.coefficients.shape[0] > 1)
-    c = model.coefficients
-    t1, t2, t3 = torques.evaluate(t, x[0], x[1], x[2], x[3], w1, w2, w3, model.params,
-                                  b * (model.params.shape[0] > 1), model.codes)
-    return c[r, 3] * t1, c[r, 4] * t2, c[r, 5] * t3
+    return free_evaluate(model, free_setup(model, b, x), tau)
 
 
 @njit(cache=True)
@@ -165,10 +138,9 @@ def _kick(model, b, t, tau, x):
     """The kick ``ω̇ = I⁻¹ τ(t, q, ω)`` over ``tau`` (s) at fixed ``t`` and ``q``: one RK4 step of it,
     which for a torque independent of ``ω`` is the exact ``ω + tau I⁻¹ τ(t, q)`` (to rounding)."""
     w1, w2, w3 = x[4], x[5], x[6]
-    k1 = _acceleration(model, b, t, x, w1, w2, w3)
-    k2 = _acceleration(model, b, t, x, w1 + 0.5 * tau * k1[0], w2 + 0.5 * tau * k1[1], w3 + 0.5 * tau * k1[2])
-    k3 = _acceleration(model, b, t, x, w1 + 0.5 * tau * k2[0], w2 + 0.5 * tau * k2[1], w3 + 0.5 * tau * k2[2])
-    k4 = _acceleration(model, b, t, x, w1 + tau * k3[0], w2 + tau * k3[1], w3 + tau * k3[2])
-    d = tau / 6.0
-    return (x[0], x[1], x[2], x[3], w1 + d * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
-            w2 + d * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]), w3 + d * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]))
+    k1 = torque_acceleration(model, b, t, x, w1, w2, w3)
+    k2 = torque_acceleration(model, b, t, x, w1 + 0.5 * tau * k1[0], w2 + 0.5 * tau * k1[1], w3 + 0.5 * tau * k1[2])
+    k3 = torque_acceleration(model, b, t, x, w1 + 0.5 * tau * k2[0], w2 + 0.5 * tau * k2[1], w3 + 0.5 * tau * k2[2])
+    k4 = torque_acceleration(model, b, t, x, w1 + tau * k3[0], w2 + tau * k3[1], w3 + tau * k3[2])
+    return (x[0], x[1], x[2], x[3], w1 + weighted_sum(tau, k1[0], k2[0], k3[0], k4[0]),
+            w2 + weighted_sum(tau, k1[1], k2[1], k3[1], k4[1]), w3 + weighted_sum(tau, k1[2], k2[2], k3[2], k4[2]))

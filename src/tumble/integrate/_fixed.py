@@ -4,7 +4,7 @@ Every fixed-step method (``rk4``, ``splitting2``, ``splitting4``, ``cf4``)
 runs through the drivers below; a method is a *scheme*, a
 :class:`typing.NamedTuple` (its coefficients, if any) that overloads two
 generic functions, in the same way as models overload the protocol of
-:mod:`tumble._model`::
+:mod:`tumble._protocol`::
 
     workspace(scheme, model, Y)                     # scratch arrays for Y (allocated once per run)
     advance(scheme, model, b0, t0, h, m, Y, work)   # m steps of h from t0 (in place)

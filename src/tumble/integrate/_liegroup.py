@@ -10,7 +10,7 @@ CF4 of E. Celledoni, A. Marthinsen & B. Owren, "Commutator-free Lie group
 methods", *Future Generation Computer Systems* 19 (2003) 341-352, written for
 the right action ``q ⊗ exp`` of body rates (``qexp(r)`` is the unit quaternion
 of the rotation vector ``r``; ``ωₛ`` is the body rate of stage ``s``, read
-from the model with :func:`tumble._model.body_rate`)::
+from the model with :func:`tumble._protocol.body_rate`)::
 
     Q₁ = q                                   ω₁ = ω(t,       Q₁, x₁)
     Q₂ = q ⊗ qexp(h ω₁/2)                    ω₂ = ω(t + h/2, Q₂, x₂)
@@ -32,8 +32,8 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from tumble import _model, _quat
-from tumble._model import body_rate, rhs
+from tumble import _protocol, _quat
+from tumble._protocol import body_rate, rhs
 from tumble.integrate import _fixed
 
 ORDER = 4
@@ -76,7 +76,7 @@ def times_unit(qw, qx, qy, qz, ew, ex, ey, ez):
 
 
 def _is_cf4(scheme):
-    return _model.is_type(scheme, CF4)
+    return _protocol.is_type(scheme, CF4)
 
 
 @overload(_fixed.workspace, jit_options={"cache": True})

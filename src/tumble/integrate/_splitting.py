@@ -62,8 +62,8 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from tumble import _model, _quat
-from tumble._model import inverse_moments
+from tumble import _protocol, _quat
+from tumble._protocol import inverse_moments
 from tumble.integrate import _fixed
 from tumble.integrate._liegroup import rotate_right, times_unit
 
@@ -99,7 +99,7 @@ ORDERS = {"splitting2": 2, "splitting4": 4}
 
 
 def _is_splitting(scheme):
-    return _model.is_type(scheme, Splitting)
+    return _protocol.is_type(scheme, Splitting)
 
 
 @overload(_fixed.workspace, jit_options={"cache": True})

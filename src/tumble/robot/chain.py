@@ -41,8 +41,8 @@ from pathlib import Path
 import numpy as np
 
 from tumble._validate import ValidationError, as_array
-from tumble.body import _as_rotation, _as_shape, _frozen, _parallel_axis, principal_axes
-from tumble.robot import _kernels
+from tumble._inertia import as_rotation, as_shape, frozen, parallel_axis, principal_axes
+from tumble.kernels import featherstone as _kernels
 
 __all__ = ["Link", "SerialChain", "load"]
 
@@ -84,26 +84,26 @@ class Link:
         set_ = object.__setattr__
         if self.joint not in JOINT_TYPES:
             raise ValidationError(f"{where}.joint: must be one of {JOINT_TYPES}, got {self.joint!r}")
-        axis = _as_shape(self.axis, f"{where}.axis", (3,))
+        axis = as_shape(self.axis, f"{where}.axis", (3,))
         norm = float(np.linalg.norm(axis))
         if norm < _MIN_AXIS_NORM:
             raise ValidationError(f"{where}.axis: must be a non-zero vector, got {axis.tolist()}")
-        set_(self, "axis", _frozen(axis / norm))
+        set_(self, "axis", frozen(axis / norm))
         for field in ("origin", "frame"):
-            set_(self, f"{field}_position", _frozen(_as_shape(getattr(self, f"{field}_position"),
+            set_(self, f"{field}_position", frozen(as_shape(getattr(self, f"{field}_position"),
                                                               f"{where}.{field}_position", (3,))))
-            set_(self, f"{field}_rotation", _frozen(_as_rotation(getattr(self, f"{field}_rotation"),
+            set_(self, f"{field}_rotation", frozen(as_rotation(getattr(self, f"{field}_rotation"),
                                                                  f"{where}.{field}_rotation")))
-        set_(self, "offset", float(_as_shape(self.offset, f"{where}.offset", ())))
-        mass = float(_as_shape(self.mass, f"{where}.mass", ()))
+        set_(self, "offset", float(as_shape(self.offset, f"{where}.offset", ())))
+        mass = float(as_shape(self.mass, f"{where}.mass", ()))
         if mass < 0.0:
             raise ValidationError(f"{where}.mass: must be >= 0 kg, got {mass}")
         set_(self, "mass", mass)
-        set_(self, "com", _frozen(_as_shape(self.com, f"{where}.com", (3,))))
-        inertia = _as_shape(self.inertia, f"{where}.inertia", (3, 3))
+        set_(self, "com", frozen(as_shape(self.com, f"{where}.com", (3,))))
+        inertia = as_shape(self.inertia, f"{where}.inertia", (3, 3))
         inertia, _, _ = principal_axes(inertia, f"{where}.inertia", definite=False,
                                        check_triangle=self.check_triangle)
-        set_(self, "inertia", _frozen(inertia))
+        set_(self, "inertia", frozen(inertia))
         lower, upper = float(self.lower), float(self.upper)
         if math.isnan(lower) or math.isnan(upper) or lower > upper:
             raise ValidationError(f"{where}.lower/upper: must satisfy lower <= upper, got {lower} and {upper}")
@@ -133,7 +133,7 @@ def _dh_link(row: Mapping, k: int, modified: bool, check_triangle: bool) -> Link
     if unknown:
         raise ValidationError(f"{where}: unknown key(s) {unknown}; allowed: {sorted(_DH_KEYS)}")
     joint = row.get("joint", "revolute")
-    a, alpha, d, theta = (float(_as_shape(row.get(key, 0.0), f"{where}.{key}", ())) for key in
+    a, alpha, d, theta = (float(as_shape(row.get(key, 0.0), f"{where}.{key}", ())) for key in
                           ("a", "alpha", "d", "theta"))
     limits = as_array(row.get("limits", (-math.inf, math.inf)), f"{where}.limits", finite=False)
     if limits.shape != (2,) or np.isnan(limits).any():
@@ -183,11 +183,11 @@ class SerialChain:
                 raise ValidationError(f"links[{k}]: must be a tumble.robot.Link, got {type(link).__name__}")
         set_ = object.__setattr__
         set_(self, "_links", links)
-        set_(self, "_gravity", np.array(_as_shape(gravity, "gravity", (3,))))
+        set_(self, "_gravity", np.array(as_shape(gravity, "gravity", (3,))))
         set_(self, "_name", name)
         set_(self, "_params", _pack(links))
-        set_(self, "_lower", _frozen([link.lower for link in links]))
-        set_(self, "_upper", _frozen([link.upper for link in links]))
+        set_(self, "_lower", frozen([link.lower for link in links]))
+        set_(self, "_upper", frozen([link.upper for link in links]))
         set_(self, "_no_wrench", np.zeros(6))
         set_(self, "_no_wrenches", np.zeros((1, 6)))
         set_(self, "_one_state", (len(links),))  # the shape of one joint array, for the fast path of a call
@@ -265,7 +265,7 @@ class SerialChain:
 
     @property
     def params(self) -> np.ndarray:
-        """(n, 42) array the compiled algorithms read (layout in :mod:`tumble.robot._kernels`), a copy."""
+        """(n, 42) array the compiled algorithms read (layout in :mod:`tumble.kernels.featherstone`), a copy."""
         return self._params.copy()
 
     def within_limits(self, q) -> np.ndarray | bool:
@@ -303,7 +303,7 @@ def _pack(links: tuple[Link, ...]) -> np.ndarray:
         com = Rf @ link.com + pf
         P[i, 17] = link.mass
         P[i, 18:21] = link.mass * com
-        P[i, 21:30] = (Rf @ link.inertia @ Rf.T + _parallel_axis(link.mass, com)).ravel()
+        P[i, 21:30] = (Rf @ link.inertia @ Rf.T + parallel_axis(link.mass, com)).ravel()
         P[i, 30:39] = Rf.ravel()
         P[i, 39:42] = pf
         prev_R, prev_p = Rf, pf

@@ -18,7 +18,7 @@ the moment taken about that frame's origin; shape (6,) or (B, 6).
 
 Algorithms: Featherstone, *Rigid Body Dynamics Algorithms* (Springer 2008):
 RNEA (Table 5.1), CRBA (Table 6.2), ABA (Table 7.1); see
-:mod:`tumble.robot._kernels`. Inputs are checked cheaply: shapes here, and
+:mod:`tumble.kernels.featherstone`. Inputs are checked cheaply: shapes here, and
 finiteness inside the compiled code (a non-finite result makes this layer
 find and name the non-finite input).
 """
@@ -29,7 +29,7 @@ import numba
 import numpy as np
 
 from tumble._validate import ValidationError, as_array
-from tumble.robot import _kernels
+from tumble.kernels import featherstone as _kernels
 from tumble.robot.chain import SerialChain
 
 __all__ = ["rnea", "gravity_torques", "coriolis", "mass_matrix", "forward_dynamics",

@@ -7,7 +7,7 @@ is the articulated-body algorithm::
 
 so every fixed-step and adaptive method of the one integration engine applies
 (``rk4``, ``dop853``), with batches of initial states run in parallel. The
-chain is a model of the protocol of :mod:`tumble._model` (:class:`RobotModel`);
+chain is a model of the protocol of :mod:`tumble._protocol` (:class:`RobotModel`);
 it has no attitude quaternion, so its projection does nothing.
 """
 
@@ -21,9 +21,9 @@ import numpy as np
 from numba import njit, objmode
 from numba.extending import overload
 
-from tumble import _model, integrate
+from tumble import _protocol, integrate
 from tumble._validate import ValidationError, as_array
-from tumble.robot import _kernels
+from tumble.kernels import featherstone as _kernels
 from tumble.robot.chain import SerialChain
 from tumble.trajectory import write_atomic
 
@@ -37,7 +37,7 @@ _ZERO, _CONSTANT, _PYTHON = 0, 1, 2
 class RobotModel(NamedTuple):
     """Compiled parameters of a chain for the integrators.
 
-    params : (n, 42) the chain (:mod:`tumble.robot._kernels`)
+    params : (n, 42) the chain (:mod:`tumble.kernels.featherstone`)
     gravity: (3,) m/s², base frame
     law    : (1,) int64 code of the torque law: zero, constant or a Python function
     torque : (n,) the constant torque (N·m or N)
@@ -49,8 +49,14 @@ class RobotModel(NamedTuple):
     torque: np.ndarray
 
     @property
-    def torque_free(self) -> bool:
-        return False  # not a free rigid body: the free-body methods do not apply
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side (joint coordinates, no attitude)."""
+        return frozenset({"rhs"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque law is a Python function (the batch then runs on one core)."""
+        return int(self.law[0]) == _PYTHON
 
 
 # A Python torque law is reachable from compiled code while its run is in progress.
@@ -99,10 +105,10 @@ def _derivative(model, t, y, ydot):
 
 
 def _is_robot(model):
-    return _model.is_type(model, RobotModel)
+    return _protocol.is_type(model, RobotModel)
 
 
-@overload(_model.rhs, jit_options={"cache": True})
+@overload(_protocol.rhs, jit_options={"cache": True})
 def _robot_rhs(model, b0, t, Y, OUT):
     if not _is_robot(model):
         return None
@@ -119,14 +125,14 @@ def _robot_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_model.project, jit_options={"cache": True})
+@overload(_protocol.project, jit_options={"cache": True})
 def _robot_project(model, b0, t, Y):
     if not _is_robot(model):
         return None
     return lambda model, b0, t, Y: None  # joint coordinates live in a vector space
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _robot_state_size(model):
     if not _is_robot(model):
         return None
@@ -215,8 +221,8 @@ def simulate(chain: SerialChain, q0, qd0, *, t, torque=None, method: str = "rk4"
     if code == _PYTHON:
         _CALLBACK[0] = torque
     try:
-        states, stats = integrate.solve(model, y0, t, method=method, dt=dt, rtol=rtol, atol=atol,
-                                        max_steps=max_steps, serial=code == _PYTHON)
+        solution = integrate.solve(model, y0, t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+        states, stats = solution.states, solution.statistics()
     finally:
         _CALLBACK[0] = None
     if q0.ndim == 1:

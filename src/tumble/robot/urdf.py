@@ -29,7 +29,7 @@ from defusedxml import DefusedXmlException
 from defusedxml import ElementTree
 
 from tumble._validate import ValidationError
-from tumble.body import _parallel_axis, principal_axes
+from tumble._inertia import parallel_axis, principal_axes
 from tumble.robot.chain import Link
 
 __all__ = ["links_from_urdf"]
@@ -218,7 +218,7 @@ def _merged(spec: dict, parts, members: list[str], check_triangle: bool) -> Link
     coms = np.array([c for _, c, _ in parts])
     mass = masses.sum()
     com = masses @ coms / mass if mass > 0.0 else np.zeros(3)
-    inertia = sum(i for _, _, i in parts) + _parallel_axis(masses, coms - com)
+    inertia = sum(i for _, _, i in parts) + parallel_axis(masses, coms - com)
     merged = f" with the fixed link(s) {members[1:]} merged into it" if len(members) > 1 else ""
     principal_axes(inertia, f"link {members[0]!r} <inertial>{merged} (moved by joint {spec['name']!r})",
                    definite=False, check_triangle=check_triangle)

@@ -1,4 +1,4 @@
-"""The spacecraft as a model for the integrators (see :mod:`tumble._model`): compiled equations.
+"""The spacecraft as a model for the integrators (see :mod:`tumble._protocol`): compiled equations.
 
 State vector (``n_w`` wheels, ``n_g`` gyros; the thruster block only when
 the spacecraft has thrusters)::
@@ -26,9 +26,9 @@ Markley & Crassidis 2014, §3.3.5)::
 inertias; ``A_i = h_g,i (g_i × s_i)`` is gyro ``i``'s torque column;
 ``τ`` the external and actuator torques (gravity gradient with the total
 inertia ``J``, thrusters, magnetorquers ``m × B``). The command states have
-zero derivative: :func:`_model.project` refreshes them at the sample times
+zero derivative: :func:`_protocol.project` refreshes them at the sample times
 (zero-order hold); a continuous controller is evaluated in the right-hand
-side itself. The PWPF triggers switch in :func:`_model.project`, at the
+side itself. The PWPF triggers switch in :func:`_protocol.project`, at the
 sample times or, with continuous control, after every step.
 
 Components a spacecraft lacks are ``None`` in :class:`SpacecraftModel`
@@ -45,7 +45,8 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from tumble import _model, _quat
+from tumble import _protocol, _quat
+from tumble._vec import clip, cross, matvec_flat, solve_symmetric
 from tumble.spacecraft._params import (GYRO_STRIDE, ROUTE_MAGNETORQUERS, SAMPLE_TOLERANCE, THRUSTER_STRIDE,
                                        WHEEL_STRIDE, SpacecraftModel)
 from tumble.spacecraft.environment import dipole_field, gravity_gradient_torque
@@ -54,37 +55,6 @@ from tumble.spacecraft.orbit import orbit_state
 def _has(model, name: str) -> bool:
     """True when the field ``name`` of the (Numba) model type is not None."""
     return not isinstance(model.types[model.fields.index(name)], types.NoneType)
-
-
-@njit(cache=True)
-def _solve3(a00, a01, a02, a11, a12, a22, b0, b1, b2):
-    """Solve the symmetric 3×3 system ``A x = b`` by Cramer's rule (A positive definite)."""
-    c00 = a11 * a22 - a12 * a12
-    c01 = a02 * a12 - a01 * a22
-    c02 = a01 * a12 - a02 * a11
-    c11 = a00 * a22 - a02 * a02
-    c12 = a01 * a02 - a00 * a12
-    c22 = a00 * a11 - a01 * a01
-    det = a00 * c00 + a01 * c01 + a02 * c02
-    return ((c00 * b0 + c01 * b1 + c02 * b2) / det, (c01 * b0 + c11 * b1 + c12 * b2) / det,
-            (c02 * b0 + c12 * b1 + c22 * b2) / det)
-
-
-@njit(cache=True)
-def _mat3(d, o, x, y, z):
-    """``M v`` for the row-major 3×3 matrix ``M = d[o:o+9]``."""
-    return (d[o] * x + d[o + 1] * y + d[o + 2] * z, d[o + 3] * x + d[o + 4] * y + d[o + 5] * z,
-            d[o + 6] * x + d[o + 7] * y + d[o + 8] * z)
-
-
-@njit(cache=True)
-def _cross(ax, ay, az, bx, by, bz):
-    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-
-
-@njit(cache=True)
-def _clip(x, limit):
-    return min(max(x, -limit), limit)
 
 
 @functools.lru_cache(maxsize=None)
@@ -166,13 +136,13 @@ def _kernels(model, ndim):
             ew, ex, ey, ez = _quat.qmul(d[o + 18], -d[o + 19], -d[o + 20], -d[o + 21], qw, qx, qy, qz)
             if ew < 0.0:
                 ex, ey, ez = -ex, -ey, -ez
-            c1, c2, c3 = _mat3(d, o + 9, -ex, -ey, -ez)
+            c1, c2, c3 = matvec_flat(d, o + 9, -ex, -ey, -ez)
             rate = math.sqrt(c1 * c1 + c2 * c2 + c3 * c3)
             if rate > d[o + 22]:  # eigen-axis slew at the rate limit (Wie & Lu 1995)
                 s = d[o + 22] / rate
                 c1, c2, c3 = s * c1, s * c2, s * c3
-            g1, g2, g3 = _cross(w1, w2, w3, H1, H2, H3)
-            u1, u2, u3 = _mat3(d, o, c1 - w1, c2 - w2, c3 - w3)
+            g1, g2, g3 = cross(w1, w2, w3, H1, H2, H3)
+            u1, u2, u3 = matvec_flat(d, o, c1 - w1, c2 - w2, c3 - w3)
             k = d[o + 24]
             u1, u2, u3 = u1 + k * g1 + d[o + 25], u2 + k * g2 + d[o + 26], u3 + k * g3 + d[o + 27]
             big = max(abs(u1), abs(u2), abs(u3))
@@ -189,7 +159,7 @@ def _kernels(model, ndim):
         @inline
         def bdot_law(model, d, w1, w2, w3, b1, b2, b3):
             k = d[model.o_bdot]
-            m1, m2, m3 = _cross(w1, w2, w3, b1, b2, b3)
+            m1, m2, m3 = cross(w1, w2, w3, b1, b2, b3)
             return k * m1, k * m2, k * m3
     else:
         @inline
@@ -200,7 +170,7 @@ def _kernels(model, ndim):
         @inline
         def dumping_law(model, d, h1, h2, h3, b1, b2, b3):
             k = d[model.o_dumping] / (b1 * b1 + b2 * b2 + b3 * b3)
-            m1, m2, m3 = _cross(h1, h2, h3, b1, b2, b3)
+            m1, m2, m3 = cross(h1, h2, h3, b1, b2, b3)
             return k * m1, k * m2, k * m3
     else:
         @inline
@@ -242,7 +212,7 @@ def _kernels(model, ndim):
             det = (m00 * (m11 * m22 - m12 * m12) - m01 * (m01 * m22 - m12 * m02)
                    + m02 * (m01 * m12 - m11 * m02)) / (hb2 * hb2 * hb2)
             lam = d[law] * math.exp(-d[law + 1] * det) * hb2
-            x1, x2, x3 = _solve3(m00 + lam, m01, m02, m11 + lam, m12, m22 + lam, -u1, -u2, -u3)
+            x1, x2, x3 = solve_symmetric(m00 + lam, m01, m02, m11 + lam, m12, m22 + lam, -u1, -u2, -u3)
             t1 = t2 = t3 = 0.0
             nw = model.n_wheels
             for i in range(model.n_gyros):
@@ -251,7 +221,7 @@ def _kernels(model, ndim):
                 a1 = h * (cd * d[b + 6] - sd * d[b + 3])
                 a2 = h * (cd * d[b + 7] - sd * d[b + 4])
                 a3 = h * (cd * d[b + 8] - sd * d[b + 5])
-                rate = _clip(a1 * x1 + a2 * x2 + a3 * x3, d[law + 3])
+                rate = clip(a1 * x1 + a2 * x2 + a3 * x3, d[law + 3])
                 put(out, o_g + i, j, rate)
                 t1 -= a1 * rate
                 t2 -= a2 * rate
@@ -316,8 +286,8 @@ def _kernels(model, ndim):
         @inline
         def magnetic_torque(model, d, m1, m2, m3, b1, b2, b3):
             o = model.o_dipole
-            m1, m2, m3 = _clip(m1, d[o]), _clip(m2, d[o + 1]), _clip(m3, d[o + 2])
-            t1, t2, t3 = _cross(m1, m2, m3, b1, b2, b3)
+            m1, m2, m3 = clip(m1, d[o]), clip(m2, d[o + 1]), clip(m3, d[o + 2])
+            t1, t2, t3 = cross(m1, m2, m3, b1, b2, b3)
             return t1, t2, t3, m1, m2, m3
     else:
         @inline
@@ -328,7 +298,7 @@ def _kernels(model, ndim):
     @inline
     def momenta(model, d, y, j):
         """(H, h_wheels): total and wheel angular momentum, body axes, N·m·s."""
-        H1, H2, H3 = _mat3(d, 9, at(y, 4, j), at(y, 5, j), at(y, 6, j))
+        H1, H2, H3 = matvec_flat(d, 9, at(y, 4, j), at(y, 5, j), at(y, 6, j))
         h1 = h2 = h3 = 0.0
         for i in range(model.n_wheels):
             b = model.o_wheels + WHEEL_STRIDE * i
@@ -348,7 +318,7 @@ def _kernels(model, ndim):
         m1, m2, m3 = m1 + e1, m2 + e2, m3 + e3
         if d[29] == ROUTE_MAGNETORQUERS:  # m = B × u / |B|²: the part of u normal to B
             k = 1.0 / (b1 * b1 + b2 * b2 + b3 * b3)
-            e1, e2, e3 = _cross(b1, b2, b3, u1, u2, u3)
+            e1, e2, e3 = cross(b1, b2, b3, u1, u2, u3)
             m1, m2, m3 = m1 + k * e1, m2 + k * e2, m3 + k * e3
         return u1, u2, u3, m1, m2, m3
 
@@ -378,7 +348,7 @@ def _kernels(model, ndim):
             b = model.o_wheels + WHEEL_STRIDE * i
             a1, a2, a3 = d[b], d[b + 1], d[b + 2]
             speed = at(y, 7 + i, j) / d[b + 3] - (a1 * w1 + a2 * w2 + a3 * w3)
-            motor = _clip(-(d[b + 9] * u1 + d[b + 10] * u2 + d[b + 11] * u3), d[b + 4])
+            motor = clip(-(d[b + 9] * u1 + d[b + 10] * u2 + d[b + 11] * u3), d[b + 4])
             saturated = abs(speed) >= d[b + 5] and motor * speed > 0.0
             if saturated:
                 motor = 0.0
@@ -399,8 +369,8 @@ def _kernels(model, ndim):
         n1, n2, n3, m1, m2, m3 = magnetic_torque(model, d, m1, m2, m3, b1, b2, b3)
         g1, g2, g3 = gravity(model, d, t, qw, qx, qy, qz)
         x1, x2, x3 = t1 + c1 + r1 + n1, t2 + c2 + r2 + n2, t3 + c3 + r3 + n3
-        k1, k2, k3 = _cross(w1, w2, w3, H1, H2, H3)
-        a1, a2, a3 = _mat3(d, 18, x1 + g1 - k1, x2 + g2 - k2, x3 + g3 - k3)
+        k1, k2, k3 = cross(w1, w2, w3, H1, H2, H3)
+        a1, a2, a3 = matvec_flat(d, 18, x1 + g1 - k1, x2 + g2 - k2, x3 + g3 - k3)
         e = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
         put(out, 0, j, 0.5 * e[0])
         put3(out, 1, j, 0.5 * e[1], 0.5 * e[2], 0.5 * e[3])
@@ -433,10 +403,10 @@ def _kernels(model, ndim):
 
 
 def _is_spacecraft(model):
-    return _model.is_type(model, SpacecraftModel)
+    return _protocol.is_type(model, SpacecraftModel)
 
 
-@overload(_model.rhs, jit_options={"cache": True})
+@overload(_protocol.rhs, jit_options={"cache": True})
 def _spacecraft_rhs(model, b0, t, Y, OUT):
     if not _is_spacecraft(model):
         return None
@@ -451,7 +421,7 @@ def _spacecraft_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_model.project, jit_options={"cache": True})
+@overload(_protocol.project, jit_options={"cache": True})
 def _spacecraft_project(model, b0, t, Y):
     if not _is_spacecraft(model):
         return None
@@ -460,9 +430,9 @@ def _spacecraft_project(model, b0, t, Y):
     # thrusters the projection is the normalisation alone
     continuous_updates = _has(model, "thrusters")
     if Y.ndim == 1:
-        normalize, lanes = _model.normalize_quaternion, njit(inline="always")(lambda Y: 1)
+        normalize, lanes = _protocol.normalize_quaternion, njit(inline="always")(lambda Y: 1)
     else:
-        normalize, lanes = _model.normalize_quaternions, njit(inline="always")(lambda Y: Y.shape[1])
+        normalize, lanes = _protocol.normalize_quaternions, njit(inline="always")(lambda Y: Y.shape[1])
 
     def impl(model, b0, t, Y):
         normalize(Y)
@@ -479,7 +449,7 @@ def _spacecraft_project(model, b0, t, Y):
     return impl
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _spacecraft_state_size(model):
     if not _is_spacecraft(model):
         return None
@@ -491,11 +461,11 @@ def _spacecraft_state_size(model):
     return impl
 
 
-@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
 def _spacecraft_body_rate(model, Y, j):
     if not _is_spacecraft(model):
         return None
-    return _model.rate_at(4, Y)
+    return _protocol.rate_at(4, Y)
 
 
 def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload in compiled code

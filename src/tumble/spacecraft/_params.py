@@ -65,7 +65,13 @@ class SpacecraftModel(NamedTuple):
     dumping: bool | None
 
     @property
-    def torque_free(self) -> bool:
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
+
+    @property
+    def calls_python(self) -> bool:
+        """False: every part of the spacecraft runs compiled."""
         return False
 
 

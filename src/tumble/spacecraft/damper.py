@@ -21,7 +21,7 @@ sphere. Without external torque the total angular momentum
 the body ends in the state of least energy for its ``|L|``, a spin about the
 axis of largest moment (the major-axis rule; :mod:`tumble.spacecraft.passive`).
 
-State of the model (:mod:`tumble._model` protocol), ``y = [q_w, q_x, q_y,
+State of the model (:mod:`tumble._protocol` protocol), ``y = [q_w, q_x, q_y,
 q_z, ω₁, ω₂, ω₃, ω_d1, ω_d2, ω_d3]``; results come back as a
 :class:`tumble.Trajectory` with the sphere's rate in
 ``extras["damper_omega"]``.
@@ -47,7 +47,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from tumble import _model, _quat, attitude, integrate, torques
+from tumble import _protocol, _quat, attitude, integrate, torques
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
 from tumble.trajectory import Extra, Trajectory
@@ -112,9 +112,14 @@ class DamperModel(NamedTuple):
     codes: np.ndarray | None
 
     @property
-    def torque_free(self) -> bool:
-        """Always False: the damper torque acts on the hub (the free-rigid-body methods do not apply)."""
-        return False
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.calls_python(self.codes)
 
 
 def build(body: RigidBody, damper: SphericalDamper, torque=None) -> DamperModel:
@@ -130,10 +135,10 @@ def build(body: RigidBody, damper: SphericalDamper, torque=None) -> DamperModel:
 
 
 def _is_damper(model):
-    return _model.is_type(model, DamperModel)
+    return _protocol.is_type(model, DamperModel)
 
 
-@overload(_model.rhs, inline="always", jit_options={"cache": True})
+@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
 def _damper_rhs(model, b0, t, Y, OUT):
     if not _is_damper(model):
         return None
@@ -191,25 +196,25 @@ def _damper_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_model.project, inline="always", jit_options={"cache": True})
+@overload(_protocol.project, inline="always", jit_options={"cache": True})
 def _damper_project(model, b0, t, Y):
     if not _is_damper(model):
         return None
-    return _model.quaternion_projection(Y)
+    return _protocol.quaternion_projection(Y)
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _damper_state_size(model):
     if not _is_damper(model):
         return None
     return lambda model: STATE_SIZE
 
 
-@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
 def _damper_body_rate(model, Y, j):
     if not _is_damper(model):
         return None
-    return _model.rate_at(4, Y)
+    return _protocol.rate_at(4, Y)
 
 
 def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0, *, t, q0=None, damper_omega0=None,
@@ -256,8 +261,9 @@ def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0, *, t, q0=N
     except ValueError:
         raise ValidationError(f"q0, damper_omega0: must broadcast to the batch of omega0 {omega0.shape}") from None
     model = build(body, damper, torque)
-    states, stats = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
+    solution = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
                                     max_steps=max_steps, progress=progress)
+    states, stats = solution.states, solution.statistics()
     if not batch:
         states = states[:, 0]
     info = {"torque": repr(torques.as_torque_model(torque)) if torque is not None else "none",

@@ -316,8 +316,9 @@ def simulate(spacecraft: Spacecraft, omega0, *, t, q0=None, wheel_speeds0=None, 
     model = spacecraft.model(float(times[0]))
     for y in y0:
         _kernel.initialise(model, float(times[0]), y)
-    states, stats = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
+    solution = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
                                     max_steps=max_steps, progress=progress)
+    states, stats = solution.states, solution.statistics()
     return _trajectory(spacecraft, model, times, states, method, stats, dt, rtol, atol)
 
 

@@ -27,7 +27,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.body import _frozen, principal_axes
+from tumble._inertia import frozen, principal_axes
 
 __all__ = ["VariableBody"]
 
@@ -80,9 +80,9 @@ class VariableBody:
         if shape_momentum.shape != (t.size, 3):
             raise ValidationError(f"shape_momentum: must have shape ({t.size}, 3), got {shape_momentum.shape}")
         channels = np.concatenate([inertia[:, _ROWS, _COLS], shape_momentum], axis=1)
-        self._t = _frozen(t)
-        self._inertia = _frozen(inertia)
-        self._shape_momentum = _frozen(shape_momentum)
+        self._t = frozen(t)
+        self._inertia = frozen(inertia)
+        self._shape_momentum = frozen(shape_momentum)
         self._spline = CubicSpline(t, channels, axis=0, bc_type="not-a-knot")
 
     @classmethod

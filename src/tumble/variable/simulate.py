@@ -6,7 +6,7 @@ Solves the equations of a deformable body in a body frame B::
 
 (Euler's law ``dL/dt = τ`` for the angular momentum about the centre of mass,
 written in the rotating axes of B), as the model of
-:mod:`tumble.variable._model`: the state holds ``L`` in inertial axes, which no
+:mod:`tumble.kernels.variable`: the state holds ``L`` in inertial axes, which no
 integrator changes when there is no torque, so ``|L|`` is conserved to
 rounding. The rotational energy ``T = ½ ω·Iω`` is *not* conserved: the
 muscles (or actuators) that change the shape work on the body at the rate
@@ -24,7 +24,7 @@ import numpy as np
 from tumble import attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
 from tumble.trajectory import Extra, Trajectory
-from tumble.variable import _model
+from tumble.kernels import variable as _model
 from tumble.variable.body import VariableBody
 
 __all__ = ["METHODS", "angular_velocity", "shape_power", "simulate_variable"]
@@ -79,7 +79,7 @@ def simulate_variable(
     if method not in METHODS:
         raise ValidationError(f"method: a body whose inertia changes is integrated by one of {list(METHODS)}, "
                               f"got {method!r} (the splitting and exact methods are built on the rigid body)")
-    integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque)
+    integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
     times = as_array(t, "t")
     if times.ndim != 1 or times.size < 1 or np.any(np.diff(times) <= 0.0):
         raise ValidationError(f"t: must be a 1-D array of strictly increasing output times, got shape {times.shape}")
@@ -105,9 +105,8 @@ def simulate_variable(
     y0[:, 7] = times[0]
     model = torques.as_torque_model(torque)
     compiled = _model.build(body, model)
-    with torques.registered(model):
-        states, stats = integrate.solve(compiled, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
-                                        max_steps=max_steps, serial=model is not None and model.needs_python)
+    solution = integrate.solve(compiled, y0, times, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+    states, stats = solution.states, solution.statistics()
 
     q = states[..., :4]
     momentum_body = attitude.rotate_inverse(q, states[..., 4:7])              # (n, B, 3)

@@ -41,6 +41,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from tumble._vec import cross
+
 PARAMS = 42
 REVOLUTE, PRISMATIC = 0, 1
 # Compiler options: fused multiply-adds allowed (contraction only: no reassociation,
@@ -55,12 +57,6 @@ _W_RNEA = 18   # transform (12), force (6)
 _W_CRBA = 25   # transform (12), composite inertia m, h, I_O (13)
 _W_ABA = 80    # transform (12), v (6), c (6), I^A (36), p^A (6), U (6), D, u, p^a (6)
 _W_POSE = 12   # transform (12)
-
-
-@njit(**_INLINE)
-def _cross(ax, ay, az, bx, by, bz):
-    """``a × b``."""
-    return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
 @njit(**_INLINE)
@@ -107,7 +103,7 @@ def _rot(A, i, o, x, y, z):
 @njit(**_INLINE)
 def _motion_to_child(W, i, wx, wy, wz, vx, vy, vz):
     """``X_i m``: motion vector (ω, v) of frame i−1 in frame i: ``(Rᵀ ω, Rᵀ (v − p × ω))``."""
-    cx, cy, cz = _cross(W[i, 9], W[i, 10], W[i, 11], wx, wy, wz)
+    cx, cy, cz = cross(W[i, 9], W[i, 10], W[i, 11], wx, wy, wz)
     a = _rot_t(W, i, 0, wx, wy, wz)
     b = _rot_t(W, i, 0, vx - cx, vy - cy, vz - cz)
     return a[0], a[1], a[2], b[0], b[1], b[2]
@@ -121,7 +117,7 @@ def _force_to_parent(A, i, o, nx, ny, nz, fx, fy, fz):
     """
     f = _rot(A, i, o, fx, fy, fz)
     n = _rot(A, i, o, nx, ny, nz)
-    c = _cross(A[i, o + 9], A[i, o + 10], A[i, o + 11], f[0], f[1], f[2])
+    c = cross(A[i, o + 9], A[i, o + 10], A[i, o + 11], f[0], f[1], f[2])
     return n[0] + c[0], n[1] + c[1], n[2] + c[2], f[0], f[1], f[2]
 
 
@@ -129,8 +125,8 @@ def _force_to_parent(A, i, o, nx, ny, nz, fx, fy, fz):
 def _inertia_times(P, i, wx, wy, wz, vx, vy, vz):
     """Rigid-body inertia of link i times a motion vector: ``(I_O ω + h × v, m v − h × ω)``."""
     hx, hy, hz = P[i, 18], P[i, 19], P[i, 20]
-    a = _cross(hx, hy, hz, vx, vy, vz)
-    b = _cross(hx, hy, hz, wx, wy, wz)
+    a = cross(hx, hy, hz, vx, vy, vz)
+    b = cross(hx, hy, hz, wx, wy, wz)
     m = P[i, 17]
     return (P[i, 21] * wx + P[i, 22] * wy + P[i, 23] * wz + a[0],
             P[i, 24] * wx + P[i, 25] * wy + P[i, 26] * wz + a[1],
@@ -165,20 +161,20 @@ def rnea_one(P, q, qd, qdd, g, fext, W, tau):
         sx, sy, sz = P[i, 12], P[i, 13], P[i, 14]
         if P[i, 15] == REVOLUTE:
             wx, wy, wz = wx + sx * qd[i], wy + sy * qd[i], wz + sz * qd[i]
-            c = _cross(wx, wy, wz, sx * qd[i], sy * qd[i], sz * qd[i])
-            d = _cross(vx, vy, vz, sx * qd[i], sy * qd[i], sz * qd[i])
+            c = cross(wx, wy, wz, sx * qd[i], sy * qd[i], sz * qd[i])
+            d = cross(vx, vy, vz, sx * qd[i], sy * qd[i], sz * qd[i])
             ax, ay, az = ax + sx * qdd[i] + c[0], ay + sy * qdd[i] + c[1], az + sz * qdd[i] + c[2]
             lx, ly, lz = lx + d[0], ly + d[1], lz + d[2]
         else:
             vx, vy, vz = vx + sx * qd[i], vy + sy * qd[i], vz + sz * qd[i]
-            c = _cross(wx, wy, wz, sx * qd[i], sy * qd[i], sz * qd[i])
+            c = cross(wx, wy, wz, sx * qd[i], sy * qd[i], sz * qd[i])
             lx, ly, lz = lx + sx * qdd[i] + c[0], ly + sy * qdd[i] + c[1], lz + sz * qdd[i] + c[2]
         # f = I a + v ×* (I v),  v ×* (n, f) = (ω × n + v × f, ω × f)
         f = _inertia_times(P, i, ax, ay, az, lx, ly, lz)
         h = _inertia_times(P, i, wx, wy, wz, vx, vy, vz)
-        c1 = _cross(wx, wy, wz, h[0], h[1], h[2])
-        c2 = _cross(vx, vy, vz, h[3], h[4], h[5])
-        c3 = _cross(wx, wy, wz, h[3], h[4], h[5])
+        c1 = cross(wx, wy, wz, h[0], h[1], h[2])
+        c2 = cross(vx, vy, vz, h[3], h[4], h[5])
+        c3 = cross(wx, wy, wz, h[3], h[4], h[5])
         W[i, 12], W[i, 13], W[i, 14] = f[0] + c1[0] + c2[0], f[1] + c1[1] + c2[1], f[2] + c1[2] + c2[2]
         W[i, 15], W[i, 16], W[i, 17] = f[3] + c3[0], f[4] + c3[1], f[5] + c3[2]
     e = _external(P, fext)
@@ -221,11 +217,11 @@ def _motion_subspace_force(W, i, o, s_rev, sx, sy, sz):
     """``F = I S`` for a composite rigid inertia (m, h, I_O) at ``W[i, o:o+13]`` and joint axis s."""
     m, hx, hy, hz = W[i, o], W[i, o + 1], W[i, o + 2], W[i, o + 3]
     if s_rev:  # S = (s, 0): (I_O s, s × h)
-        c = _cross(sx, sy, sz, hx, hy, hz)
+        c = cross(sx, sy, sz, hx, hy, hz)
         return (W[i, o + 4] * sx + W[i, o + 5] * sy + W[i, o + 6] * sz,
                 W[i, o + 7] * sx + W[i, o + 8] * sy + W[i, o + 9] * sz,
                 W[i, o + 10] * sx + W[i, o + 11] * sy + W[i, o + 12] * sz, c[0], c[1], c[2])
-    c = _cross(hx, hy, hz, sx, sy, sz)  # S = (0, s): (h × s, m s)
+    c = cross(hx, hy, hz, sx, sy, sz)  # S = (0, s): (h × s, m s)
     return c[0], c[1], c[2], m * sx, m * sy, m * sz
 
 
@@ -312,7 +308,7 @@ def _add_articulated_to_parent(W, i, X, T):
     for r in range(3):
         # row r of −E [p]× is −(eᵣᵀ [p]×) = −(eᵣ × p)ᵀ = (p × eᵣ)ᵀ,
         # eᵣ = row r of E = column r of R
-        c = _cross(W[i, 9], W[i, 10], W[i, 11], W[i, r], W[i, 3 + r], W[i, 6 + r])
+        c = cross(W[i, 9], W[i, 10], W[i, 11], W[i, r], W[i, 3 + r], W[i, 6 + r])
         X[3 + r, 0], X[3 + r, 1], X[3 + r, 2] = c[0], c[1], c[2]
     for r in range(6):  # T = I^a X
         for c in range(6):
@@ -342,12 +338,12 @@ def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
         sx, sy, sz = P[i, 12] * qd[i], P[i, 13] * qd[i], P[i, 14] * qd[i]
         if P[i, 15] == REVOLUTE:
             wx, wy, wz = wx + sx, wy + sy, wz + sz
-            c1 = _cross(wx, wy, wz, sx, sy, sz)
-            c2 = _cross(vx, vy, vz, sx, sy, sz)
+            c1 = cross(wx, wy, wz, sx, sy, sz)
+            c2 = cross(vx, vy, vz, sx, sy, sz)
         else:
             vx, vy, vz = vx + sx, vy + sy, vz + sz
             c1 = (0.0, 0.0, 0.0)
-            c2 = _cross(wx, wy, wz, sx, sy, sz)
+            c2 = cross(wx, wy, wz, sx, sy, sz)
         W[i, 12], W[i, 13], W[i, 14], W[i, 15], W[i, 16], W[i, 17] = wx, wy, wz, vx, vy, vz
         W[i, 18], W[i, 19], W[i, 20], W[i, 21], W[i, 22], W[i, 23] = c1[0], c1[1], c1[2], c2[0], c2[1], c2[2]
         # I^A = [[I_O, [h]×], [−[h]×, m E]]
@@ -362,9 +358,9 @@ def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
                 W[i, 24 + 6 * r + 3 + c] = hxm[r][c]
                 W[i, 24 + 6 * (3 + r) + c] = -hxm[r][c]
         h = _inertia_times(P, i, wx, wy, wz, vx, vy, vz)
-        d1 = _cross(wx, wy, wz, h[0], h[1], h[2])
-        d2 = _cross(vx, vy, vz, h[3], h[4], h[5])
-        d3 = _cross(wx, wy, wz, h[3], h[4], h[5])
+        d1 = cross(wx, wy, wz, h[0], h[1], h[2])
+        d2 = cross(vx, vy, vz, h[3], h[4], h[5])
+        d3 = cross(wx, wy, wz, h[3], h[4], h[5])
         W[i, 60], W[i, 61], W[i, 62] = d1[0] + d2[0], d1[1] + d2[1], d1[2] + d2[2]
         W[i, 63], W[i, 64], W[i, 65] = d3[0], d3[1], d3[2]
     e = _external(P, fext)

@@ -1,42 +1,54 @@
-"""The model protocol: what an integrator needs from the thing it integrates.
+"""The model protocol: what an integrator needs from the compiled model it integrates.
 
-A *model* is an immutable :class:`typing.NamedTuple` of NumPy arrays (its
-parameters: one row shared by the whole batch, or one row per body). Its state
-is a flat float64 vector whose first four entries are the attitude quaternion
-(scalar first). Integrators hold states as structure-of-arrays *blocks*
-``Y[i, j]`` = component ``i`` of batch member ``b0 + j``, so that the loop
-over the lanes ``j`` compiles to SIMD instructions. A model type provides,
-through :func:`numba.extending.overload` of the three generic functions below,
-its right-hand side, its projection back onto the state manifold and its
-state size::
+A *compiled model* (a *kernel*) is an immutable :class:`typing.NamedTuple` of
+NumPy arrays (its parameters: one row shared by the whole batch, or one row
+per body), built by a user-level model (:class:`tumble.simulate.Model`). Its
+state is a flat float64 vector. Integrators hold states as
+structure-of-arrays *blocks* ``Y[i, j]`` = component ``i`` of batch member
+``b0 + j``, so that the loop over the lanes ``j`` compiles to SIMD
+instructions. A kernel type provides, through
+:func:`numba.extending.overload` of the generic functions below, what the
+methods need. Every kernel provides the core three::
 
     rhs(model, b0, t, Y, OUT)    # OUT[:, j] = dy/dt of batch member b0 + j at (t, Y[:, j])
     project(model, b0, t, Y)     # after a step that ends at t: e.g. normalise the quaternion
-                                 # Y[0:4, j] of every lane; also the place of discrete updates
+                                 # of every lane; also the place of discrete updates
     state_size(model)            # length of the state vector, a compile-time constant
 
 where ``Y`` is a block (state × lanes) or the state vector of one body
 (``Y[i]``, batch member ``b0``); the overloads specialise on ``Y.ndim``.
 
-Two more functions serve the geometric integrators (:mod:`tumble.integrate`);
-a model provides those that apply to it::
+The others serve particular methods; a kernel provides those that apply to
+it, and says so in Python with its ``provides`` property, a set of the
+capability names of :data:`CAPABILITIES`. A method declares the capabilities
+it needs (:class:`tumble.integrate.Method`), and one check
+(:func:`tumble.integrate.check_method`) refuses a mismatch before anything
+compiles::
 
-    body_rate(model, Y, j)       # (ω₁, ω₂, ω₃) of lane j (rad/s, body axes of the quaternion):
-                                 # q̇ = ½ q ⊗ [0, ω]; the Lie-group method (cf4) needs it
-    inverse_moments(model, b)    # (1/I₁, 1/I₂, 1/I₃) of batch member b, principal axes (1/(kg·m²)),
-                                 # for a torque-free rigid body whose state is [q, ω]; the
-                                 # splitting methods need it
+    "rhs"          rhs, project, state_size (every kernel)
+    "body_rate"    body_rate(model, Y, j) -> (ω₁, ω₂, ω₃) of lane j (rad/s, body axes of the
+                   quaternion Y[0:4]): q̇ = ½ q ⊗ [0, ω]; the Lie-group method (cf4)
+    "free_flow"    the state is [q_NP, ω_P] (7) of a rigid body in principal axes P, and
+                   free_setup(model, b, x) -> motion,  free_evaluate(model, motion, τ) -> x
+                   give its closed-form torque-free motion over τ seconds (any sign), while
+                   torque_acceleration(model, b, t, x, ω₁, ω₂, ω₃) -> I⁻¹τ (rad/s²) and
+                   torque_free(model) -> bool (a compile-time constant) give the kicks of
+                   the torque; the exact method and the exact-flow splittings
+    "torque_free"  no torque at all: the state is [q_NP, ω_P] and
+                   inverse_moments(model, b) -> (1/I₁, 1/I₂, 1/I₃); the Lie–Poisson splittings
+    "cuda"         the kernel's fields are those that tumble.integrate._cuda reads (a rigid
+                   body with a compiled torque program): rk4 on an NVIDIA GPU
 
-A model also tells Python code whether it has an external torque: the
-attribute ``torque_free`` (True when it has none) is read by
-:func:`tumble.integrate.solve`, which refuses a free-body-only method otherwise.
+A kernel also tells Python whether it calls back into the interpreter
+(``calls_python``): the integrators then run its batch on one core.
 
 The integrators call these generic functions; Numba picks the implementation
 from the model's type when it compiles the integrator, so each model gets its
 own fully inlined integrator, and the compiled code is cached on disk. (Passing
 functions as arguments instead would defeat the disk cache, and a run-time
 switch on a model code costs 2–3× in the inner loop.) Adding a model is one
-module: a NamedTuple, its overloads, and a row in ``docs/architecture.md``.
+kernel file under :mod:`tumble.kernels` and one model file above the engine
+(``docs/architecture.md``).
 """
 
 from __future__ import annotations
@@ -94,6 +106,39 @@ def inverse_moments(model, b):  # pragma: no cover - replaced by overloads in co
     whose motion is torque-free provide it: the splitting methods rely on both.
     """
     raise NotImplementedError(f"{type(model).__name__} is not a torque-free rigid body")
+
+
+#: What a compiled model can provide to the methods, in the words of the error message that
+#: names what a method misses (see the module docstring for the functions behind each).
+CAPABILITIES = {
+    "rhs": "a right-hand side",
+    "body_rate": "the body rate of its attitude quaternion",
+    "free_flow": "the closed-form motion of a free rigid body, with torque kicks",
+    "torque_free": "a rigid body without torque",
+    "cuda": "an RK4 kernel for NVIDIA GPUs (device='cuda')",
+}
+
+
+def free_setup(model, b, x):  # pragma: no cover - replaced by overloads in compiled code
+    """The torque-free motion of batch member ``b`` from the state ``x = (q_NP, ω_P)`` (a 7-tuple),
+    in a form that :func:`free_evaluate` reads (``"free_flow"``)."""
+    raise NotImplementedError(f"{type(model).__name__} has no closed-form free motion")
+
+
+def free_evaluate(model, motion, tau):  # pragma: no cover - replaced by overloads in compiled code
+    """The state ``(q_NP, ω_P)`` (a 7-tuple) ``tau`` seconds (any sign) along a :func:`free_setup` motion."""
+    raise NotImplementedError(f"{type(model).__name__} has no closed-form free motion")
+
+
+def torque_acceleration(model, b, t, x, w1, w2, w3):  # pragma: no cover - replaced by overloads
+    """``I⁻¹ τ(t, q, ω)`` (rad/s², principal axes) of batch member ``b`` at the attitude of the state
+    ``x`` and the rate ``ω`` (``"free_flow"``: the kicks of the exact-flow splittings)."""
+    raise NotImplementedError(f"{type(model).__name__} has no torque kicks")
+
+
+def torque_free(model):  # pragma: no cover - replaced by overloads in compiled code
+    """True when ``model`` has no torque (a compile-time constant of its type; ``"free_flow"``)."""
+    raise NotImplementedError(f"{type(model).__name__} does not say whether it has a torque")
 
 
 @njit(cache=True)

@@ -1,4 +1,4 @@
-"""The deformable body as a model for the integrators (see :mod:`tumble._model`).
+"""The deformable body as a model for the integrators (see :mod:`tumble._protocol`).
 
 State ``y = [q_w, q_x, q_y, q_z, L_x, L_y, L_z, s]``: the attitude of the body
 frame B (``q_NB``, B → inertial), the angular momentum about the centre of
@@ -12,8 +12,8 @@ kinematics::
 
 Without a torque ``L̇_N = 0`` exactly: every integrator leaves ``L_N`` as it
 was, bit for bit, so ``|L|`` is conserved to rounding whatever the step. The
-clock ``s`` carries the time into :func:`tumble._model.body_rate` (the rate
-depends on time through ``I`` and ``A``); :func:`~tumble._model.project`
+clock ``s`` carries the time into :func:`tumble._protocol.body_rate` (the rate
+depends on time through ``I`` and ``A``); :func:`~tumble._protocol.project`
 resets it to the step's end time and normalises ``q``.
 
 ``I(s)`` (6 components) and ``A(s)`` (3) are the cubic splines of
@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from tumble import _model, _quat, torques
+from tumble import _protocol, _quat, torques
 
 STATE_SIZE = 8
 
@@ -48,9 +48,14 @@ class VariableModel(NamedTuple):
     codes: np.ndarray | None
 
     @property
-    def torque_free(self) -> bool:
-        """Always False: the free-rigid-body methods (splitting, exact) do not apply to a changing body."""
-        return False
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.calls_python(self.codes)
 
 
 def build(body, torque) -> VariableModel:
@@ -104,10 +109,10 @@ def angular_rate(breaks, c, s, qw, qx, qy, qz, lx, ly, lz):
 
 
 def _is_variable(model):
-    return _model.is_type(model, VariableModel)
+    return _protocol.is_type(model, VariableModel)
 
 
-@overload(_model.rhs, inline="always", jit_options={"cache": True})
+@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
 def _variable_rhs(model, b0, t, Y, OUT):
     if not _is_variable(model):
         return None
@@ -147,7 +152,7 @@ def _variable_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_model.project, inline="always", jit_options={"cache": True})
+@overload(_protocol.project, inline="always", jit_options={"cache": True})
 def _variable_project(model, b0, t, Y):
     if not _is_variable(model):
         return None
@@ -155,27 +160,27 @@ def _variable_project(model, b0, t, Y):
     if Y.ndim == 1:
 
         def impl(model, b0, t, Y):
-            _model.normalize_quaternion(Y)
+            _protocol.normalize_quaternion(Y)
             Y[7] = t
 
     else:
 
         def impl(model, b0, t, Y):
-            _model.normalize_quaternions(Y)
+            _protocol.normalize_quaternions(Y)
             for j in range(Y.shape[1]):
                 Y[7, j] = t
 
     return impl
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _variable_state_size(model):
     if not _is_variable(model):
         return None
     return lambda model: STATE_SIZE
 
 
-@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
 def _variable_body_rate(model, Y, j):
     if not _is_variable(model):
         return None

@@ -1,4 +1,4 @@
-"""A hub with flexible appendages as a model for the integrators (see :mod:`tumble._model`).
+"""A hub with flexible appendages as a model for the integrators (see :mod:`tumble._protocol`).
 
 State ``y = [q_w, q_x, q_y, q_z, ω₁, ω₂, ω₃, η₁ … η_m, η̇₁ … η̇_m]``: the
 attitude of the body axes B (body → inertial), the body rate (rad/s, body
@@ -25,7 +25,8 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from tumble import _model, _quat, torques
+from tumble import _protocol, _quat, torques
+from tumble._vec import cross, matvec
 
 
 class FlexibleModel(NamedTuple):
@@ -48,25 +49,14 @@ class FlexibleModel(NamedTuple):
     codes: np.ndarray
 
     @property
-    def torque_free(self) -> bool:
-        """Always False: the free-rigid-body methods do not apply to a flexible body."""
-        return False
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
 
-
-@njit(cache=True, inline="always")
-def cross(a1, a2, a3, b1, b2, b3):
-    """``a × b`` of two 3-vectors given by components."""
-    return a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1
-
-
-@njit(cache=True, inline="always")
-def matvec(M, x1, x2, x3):
-    """``M x`` for a (3, 3) array ``M`` and a 3-vector given by components."""
-    return (
-        M[0, 0] * x1 + M[0, 1] * x2 + M[0, 2] * x3,
-        M[1, 0] * x1 + M[1, 1] * x2 + M[1, 2] * x3,
-        M[2, 0] * x1 + M[2, 1] * x2 + M[2, 2] * x3,
-    )
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.calls_python(self.codes)
 
 
 @njit(cache=True)
@@ -98,32 +88,32 @@ def derivative(model, t, y, out):
 
 
 def _is_flexible(model):
-    return _model.is_type(model, FlexibleModel)
+    return _protocol.is_type(model, FlexibleModel)
 
 
-@overload(_model.rhs, inline="always", jit_options={"cache": True})
+@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
 def _flexible_rhs(model, b0, t, Y, OUT):
     if not _is_flexible(model):
         return None
-    return _model.lanewise_rhs(derivative, Y)
+    return _protocol.lanewise_rhs(derivative, Y)
 
 
-@overload(_model.project, inline="always", jit_options={"cache": True})
+@overload(_protocol.project, inline="always", jit_options={"cache": True})
 def _flexible_project(model, b0, t, Y):
     if not _is_flexible(model):
         return None
-    return _model.quaternion_projection(Y)
+    return _protocol.quaternion_projection(Y)
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _flexible_state_size(model):
     if not _is_flexible(model):
         return None
     return lambda model: 7 + 2 * model.stiffness.shape[0]
 
 
-@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
 def _flexible_body_rate(model, Y, j):
     if not _is_flexible(model):
         return None
-    return _model.rate_at(4, Y)
+    return _protocol.rate_at(4, Y)

@@ -1,4 +1,4 @@
-"""The rigid body as a model for the integrators (see :mod:`tumble._model`).
+"""The rigid body as a model for the integrators (see :mod:`tumble._protocol`).
 
 State ``y = [q_w, q_x, q_y, q_z, ω₁, ω₂, ω₃]``: the attitude of the principal
 axes P (``q_NP``, P → inertial) and the body rate in principal axes (rad/s).
@@ -17,11 +17,10 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from tumble import _model, _quat, torques
+from tumble import _free_flow, _protocol, _quat, torques
 from tumble.dynamics import euler_coefficients, euler_principal
 
 STATE_SIZE = 7
-
 
 
 class RigidModel(NamedTuple):
@@ -40,9 +39,17 @@ class RigidModel(NamedTuple):
     moments: np.ndarray
 
     @property
-    def torque_free(self) -> bool:
-        """True when the bodies have no torque program (the free-rigid-body methods apply)."""
-        return self.codes is None
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): every one; ``"torque_free"`` only without
+        a torque program, ``"cuda"`` only without a Python torque function."""
+        free = {"torque_free"} if self.codes is None else set()
+        gpu = set() if self.calls_python else {"cuda"}
+        return frozenset({"rhs", "body_rate", "free_flow", *free, *gpu})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.calls_python(self.codes)
 
 
 def build(bodies, model) -> RigidModel:
@@ -70,10 +77,10 @@ def from_principal(moments, axes, model) -> RigidModel:
 
 
 def _is_rigid(model):
-    return _model.is_type(model, RigidModel)
+    return _protocol.is_type(model, RigidModel)
 
 
-@overload(_model.rhs, inline="always", jit_options={"cache": True})
+@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
 def _rigid_rhs(model, b0, t, Y, OUT):
     if not _is_rigid(model):
         return None
@@ -129,14 +136,14 @@ def _rigid_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_model.project, inline="always", jit_options={"cache": True})
+@overload(_protocol.project, inline="always", jit_options={"cache": True})
 def _rigid_project(model, b0, t, Y):
     if not _is_rigid(model):
         return None
-    return _model.quaternion_projection(Y)
+    return _protocol.quaternion_projection(Y)
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _rigid_state_size(model):
     if not _is_rigid(model):
         return None
@@ -147,14 +154,14 @@ def _rigid_state_size(model):
     return impl
 
 
-@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
 def _rigid_body_rate(model, Y, j):
     if not _is_rigid(model):
         return None
-    return _model.rate_at(4, Y)
+    return _protocol.rate_at(4, Y)
 
 
-@overload(_model.inverse_moments, inline="always", jit_options={"cache": True})
+@overload(_protocol.inverse_moments, inline="always", jit_options={"cache": True})
 def _rigid_inverse_moments(model, b):
     if not _is_rigid(model) or not isinstance(model.types[2], types.NoneType):
         return None  # with a torque program, the body is not free: no splitting
@@ -165,3 +172,53 @@ def _rigid_inverse_moments(model, b):
         return c[r, 3], c[r, 4], c[r, 5]
 
     return impl
+
+
+@overload(_protocol.free_setup, inline="always", jit_options={"cache": True})
+def _rigid_free_setup(model, b, x):
+    if not _is_rigid(model):
+        return None
+
+    def impl(model, b, x):
+        r = b * (model.moments.shape[0] > 1)
+        return _free_flow._setup(model.moments[r, 0], model.moments[r, 1], model.moments[r, 2],
+                                 x[4], x[5], x[6], x[0], x[1], x[2], x[3])
+
+    return impl
+
+
+@overload(_protocol.free_evaluate, inline="always", jit_options={"cache": True})
+def _rigid_free_evaluate(model, motion, tau):
+    if not _is_rigid(model):
+        return None
+
+    def impl(model, motion, tau):
+        w1, w2, w3, qw, qx, qy, qz = _free_flow._evaluate(motion, tau)
+        return qw, qx, qy, qz, w1, w2, w3
+
+    return impl
+
+
+@overload(_protocol.torque_acceleration, inline="always", jit_options={"cache": True})
+def _rigid_torque_acceleration(model, b, t, x, w1, w2, w3):
+    if not _is_rigid(model):
+        return None
+    if isinstance(model.types[2], types.NoneType):
+        return lambda model, b, t, x, w1, w2, w3: (0.0, 0.0, 0.0)
+
+    def impl(model, b, t, x, w1, w2, w3):
+        r = b * (model.coefficients.shape[0] > 1)
+        c = model.coefficients
+        t1, t2, t3 = torques.evaluate(t, x[0], x[1], x[2], x[3], w1, w2, w3, model.params,
+                                      b * (model.params.shape[0] > 1), model.codes)
+        return c[r, 3] * t1, c[r, 4] * t2, c[r, 5] * t3
+
+    return impl
+
+
+@overload(_protocol.torque_free, inline="always", jit_options={"cache": True})
+def _rigid_torque_free(model):
+    if not _is_rigid(model):
+        return None
+    free = isinstance(model.types[2], types.NoneType)
+    return lambda model: free

@@ -1,4 +1,4 @@
-"""A rigid hub with a spherical slosh pendulum as a model for the integrators (see :mod:`tumble._model`).
+"""A rigid hub with a spherical slosh pendulum as a model for the integrators (see :mod:`tumble._protocol`).
 
 State ``y = [q_w, q_x, q_y, q_z, ω₁, ω₂, ω₃, s₁, s₂, s₃, ν₁, ν₂, ν₃]``: the
 attitude of the hub (body → inertial), its rate ω (rad/s, body axes), the unit
@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from tumble import _model, _quat, torques
-from tumble._flexible import cross, matvec
+from tumble import _protocol, _quat, torques
+from tumble._vec import cross, matvec
 
 STATE_SIZE = 13
 
@@ -51,9 +51,14 @@ class SloshModel(NamedTuple):
     codes: np.ndarray
 
     @property
-    def torque_free(self) -> bool:
-        """Always False: the free-rigid-body methods do not apply."""
-        return False
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.calls_python(self.codes)
 
 
 @njit(cache=True)
@@ -101,7 +106,7 @@ def derivative(model, t, y, out):
 @njit(cache=True)
 def project_state(y):
     """Normalise ``q`` and ``s`` of one state vector and remove the component of ``ν`` along ``s``."""
-    _model.normalize_quaternion(y)
+    _protocol.normalize_quaternion(y)
     scale = 1.0 / np.sqrt(y[7] * y[7] + y[8] * y[8] + y[9] * y[9])
     y[7], y[8], y[9] = y[7] * scale, y[8] * scale, y[9] * scale
     along = y[10] * y[7] + y[11] * y[8] + y[12] * y[9]
@@ -109,17 +114,17 @@ def project_state(y):
 
 
 def _is_slosh(model):
-    return _model.is_type(model, SloshModel)
+    return _protocol.is_type(model, SloshModel)
 
 
-@overload(_model.rhs, inline="always", jit_options={"cache": True})
+@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
 def _slosh_rhs(model, b0, t, Y, OUT):
     if not _is_slosh(model):
         return None
-    return _model.lanewise_rhs(derivative, Y)
+    return _protocol.lanewise_rhs(derivative, Y)
 
 
-@overload(_model.project, inline="always", jit_options={"cache": True})
+@overload(_protocol.project, inline="always", jit_options={"cache": True})
 def _slosh_project(model, b0, t, Y):
     if not _is_slosh(model):
         return None
@@ -133,15 +138,15 @@ def _slosh_project(model, b0, t, Y):
     return impl
 
 
-@overload(_model.state_size, jit_options={"cache": True})
+@overload(_protocol.state_size, jit_options={"cache": True})
 def _slosh_state_size(model):
     if not _is_slosh(model):
         return None
     return lambda model: STATE_SIZE
 
 
-@overload(_model.body_rate, inline="always", jit_options={"cache": True})
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
 def _slosh_body_rate(model, Y, j):
     if not _is_slosh(model):
         return None
-    return _model.rate_at(4, Y)
+    return _protocol.rate_at(4, Y)

@@ -1,0 +1,82 @@
+"""Python functions called back from compiled code: the one registry for every model.
+
+A model that accepts a Python function (an external torque ``f(t, q, omega)``,
+a spacecraft control law, a robot's joint-torque law) registers it here and
+gets a *slot*, an integer it stores among its compiled parameters. Compiled
+code calls :func:`invoke` in object mode with that slot; the call costs a few
+microseconds, and a batch that makes such calls runs on one core (the kernel's
+``calls_python``).
+
+A registration lasts as long as its *owner*, the object that registered the
+function (a :class:`tumble.torques.PythonTorque`, a control law, ...): the
+entry goes when the owner is garbage-collected. An owner made while a model
+compiles (a plain function wrapped as a torque model) lives as long as the
+run, which holds it through :func:`keep_alive`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import weakref
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import NamedTuple
+
+import numpy as np
+
+from tumble._validate import ValidationError
+
+__all__ = ["invoke", "keep_alive", "register"]
+
+
+class _Entry(NamedTuple):
+    function: Callable
+    field: str       # the argument the function was given as, for the message
+    signature: str   # its arguments, e.g. "(t, q, omega)"
+    returns: str     # what it must return, e.g. "3 finite numbers (body torque, N·m)"
+
+
+_ENTRIES: dict[int, _Entry] = {}
+_SLOTS = itertools.count()
+_KEPT: list[list] = []  # the owners registered inside each open keep_alive() scope
+
+
+@contextmanager
+def keep_alive() -> Iterator[None]:
+    """Hold every owner registered inside the ``with`` block until it ends (a run: compile, then integrate)."""
+    _KEPT.append([])
+    try:
+        yield
+    finally:
+        _KEPT.pop()
+
+
+def register(owner, function: Callable, *, field: str, signature: str, returns: str) -> int:
+    """Register ``function`` for as long as ``owner`` lives; returns its slot.
+
+    ``field``, ``signature`` and ``returns`` word the error raised when the
+    function returns something other than what its caller needs.
+    """
+    if not callable(function):
+        raise ValidationError(f"{field}: must be a callable f{signature}, got {function!r}")
+    slot = next(_SLOTS)
+    _ENTRIES[slot] = _Entry(function, field, signature, returns)
+    weakref.finalize(owner, _ENTRIES.pop, slot, None)
+    if _KEPT:
+        _KEPT[-1].append(owner)
+    return slot
+
+
+def invoke(slot: int, t: float, args: tuple, out: np.ndarray) -> None:
+    """``out[:] = f(t, *args)`` for the function in ``slot`` (each argument passed as a fresh copy).
+
+    Raises :class:`~tumble.ValidationError` naming the function when its
+    result does not have the shape of ``out`` or is not finite.
+    """
+    entry = _ENTRIES[int(slot)]
+    value = np.asarray(entry.function(float(t), *(np.array(a) for a in args)), dtype=np.float64)
+    if value.shape != out.shape or not np.all(np.isfinite(value)):
+        name = getattr(entry.function, "__name__", repr(entry.function))
+        raise ValidationError(f"{entry.field}: the function {name}{entry.signature} must return {entry.returns}; "
+                              f"at t={t} it returned {value!r}")
+    out[:] = value

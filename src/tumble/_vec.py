@@ -1,0 +1,56 @@
+"""Compiled 3-vector algebra on scalar components: the one cross product, matrix product and 3×3 solve.
+
+Kernels pass vectors as three floats (``a1, a2, a3``) rather than arrays, so
+that nothing is allocated in the inner loops; these functions are inlined
+into their callers. Frames are the callers' (the functions are frame-free).
+"""
+
+from __future__ import annotations
+
+from numba import njit
+
+
+@njit(cache=True, inline="always")
+def cross(a1, a2, a3, b1, b2, b3):
+    """``a × b = (a₂b₃ − a₃b₂, a₃b₁ − a₁b₃, a₁b₂ − a₂b₁)`` of two 3-vectors given by components."""
+    return a2 * b3 - a3 * b2, a3 * b1 - a1 * b3, a1 * b2 - a2 * b1
+
+
+@njit(cache=True, inline="always")
+def matvec(M, x1, x2, x3):
+    """``M x`` for a (3, 3) array ``M`` and a 3-vector given by components."""
+    return (
+        M[0, 0] * x1 + M[0, 1] * x2 + M[0, 2] * x3,
+        M[1, 0] * x1 + M[1, 1] * x2 + M[1, 2] * x3,
+        M[2, 0] * x1 + M[2, 1] * x2 + M[2, 2] * x3,
+    )
+
+
+@njit(cache=True, inline="always")
+def matvec_flat(d, o, x1, x2, x3):
+    """``M x`` for the row-major 3×3 matrix ``M = d[o:o+9]`` stored in a flat parameter block."""
+    return (d[o] * x1 + d[o + 1] * x2 + d[o + 2] * x3, d[o + 3] * x1 + d[o + 4] * x2 + d[o + 5] * x3,
+            d[o + 6] * x1 + d[o + 7] * x2 + d[o + 8] * x3)
+
+
+@njit(cache=True, inline="always")
+def solve_symmetric(a00, a01, a02, a11, a12, a22, b0, b1, b2):
+    """Solve ``A x = b`` for a symmetric 3×3 ``A`` (upper triangle given) by Cramer's rule.
+
+    ``A`` must be non-singular (the callers pass positive-definite matrices).
+    """
+    c00 = a11 * a22 - a12 * a12
+    c01 = a02 * a12 - a01 * a22
+    c02 = a01 * a12 - a02 * a11
+    c11 = a00 * a22 - a02 * a02
+    c12 = a01 * a02 - a00 * a12
+    c22 = a00 * a11 - a01 * a01
+    det = a00 * c00 + a01 * c01 + a02 * c02
+    return ((c00 * b0 + c01 * b1 + c02 * b2) / det, (c01 * b0 + c11 * b1 + c12 * b2) / det,
+            (c02 * b0 + c12 * b1 + c22 * b2) / det)
+
+
+@njit(cache=True, inline="always")
+def clip(x, limit):
+    """``x`` clipped to ``[−limit, limit]`` (``limit ≥ 0``; ``inf`` for none)."""
+    return min(max(x, -limit), limit)

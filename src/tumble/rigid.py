@@ -1,0 +1,130 @@
+"""The rigid body as a model of the front door (:class:`tumble.simulate.Model`).
+
+The integrators work in each body's principal axes P, where Euler's
+equations are cheapest (``I₁ω̇₁ = τ₁ + (I₂ − I₃)ω₂ω₃`` and cyclic; the kernel
+is :mod:`tumble.kernels.rigid`). The initial state moves into those axes and
+the results back::
+
+    q_NP = q_NB ⊗ q_BP,   ω_P = R_BPᵀ ω_B        (in)
+    q_NB = q_NP ⊗ q_BP*,  ω_B = R_BP ω_P         (out)
+
+with ``R_BP = body.axes`` (columns: the principal axes in body axes). The
+change of axes is exact for a diagonal inertia and costs a few rounding errors
+otherwise; the motion does not depend on the body axes chosen (tested).
+
+:class:`RigidMotion` implements the model interface for anything that has
+principal moments and axes: a :class:`tumble.RigidBody`, or
+:class:`RigidBodies`, a batch with one body per member (a sequence of
+RigidBody or an (N, 3, 3) inertia array, validated in one vectorised call).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from tumble import attitude, limits, torques
+from tumble._inertia import principal_axes
+from tumble._validate import ValidationError, as_array
+from tumble.kernels import rigid as _kernel
+from tumble.simulate import Model, Outputs, StateField
+
+__all__ = ["RigidMotion", "RigidBodies"]
+
+#: The stack depth from the warnings of :mod:`tumble.limits` to the caller of ``simulate``.
+_STACKLEVEL = 4
+
+
+class RigidMotion(Model):
+    """The model interface of rigid bodies: initial state ``omega0`` (and ``q0``), outputs in body axes.
+
+    A subclass provides ``_principal()``, the principal moments (B, 3) (kg·m²,
+    ascending) and axes R_BP (B, 3, 3) of B = 1 body or one per member,
+    ``_reported_inertia()`` (the inertia tensor(s) in body axes) and
+    ``_masses()`` (kg, or None when unknown: for the rigidity check).
+    """
+
+    __slots__ = ()
+
+    def state_fields(self) -> tuple[StateField, ...]:
+        return (
+            StateField("omega0", 3, "initial body rate, rad/s, body axes"),
+            StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
+                       default=attitude.identity(), quaternion=True),
+        )
+
+    def compile(self, torque, t0: float) -> _kernel.RigidModel:
+        moments, axes = self._principal()
+        return _kernel.from_principal(moments, axes, torques.as_torque_model(torque))
+
+    def initial_states(self, kernel, values, t0):
+        moments, axes = self._principal()
+        q_bp = attitude.from_matrix(axes)                              # (B, 4)
+        y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
+        y0[:, :4] = attitude.multiply(values["q0"], q_bp)
+        y0[:, 4:] = np.einsum("bji,bj->bi", axes, values["omega0"])
+        limits.check_rigid_motion(moments, y0[:, 4:], self._masses(), stacklevel=_STACKLEVEL)
+        return y0
+
+    def outputs(self, kernel, t, states) -> Outputs:
+        moments, axes = self._principal()
+        if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
+            limits.check_rigid_motion(moments, states[-1, :, 4:], self._masses(), stacklevel=_STACKLEVEL)
+        q = attitude.multiply(states[..., :4], attitude.conjugate(attitude.from_matrix(axes)))
+        omega = np.einsum("bij,tbj->tbi", axes, states[..., 4:])
+        return Outputs(q=q, omega=omega, inertia=self._reported_inertia(), extras={}, totals={}, info={})
+
+
+class RigidBodies(RigidMotion):
+    """A batch of rigid bodies, one per member: ``simulate(bodies, omega0 (N, 3), ...)``.
+
+    Made by :meth:`of` from a sequence of :class:`tumble.RigidBody` or an
+    inertia array (3, 3) or (N, 3, 3) (kg·m², body axes), validated with the
+    rules of :class:`tumble.RigidBody` (:func:`tumble._inertia.principal_axes`).
+    """
+
+    __slots__ = ("inertia", "moments", "axes", "masses")
+
+    def __init__(self, inertia, moments, axes, masses):
+        self.inertia, self.moments, self.axes, self.masses = inertia, moments, axes, masses
+
+    @classmethod
+    def of(cls, bodies) -> RigidBodies:
+        """The batch of ``bodies``: a RigidBody, a sequence of them, or an inertia array (3, 3) or (N, 3, 3)."""
+        from tumble.body import RigidBody  # the rigid body's class builds on this module
+
+        if isinstance(bodies, RigidBody):
+            return cls(np.array(bodies.inertia), bodies.moments[None], bodies.axes[None], bodies.mass)
+        if isinstance(bodies, Sequence) and bodies and all(isinstance(b, RigidBody) for b in bodies):
+            masses = [b.mass for b in bodies]
+            return cls(np.stack([b.inertia for b in bodies]), np.stack([b.moments for b in bodies]),
+                       np.stack([b.axes for b in bodies]), None if None in masses else np.array(masses))
+        try:
+            np.asarray(bodies, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise ValidationError(f"model: must be a tumble model (RigidBody, FlexibleBody, Spacecraft, SerialChain, "
+                                  f"...) or an inertia array (kg m^2, body axes), got {type(bodies).__name__}") from None
+        inertia = as_array(bodies, "inertia", tail=(3, 3))
+        if inertia.ndim not in (2, 3):
+            raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
+        inertia, moments, axes = principal_axes(inertia, "inertia")
+        if inertia.ndim == 2:
+            return cls(inertia, moments[None], axes[None], None)
+        return cls(inertia, moments, axes, None)
+
+    @property
+    def batch_size(self) -> int | None:
+        return None if self.inertia.ndim == 2 else self.inertia.shape[0]
+
+    def _principal(self):
+        return self.moments, self.axes
+
+    def _reported_inertia(self):
+        return self.inertia
+
+    def _masses(self):
+        return self.masses
+
+    def __repr__(self) -> str:
+        return f"RigidBodies(batch_size={self.batch_size})"
