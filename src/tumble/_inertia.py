@@ -19,6 +19,12 @@ _SYMMETRY_RTOL = 1e-12
 # largest: below that a moment is indistinguishable from zero at the float64
 # rounding of the eigen-decomposition (~1e-16 × the largest moment).
 _DEFINITE_RTOL = 1e-14
+# Principal moments closer than _DEGENERATE_RTOL × the largest are equal: the
+# eigen-decomposition of a tensor with a double moment splits it by a few ulps
+# (9 ulps measured for diag(1, 2, 2) in rotated axes), which would turn a
+# symmetric top into an asymmetric body whose motion drifts from the
+# symmetric one by ~(split) × (angle turned).
+_DEGENERATE_RTOL = 16 * np.finfo(np.float64).eps
 # Triangle inequality I₁ + I₂ ≥ I₃ (1 − _TRIANGLE_RTOL) on the moments.
 _TRIANGLE_RTOL = 1e-9
 # A rotation matrix must satisfy max |RᵀR − E| ≤ _ROTATION_TOL; a quaternion
@@ -60,7 +66,10 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
     raises :class:`ValidationError` naming ``name`` (and the batch index);
     ``member_note(k)``, if given, adds a word on member ``k`` (an index tuple),
     e.g. its sample time.
-    ``moments`` (…, 3) ascend; ``axes`` (…, 3, 3) = R_BP, columns the principal
+    ``moments`` (…, 3) ascend, and two that differ by less than
+    ``_DEGENERATE_RTOL`` (16 ε) × the largest — the rounding of the
+    eigen-decomposition — are replaced by their mean, so a symmetric body
+    described in rotated axes stays symmetric; ``axes`` (…, 3, 3) = R_BP, columns the principal
     axes in body axes, made deterministic: each eigenvector's largest-magnitude
     component is positive, then the third is flipped if needed for det +1.
     Batched, so that a batch of N bodies is validated in one call.
@@ -85,6 +94,11 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
         )
     inertia = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
     moments, axes = np.linalg.eigh(inertia)
+    for i in (0, 1):  # a double (or triple) moment split by rounding: made equal again
+        close = moments[..., i + 1] - moments[..., i] <= _DEGENERATE_RTOL * np.abs(moments[..., 2])
+        mean = 0.5 * (moments[..., i] + moments[..., i + 1])
+        moments[..., i] = np.where(close, mean, moments[..., i])
+        moments[..., i + 1] = np.where(close, mean, moments[..., i + 1])
     m1, m2, m3 = moments[..., 0], moments[..., 1], moments[..., 2]
     bad = ~(m1 > _DEFINITE_RTOL * m3) if definite else m1 < -_DEFINITE_RTOL * m3
     if bad.any():
