@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tumble import attitude
 from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.rigid import RigidMotion
@@ -108,7 +109,7 @@ class RigidBody(RigidMotion):
     com are equal (the ``name`` is a label and is not compared).
     """
 
-    __slots__ = ("_inertia", "_moments", "_axes", "_mass", "_com", "_check_triangle", "_name")
+    __slots__ = ("_inertia", "_moments", "_axes", "_mass", "_com", "_check_triangle", "_name", "_q_bp")
 
     def __init__(self, inertia, *, mass=None, com=None, check_triangle: bool = True, name: str | None = None):
         inertia, moments, axes = check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)
@@ -120,6 +121,7 @@ class RigidBody(RigidMotion):
         set_(self, "_com", None if com is None else frozen(as_shape(com, "com", (3,))))
         set_(self, "_check_triangle", bool(check_triangle))
         set_(self, "_name", name)
+        set_(self, "_q_bp", None)  # the quaternion of R_BP, made on the first simulation
 
     # -- data ---------------------------------------------------------------
 
@@ -389,7 +391,9 @@ class RigidBody(RigidMotion):
     # -- the model interface (tumble.rigid.RigidMotion) -----------------------
 
     def _principal(self):
-        return self._moments[None], self._axes[None]
+        if self._q_bp is None:
+            object.__setattr__(self, "_q_bp", frozen(attitude.from_matrix(self._axes)))
+        return self._moments[None], self._axes[None], self._q_bp[None]
 
     def _reported_inertia(self):
         return self._inertia

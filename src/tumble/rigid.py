@@ -40,7 +40,8 @@ class RigidMotion(Model):
     """The model interface of rigid bodies: initial state ``omega0`` (and ``q0``), outputs in body axes.
 
     A subclass provides ``_principal()``, the principal moments (B, 3) (kg·m²,
-    ascending) and axes R_BP (B, 3, 3) of B = 1 body or one per member,
+    ascending), axes R_BP (B, 3, 3) and their quaternions q_BP (B, 4) of B = 1
+    body or one per member,
     ``_reported_inertia()`` (the inertia tensor(s) in body axes) and
     ``_masses()`` (kg, or None when unknown: for the rigidity check).
     """
@@ -55,12 +56,11 @@ class RigidMotion(Model):
         )
 
     def compile(self, torque, t0: float) -> _kernel.RigidModel:
-        moments, axes = self._principal()
+        moments, axes, _ = self._principal()
         return _kernel.from_principal(moments, axes, torques.as_torque_model(torque))
 
     def initial_states(self, kernel, values, t0):
-        moments, axes = self._principal()
-        q_bp = attitude.from_matrix(axes)                              # (B, 4)
+        moments, axes, q_bp = self._principal()
         y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
         y0[:, :4] = attitude.multiply(values["q0"], q_bp)
         y0[:, 4:] = np.einsum("bji,bj->bi", axes, values["omega0"])
@@ -68,10 +68,10 @@ class RigidMotion(Model):
         return y0
 
     def outputs(self, kernel, t, states) -> Outputs:
-        moments, axes = self._principal()
+        moments, axes, q_bp = self._principal()
         if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
             limits.check_rigid_motion(moments, states[-1, :, 4:], self._masses(), stacklevel=_STACKLEVEL)
-        q = attitude.multiply(states[..., :4], attitude.conjugate(attitude.from_matrix(axes)))
+        q = attitude.multiply(states[..., :4], attitude.conjugate(q_bp))
         omega = np.einsum("bij,tbj->tbi", axes, states[..., 4:])
         return Outputs(q=q, omega=omega, inertia=self._reported_inertia(), extras={}, totals={}, info={})
 
@@ -84,18 +84,17 @@ class RigidBodies(RigidMotion):
     rules of :class:`tumble.RigidBody` (:func:`tumble._inertia.principal_axes`).
     """
 
-    __slots__ = ("inertia", "moments", "axes", "masses")
+    __slots__ = ("inertia", "moments", "axes", "q_bp", "masses")
 
     def __init__(self, inertia, moments, axes, masses):
         self.inertia, self.moments, self.axes, self.masses = inertia, moments, axes, masses
+        self.q_bp = attitude.from_matrix(axes)
 
     @classmethod
     def of(cls, bodies) -> RigidBodies:
-        """The batch of ``bodies``: a RigidBody, a sequence of them, or an inertia array (3, 3) or (N, 3, 3)."""
+        """The batch of ``bodies``: a sequence of RigidBody, or an inertia array (3, 3) or (N, 3, 3)."""
         from tumble.body import RigidBody  # the rigid body's class builds on this module
 
-        if isinstance(bodies, RigidBody):
-            return cls(np.array(bodies.inertia), bodies.moments[None], bodies.axes[None], bodies.mass)
         if isinstance(bodies, Sequence) and bodies and all(isinstance(b, RigidBody) for b in bodies):
             masses = [b.mass for b in bodies]
             return cls(np.stack([b.inertia for b in bodies]), np.stack([b.moments for b in bodies]),
@@ -118,7 +117,7 @@ class RigidBodies(RigidMotion):
         return None if self.inertia.ndim == 2 else self.inertia.shape[0]
 
     def _principal(self):
-        return self.moments, self.axes
+        return self.moments, self.axes, self.q_bp
 
     def _reported_inertia(self):
         return self.inertia
