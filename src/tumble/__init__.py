@@ -9,6 +9,10 @@ tensor about the centre of mass in body axes. See ``docs/conventions.md``.
     >>> import numpy as np, tumble
     >>> body = tumble.RigidBody(inertia=np.diag([1.0, 2.0, 3.0]))
     >>> traj = tumble.simulate(body, [1e-3, 1.0, 1e-3], t=np.linspace(0, 100, 1001))
+
+``tumble.simulate`` is the one front door: every model (rigid bodies, flexible,
+sloshing and shape-changing bodies, spacecraft, robot arms, gyroscopes)
+implements :class:`tumble.Model` and runs through it.
 """
 
 from tumble import attitude, dynamics, integrate, limits, torques
@@ -16,7 +20,7 @@ from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.integrate import SolverError
 from tumble.limits import RigidityWarning
-from tumble.simulate import simulate
+from tumble.simulate import Model, simulate
 from tumble.trajectory import Trajectory, load
 
 __version__ = "0.1.0"
@@ -35,6 +39,7 @@ def __getattr__(name):
     raise AttributeError(f"module 'tumble' has no attribute {name!r}")
 
 __all__ = [
+    "Model",
     "RigidBody",
     "RigidityWarning",
     "analysis",
