@@ -51,7 +51,8 @@ DEMOS: dict[str, Demo] = {
                     "for tilts of 10-30 deg"),
             ("(c)", f"{abs(s['dive_somersaults']):.2f} somersaults, {abs(s['dive_twists']):.2f} twists, "
                     f"final tilt {s['dive_final_tilt_deg']:.1f} deg"),
-            ("|L|", f"largest relative drift {max(s['dive_momentum_drift'], s['twisting_somersault_momentum_drift']):.1e} "
+            ("|L|", "largest relative drift "
+                    f"{max(s['dive_momentum_drift'], s['twisting_somersault_momentum_drift']):.1e} "
                     "(torque-free flight: L is conserved)"),
         ],
     ),
