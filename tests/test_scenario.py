@@ -64,6 +64,17 @@ def test_every_example_builds_and_runs(path):
     assert traj.method == scenario.solver.method
 
 
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")) + sorted(EXAMPLES.glob("spacecraft/*.toml")),
+                         ids=lambda p: p.stem)
+def test_every_example_of_every_kind_loads_and_builds(path):
+    # `tumble run` runs these (it reads a file with load and checks it with build before running it);
+    # the spacecraft runs themselves are in tests/test_spacecraft_*.py and tests/test_cli.py.
+    scenario = load_scenario(path)
+    assert scenario.kind == ("spacecraft" if "[spacecraft" in path.read_text(encoding="utf-8") else "rigid")
+    problem = scenario.build()
+    assert problem.model is not None and problem.t[-1] == scenario.time.stop
+
+
 def test_at_least_three_examples():
     names = {p.stem for p in EXAMPLES.glob("*.toml")}
     assert {"intermediate_axis", "box_inertial_torque", "symmetric_top"} <= names
