@@ -107,7 +107,7 @@ def test_solver_failure_exits_1_and_writes_nothing(tmp_path, monkeypatch):
     def give_up(*args, **kwargs):
         raise tumble.SolverError("max_steps reached")
 
-    monkeypatch.setattr("tumble.scenario.simulate", give_up)
+    monkeypatch.setattr("tumble.scenario.rigid.simulate", give_up)
     result = invoke("run", EXAMPLES / "symmetric_top.toml", "-o", tmp_path / "out.nc")
     assert result.exit_code == 1
     assert "error: max_steps reached" in result.stderr
@@ -254,3 +254,41 @@ def test_run_dispatches_a_spacecraft_scenario(tmp_path):
     assert "wheel_speed" in traj.extras and traj.extras["wheel_speed"].data.shape == (len(traj), 4)
     peak = np.abs(traj.extras["wheel_speed"].data).max()
     assert f"peak speed {peak:.4g} rad/s" in result.stdout
+
+
+@pytest.mark.parametrize("scenario", [EXAMPLES / "symmetric_top.toml", EXAMPLES / "spacecraft" / "slew_wheels.toml"],
+                         ids=lambda p: p.stem)
+def test_run_parses_the_file_once(tmp_path, monkeypatch, scenario):
+    # Count the TOML parses of one `tumble run` (the parser still runs: the call is passed on).
+    import tomllib
+
+    calls = []
+    parse = tomllib.loads
+
+    def counted(text, **kwargs):
+        calls.append(text)
+        return parse(text, **kwargs)
+
+    monkeypatch.setattr(tomllib, "loads", counted)
+    result = invoke("run", scenario, "-o", tmp_path / "out.nc", "--quiet")
+    assert result.exit_code == 0, result.output
+    assert calls == [scenario.read_text(encoding="utf-8")]
+
+
+def test_run_refuses_an_unknown_kind_naming_the_kinds(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text('kind = "robot"\n' + (EXAMPLES / "symmetric_top.toml").read_text(encoding="utf-8"))
+    result = invoke("run", bad, "-o", tmp_path / "out.nc")
+    assert result.exit_code == 2
+    assert result.stderr == f"error: {bad}: kind: must be one of 'rigid', 'spacecraft', got 'robot'\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
+
+
+def test_cli_does_not_import_back():
+    # The demo table and the scenario package are read by the CLI; neither imports it (no cycle).
+    code = ("import sys, tumble._demos, tumble.scenario, tumble.scenario.rigid, tumble.scenario.spacecraft; "
+            "print('tumble.cli' in sys.modules)")
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"

@@ -64,6 +64,17 @@ def test_every_example_builds_and_runs(path):
     assert traj.method == scenario.solver.method
 
 
+@pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.toml")) + sorted(EXAMPLES.glob("spacecraft/*.toml")),
+                         ids=lambda p: p.stem)
+def test_every_example_of_every_kind_loads_and_builds(path):
+    # `tumble run` runs these (it reads a file with load and checks it with build before running it);
+    # the spacecraft runs themselves are in tests/test_spacecraft_*.py and tests/test_cli.py.
+    scenario = load_scenario(path)
+    assert scenario.kind == ("spacecraft" if "[spacecraft" in path.read_text(encoding="utf-8") else "rigid")
+    problem = scenario.build()
+    assert problem.model is not None and problem.t[-1] == scenario.time.stop
+
+
 def test_at_least_three_examples():
     names = {p.stem for p in EXAMPLES.glob("*.toml")}
     assert {"intermediate_axis", "box_inertial_torque", "symmetric_top"} <= names
@@ -327,3 +338,98 @@ def test_exact_method_takes_no_solver_options(tmp_path):
     for option in ("dt = 0.01", "rtol = 1e-9"):
         with pytest.raises(ScenarioError, match=r"solver\.(dt|rtol): not used by method 'exact'"):
             load_scenario(write(tmp_path, BASE + f'\n[solver]\nmethod = "exact"\n{option}\n'))
+
+
+# --------------------------------------------------------------------------
+# One dialect: the kind table, the one orbit table, library errors by .field
+# --------------------------------------------------------------------------
+
+SPACECRAFT = """
+[spacecraft]
+moments = [1.0, 2.0, 2.5]
+[initial]
+omega = [0.1, 0.0, 0.0]
+[time]
+stop = 1.0
+samples = 3
+"""
+
+
+def test_kind_is_given_or_inferred_from_the_tables():
+    from tumble.scenario.rigid import RigidScenario
+    from tumble.scenario.spacecraft import SpacecraftScenario
+
+    assert type(parse_scenario(BASE)) is RigidScenario and parse_scenario(BASE).kind == "rigid"
+    assert type(parse_scenario('kind = "rigid"\n' + BASE)) is RigidScenario
+    assert type(parse_scenario(SPACECRAFT)) is SpacecraftScenario  # a [spacecraft] table: no kind needed
+    assert parse_scenario('kind = "spacecraft"\n' + SPACECRAFT).kind == "spacecraft"
+
+
+def test_every_kind_of_the_table_is_a_scenario():
+    from tumble.scenario.kinds import KINDS, scenario_class
+
+    assert set(KINDS) == {"rigid", "spacecraft"}
+    for kind in KINDS:
+        assert issubclass(scenario_class(kind), Scenario)
+
+
+@pytest.mark.parametrize(("kind", "got"), [('"robot"', "'robot'"), ("3", "3")])
+def test_unknown_kind_is_refused_naming_the_kinds(tmp_path, kind, got):
+    path = write(tmp_path, f"kind = {kind}\n" + BASE)
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path)
+    assert str(info.value) == f"{path}: kind: must be one of 'rigid', 'spacecraft', got {got}"
+    assert info.value.field == "kind"
+
+
+def test_a_kind_refuses_the_tables_of_another():
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario('kind = "spacecraft"\n' + BASE, source="case.toml")
+    assert {where for where, _ in info.value.problems} == {"body", "spacecraft"}
+
+
+# An orbit with every element away from its default, once by altitude (degrees) and once by
+# semi-major axis (rad): the Orbit each kind builds, and the one built here by hand.
+ORBITS = [
+    ("altitude = 600e3\ninclination = 97.8\nraan = 20.0\narg_periapsis = 10.0\nmean_anomaly = 5.0",
+     tumble.spacecraft.Orbit(6378137.0 + 600e3, 0.0, np.radians(97.8), np.radians(20.0), np.radians(10.0),
+                             np.radians(5.0))),
+    ("semi_major_axis = 7.2e6\neccentricity = 0.1\ninclination = 0.5\narg_periapsis = 1.0\ndegrees = false\n"
+     "mu = 4.9e12",
+     tumble.spacecraft.Orbit(7.2e6, 0.1, 0.5, 0.0, 1.0, 0.0, mu=4.9e12)),
+]
+
+
+@pytest.mark.parametrize(("orbit", "expected"), ORBITS, ids=["altitude", "semi_major_axis"])
+def test_the_one_orbit_table_gives_the_same_orbit_in_every_kind(orbit, expected):
+    rigid = parse_scenario(BASE + f"\n[[torque]]\nkind = 'gravity_gradient'\n[torque.orbit]\n{orbit}\n")
+    craft = parse_scenario(SPACECRAFT + f"\n[spacecraft.orbit]\n{orbit}\n")
+    # Orbit is a frozen dataclass: == compares every element exactly
+    assert rigid.build().torque.orbit == expected
+    assert craft.model.orbit == expected
+
+
+@pytest.mark.parametrize(("text", "key", "argument"), [
+    (BASE.replace("moments = [1.0, 2.0, 3.0]", "inertia = [[1, 0, 0], [0, 2, 0], [0, 0, -3]]"),
+     "body.inertia", "inertia"),
+    (BASE.replace("moments = [1.0, 2.0, 3.0]", "moments = [1.0, 1.0, 3.0]"), "body.moments", "inertia"),
+    (BASE + "[[torque]]\nkind = 'tabulated'\ntimes = [0, 1, 1]\nvalues = [[0, 0, 0], [0, 0, 1], [0, 0, 0]]\n",
+     "torque[0].times", "t"),
+    (SPACECRAFT.replace("moments = [1.0, 2.0, 2.5]", "moments = [1.0, 2.0, 5.0]"), "spacecraft.moments", "inertia"),
+])
+def test_a_library_error_reaches_the_user_with_its_key(text, key, argument):
+    # The library names the argument it refuses (ValidationError.field); the table's argument -> key
+    # table turns it into the key of the file, without reading the message.
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(text, source="case.toml").model
+    assert info.value.field == key
+    assert str(info.value).startswith(f"case.toml: {key}: ")
+    cause = info.value.__cause__
+    assert isinstance(cause, tumble.ValidationError) and cause.field == argument
+    assert info.value.rule == cause.rule
+
+
+def test_scenario_error_field_is_the_first_problem():
+    with pytest.raises(ScenarioError) as info:
+        parse_scenario(BASE.replace("stop = 1.0", 'stop = "x"').replace("[body]", "[body]\ncolour = 1"))
+    assert info.value.field == "body.colour" and info.value.rule.startswith("unknown key")

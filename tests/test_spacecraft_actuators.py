@@ -11,7 +11,7 @@ from tumble import attitude
 from tumble._validate import ValidationError
 from tumble.spacecraft import (PWPF, BDot, CMGCluster, ConstantTorque, Magnetorquers, QuaternionPD, Spacecraft,
                                Thruster, simulate)
-from tumble.spacecraft.scenario import load_spacecraft_scenario
+from tumble.scenario import load
 
 # Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
 # on 2 shared cores, under 1 s warm).
@@ -55,8 +55,8 @@ BDOT_FACTOR = 1.25
 
 
 def test_bdot_example_detumbles_at_the_orbit_averaged_rate():
-    scenario = load_spacecraft_scenario(BDOT_EXAMPLE)
-    craft, traj = scenario.spacecraft.build(str(BDOT_EXAMPLE)), scenario.run()
+    scenario = load(BDOT_EXAMPLE)
+    craft, traj = scenario.model, scenario.run()
     # the kinetic energy never rises: T' = ω·(m × B) = −Σ clip(k x_i) x_i ≤ 0 with x = ω × B,
     # the per-axis dipole limit included (no other torque acts); measured largest step −1.1e-17 J
     energy = traj.extras["total_energy"].data

@@ -8,7 +8,7 @@ import pytest
 from tumble import attitude
 from tumble.spacecraft import (DipoleField, Magnetorquers, MomentumDumping, Orbit, QuaternionPD, Spacecraft,
                                pyramid_wheels)
-from tumble.spacecraft.scenario import load_spacecraft_scenario
+from tumble.scenario import load
 
 # Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
 # on 2 shared cores, under 1 s warm).
@@ -26,8 +26,8 @@ EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "
 @pytest.fixture(scope="module")
 def dumping():
     """examples/spacecraft/momentum_dumping.toml, run as ``tumble run`` runs it."""
-    scenario = load_spacecraft_scenario(EXAMPLE)
-    return scenario.spacecraft.build(str(EXAMPLE)), scenario.run()
+    scenario = load(EXAMPLE)
+    return scenario.model, scenario.run()
 
 
 def test_dumping_example_is_the_spacecraft_described_here(dumping):

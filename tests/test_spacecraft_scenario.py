@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 
 from tumble import attitude
-from tumble.scenario import ScenarioError
+from tumble.scenario import ScenarioError, load, parse, run_scenario
 from tumble.spacecraft.figure import spacecraft_figure
-from tumble.spacecraft.scenario import load_spacecraft_scenario, parse_spacecraft_scenario, run_spacecraft_scenario
 
 # Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
 # on 2 shared cores, under 1 s warm).
@@ -18,7 +17,7 @@ EXAMPLES = Path(__file__).parent.parent / "examples" / "spacecraft"
 
 
 def test_slew_example_reaches_its_target():
-    traj = run_spacecraft_scenario(EXAMPLES / "slew_wheels.toml")
+    traj = run_scenario(EXAMPLES / "slew_wheels.toml")
     target = attitude.from_euler("ZYX", [60.0, 0.0, 0.0], degrees=True)
     error = np.degrees(attitude.relative_angle(traj.q[-1], target))
     assert error < 1e-4                                   # measured 1.3e-6 deg after 150 s
@@ -31,10 +30,10 @@ def test_slew_example_reaches_its_target():
 
 @pytest.mark.parametrize("name", ["cmg_slew", "thruster_pwpf"])
 def test_examples_load_and_run(name):
-    traj = run_spacecraft_scenario(EXAMPLES / f"{name}.toml")
+    traj = run_scenario(EXAMPLES / f"{name}.toml")
     assert np.all(np.isfinite(traj.q))
     # both hold their target to better than 1 degree at the end (measured 2e-4 and 0.44 deg)
-    scenario = load_spacecraft_scenario(EXAMPLES / f"{name}.toml")
+    scenario = load(EXAMPLES / f"{name}.toml")
     pd = scenario.spacecraft.controller[0]
     target = pd.target_euler.quaternion() if pd.target_euler is not None else attitude.identity()
     assert np.degrees(attitude.relative_angle(traj.q[-1], target)) < 1.0
@@ -68,7 +67,7 @@ samples = 3
 def test_bad_scenarios_name_the_key(edit, where, rule):
     text = GOOD.replace(*edit)
     with pytest.raises(ScenarioError) as info:
-        parse_spacecraft_scenario(text, source="craft.toml").run()
+        parse(text, source="craft.toml").run()
     assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems
 
 
@@ -121,8 +120,8 @@ def _total_inertia():
 def test_hub_description_gives_the_motion_of_the_total_inertia():
     total = _total_inertia()
     given = "[spacecraft]\ninertia = " + repr(total.tolist()) + "\n"   # repr: the floats round-trip exactly
-    hub = parse_spacecraft_scenario(HUB + WHEELS + REST).run()
-    tot = parse_spacecraft_scenario(given + WHEELS + REST).run()
+    hub = parse(HUB + WHEELS + REST).run()
+    tot = parse(given + WHEELS + REST).run()
     # the composite of the hub table equals the independent sum (measured: 1.5e-19 of max |J|)
     np.testing.assert_allclose(hub.inertia, total, rtol=1e-14)
     # and the motion (a 29° turn in 5 s) is the same, to the tolerance of the Python test
@@ -153,5 +152,5 @@ def test_hub_description_gives_the_motion_of_the_total_inertia():
 ])
 def test_bad_hub_descriptions_name_the_key(text, where, rule):
     with pytest.raises(ScenarioError) as info:
-        parse_spacecraft_scenario(text, source="craft.toml").run()
+        parse(text, source="craft.toml").run()
     assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems

@@ -1,191 +1,177 @@
-"""Demonstrations of the extension packages, as ``tumble demo NAME [-o DIRECTORY]``.
+"""The demonstrations of the extension packages, as a table the ``tumble demo`` command reads.
 
 Each demo is a function of its package, ``demo_xxx(out_dir) -> dict``, that
-writes its files atomically into an existing directory and returns its numbers;
-this module turns it into a command and prints the numbers as rows. Registered
-on the ``demo`` group by :mod:`tumble.cli` (imported at its end).
+writes its files atomically into an existing directory and returns its numbers.
+A row of :data:`DEMOS` names it (``"module:function"``, imported only when the
+demo runs), gives the command's help and turns the returned numbers into
+printed rows. :mod:`tumble.cli` reads this table and makes one
+``tumble demo NAME [-o DIRECTORY]`` command per row; this module imports
+nothing of the CLI.
 """
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Callable
-from pathlib import Path
-from typing import Annotated
+from dataclasses import dataclass
 
-import typer
-
-from tumble.cli import _exit_codes, _print_rows, demo_app
+__all__ = ["DEMOS", "Demo"]
 
 Rows = Callable[[dict], list[tuple[str, str]]]
 
 
-def _written(summary: dict) -> tuple[str, str]:
-    """The row listing every file the demo wrote (the summary's values that are paths of figures or data)."""
-    paths = [str(v) for v in summary.values() if isinstance(v, (str, Path)) and str(v).endswith((".png", ".nc"))]
-    return "wrote", ", ".join(paths)
+@dataclass(frozen=True)
+class Demo:
+    """One ``tumble demo`` command.
+
+    target : ``"module:function"``, a function ``(out_dir) -> dict`` that writes its files in ``out_dir``
+    help   : the command's help (its first line is the summary of ``tumble demo --help``)
+    rows   : the printed rows ``(label, text)`` of the returned dict (the CLI adds the files written)
+    """
+
+    target: str
+    help: str
+    rows: Rows
 
 
-def _register(name: str, target: str, help_text: str, rows: Rows) -> None:
-    """Add ``tumble demo NAME``: call ``target`` (``"module:function"``) and print ``rows(summary)``."""
-    module, function = target.split(":")
+DEMOS: dict[str, Demo] = {
+    "diver": Demo(
+        "tumble.variable.demo:demo_diver",
+        """A diver's twisting somersaults: a segment model (de Leva 1996) whose arms move in flight.
 
-    def command(
-        output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write the files in.")]
-        = Path("."),
-    ) -> None:
-        with _exit_codes():
-            summary = getattr(importlib.import_module(module), function)(output)
-        _print_rows([*rows(summary), _written(summary)])
+        Runs the three experiments of docs/diver.md: (a) a layout somersault that acquires twist
+        when one arm drops; (b) the rule of thumb twists/somersault = sin(tilt) (I_s/I_l - 1)
+        against simulation over tilts of 2-30 deg; (c) a forward 1.5-somersault dive with twists.
+        Writes diver_twisting_somersault.png, diver_twist_rule.png, diver_513xd.png and
+        diver_513xd.nc in the directory.
+        """,
+        lambda s: [
+            ("(a)", f"{s['twisting_somersault_twists']:.2f} twists in {s['twisting_somersault_somersaults']:.2f} "
+                    "somersaults after the left arm drops"),
+            ("(b)", f"rule of thumb within {s['rule_max_relative_error_10_30_deg']:.1%} of the simulation "
+                    "for tilts of 10-30 deg"),
+            ("(c)", f"{abs(s['dive_somersaults']):.2f} somersaults, {abs(s['dive_twists']):.2f} twists, "
+                    f"final tilt {s['dive_final_tilt_deg']:.1f} deg"),
+            ("|L|", "largest relative drift "
+                    f"{max(s['dive_momentum_drift'], s['twisting_somersault_momentum_drift']):.1e} "
+                    "(torque-free flight: L is conserved)"),
+        ],
+    ),
+    "flexible": Demo(
+        "tumble.flexible:demo_flexible",
+        """A 30 deg rest-to-rest slew of a spacecraft with two flexible panel modes (0.2 and 1.1 Hz).
 
-    command.__doc__ = help_text
-    demo_app.command(name)(command)
+        Bang-bang torque over 40 s, flexible hub against the rigid body (docs/flexible.md): the
+        panels keep vibrating after the manoeuvre and the hub jitters. Writes flexible.nc and
+        flexible.png in the directory.
+        """,
+        lambda s: [
+            ("torque", f"bang-bang, peak {s['peak_torque']:.4g} N m"),
+            ("modes", "residual amplitude " + ", ".join(f"{a:.3g}" for a in s["residual_modal_amplitude"])
+                      + " kg^0.5 m after the slew"),
+            ("jitter", f"{s['jitter_peak_arcsec']:.4g} arcsec peak, {s['jitter_rms_arcsec']:.4g} arcsec RMS, rate "
+                       f"{s['rate_jitter_peak_arcsec_per_s']:.4g} arcsec/s peak (rigid body: "
+                       f"{s['rigid_pointing_error_arcsec']:.2g} arcsec)"),
+        ],
+    ),
+    "slosh": Demo(
+        "tumble.slosh:demo_slosh",
+        """Fuel slosh turns a minor-axis spinner into a flat spin (pendulum analogue, docs/slosh.md).
 
+        The nutation angle grows exponentially at the rate of the linearised steady spin while the
+        sloshing fuel dissipates energy at constant |H|, until the spacecraft spins about its major
+        axis. Writes slosh.nc and slosh.png in the directory.
+        """,
+        lambda s: [
+            ("nutation", f"{s['nutation_initial_deg']:.3g} deg -> {s['nutation_final_deg']:.4g} deg"),
+            ("growth", f"time constant {s['growth_time_constant_s']:.4g} s (simulation), "
+                       f"{s['growth_time_constant_linear_s']:.4g} s (linearised steady spin)"),
+            ("energy", f"{s['energy_change']:+.1%}, final {s['energy_final']:.7g} J vs flat spin "
+                       f"{s['energy_flat_spin']:.7g} J, monotonic: {s['energy_monotonic']}"),
+            ("|H|", f"largest relative drift {s['momentum_norm_drift']:.1e}"),
+        ],
+    ),
+    "gyro": Demo(
+        "tumble.ins.demo:demo_gyroscope",
+        """A mechanical gyroscope: precession under a torque, nutation, and drift from imbalance and friction.
 
-_register(
-    "diver", "tumble.variable.demo:demo_diver",
-    """A diver's twisting somersaults: a segment model (de Leva 1996) whose arms move in flight.
+        A rotor on a pivot simulated with Euler's equations (docs/ins.md): precession rate
+        torque/(I_s w_s) and nutation period against theory. Writes ins_gyro_precession.png and
+        ins_gyro_drift.png in the directory.
+        """,
+        lambda s: [
+            ("precession", f"{s['precession_rate_measured']:.9g} rad/s (simulated), "
+                           f"{s['precession_rate']:.9g} rad/s (torque/(I_s w_s))"),
+            ("nutation", f"period {s['nutation_period_s_measured']:.9g} s (simulated), "
+                         f"{s['nutation_period_s_exact']:.9g} s (exact heavy top), "
+                         f"{s['nutation_period_s']:.9g} s (2 pi I_t/(I_s w_s))"),
+            ("drift", f"against the laws: imbalance {s['imbalance_drift_error_rad']:.2g} rad, spin drag "
+                      f"{s['spin_drag_drift_error_rad']:.2g} rad, pivot friction {s['pivot_tilt_error_rad']:.2g} rad"),
+        ],
+    ),
+    "coning": Demo(
+        "tumble.ins.demo:demo_coning",
+        """The classic coning test of strapdown attitude algorithms (alpha = 0.01 rad, Omega = 2 pi rad/s).
 
-    Runs the three experiments of docs/diver.md: (a) a layout somersault that acquires twist
-    when one arm drops; (b) the rule of thumb twists/somersault = sin(tilt) (I_s/I_l - 1)
-    against simulation over tilts of 2-30 deg; (c) a forward 1.5-somersault dive with twists.
-    Writes diver_twisting_somersault.png, diver_twist_rule.png, diver_513xd.png and
-    diver_513xd.nc in the directory.
-    """,
-    lambda s: [
-        ("(a)", f"{s['twisting_somersault_twists']:.2f} twists in {s['twisting_somersault_somersaults']:.2f} "
-                "somersaults after the left arm drops"),
-        ("(b)", f"rule of thumb within {s['rule_max_relative_error_10_30_deg']:.1%} of the simulation "
-                "for tilts of 10-30 deg"),
-        ("(c)", f"{abs(s['dive_somersaults']):.2f} somersaults, {abs(s['dive_twists']):.2f} twists, "
-                f"final tilt {s['dive_final_tilt_deg']:.1f} deg"),
-        ("|L|", f"largest relative drift {max(s['dive_momentum_drift'], s['twisting_somersault_momentum_drift']):.1e} "
-                "(torque-free flight: L is conserved)"),
-    ],
-)
+        Drift rate about the cone axis of the uncompensated, one-, two- and three-sample
+        algorithms against their laws (docs/ins.md): 1/2 sin^2(alpha) Omega (1 - sin(Omega T)/(Omega T))
+        uncompensated, alpha^2 Omega (Omega T)^4/60 one-sample, alpha^2 Omega (Omega T)^4/960 two-sample and
+        alpha^2 Omega (Omega T)^6/204120 three-sample. Writes ins_coning.png in the directory.
+        """,
+        lambda s: [(algorithm, f"measured drift within {s[algorithm]['max_relative_deviation']:.1%} of its law")
+                   for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
+    ),
+    "ins": Demo(
+        "tumble.ins.demo:demo_ins",
+        """End to end: a tumbling body, a gyro with errors, strapdown integration, attitude error.
 
+        The exact torque-free motion is sampled by a 200 Hz gyro (error-free, angle random walk only,
+        all error terms) and integrated back with the three-sample algorithm for 60 s; the same gyro
+        at rest gives an Allan deviation from which N and B are recovered (docs/ins.md). Writes
+        ins_error.png and ins_allan.png in the directory.
+        """,
+        lambda s: [
+            *[(name, f"attitude error after {s['duration_s']:g} s: {s[name]['final_rad']:.2g} rad")
+              for name in ("error-free", "angle random walk", "all error terms")],
+            ("ARW", f"prediction N sqrt(3t) = {s['arw_prediction_rad']:.2g} rad"),
+            ("Allan", f"N {s['white_noise']:.3g} -> recovered "
+                      + ", ".join(f"{v:.3g}" for v in s["white_noise_recovered"])
+                      + f"; B {s['bias_instability']:.3g} -> recovered "
+                      + ", ".join(f"{v:.3g}" for v in s["bias_instability_recovered"])),
+        ],
+    ),
+    "explorer1": Demo(
+        "tumble.spacecraft.passive:demo_explorer1",
+        """Explorer 1 (1958): a spin about the minor axis decays into a flat spin about the major axis.
 
-_register(
-    "flexible", "tumble.flexible:demo_flexible",
-    """A 30 deg rest-to-rest slew of a spacecraft with two flexible panel modes (0.2 and 1.1 Hz).
+        The satellite (750 rpm about its long, minor axis) dissipates energy in a spherical viscous
+        damper standing in for its whip antennas; the nutation angle grows to 90 deg at constant |L|
+        with the energy-sink time constant (docs/passive_stability.md). Writes explorer1.nc and
+        explorer1.png in the directory.
+        """,
+        lambda s: [
+            ("time", f"constant {s['time_constant_s']:.4g} s (simulation), {s['time_constant_estimate_s']:.4g} s "
+                     "(energy-sink estimate)"),
+            ("nutation", f"final {s['final_nutation_deg']:.4f} deg: a flat spin about the major axis"),
+            ("energy", f"{s['energy_initial_J']:.4g} J -> {s['energy_final_J']:.4g} J, "
+                       + ("falling at every sample" if s["max_energy_increase"] < 0.0 else
+                          f"rising by up to {s['max_energy_increase']:.1e} (relative) between samples")),
+            ("|L|", f"largest relative drift {s['momentum_drift']:.1e} (magnitude), {s['momentum_vector_drift']:.1e} "
+                    "(inertial vector), hub and damper together"),
+        ],
+    ),
+    "gravity-gradient": Demo(
+        "tumble.spacecraft.passive:demo_gravity_gradient",
+        """A gravity-gradient-stabilised satellite librating about the local-vertical frame (LVLH).
 
-    Bang-bang torque over 40 s, flexible hub against the rigid body (docs/flexible.md): the
-    panels keep vibrating after the manoeuvre and the hub jitters. Writes flexible.nc and
-    flexible.png in the directory.
-    """,
-    lambda s: [
-        ("torque", f"bang-bang, peak {s['peak_torque']:.4g} N m"),
-        ("modes", "residual amplitude " + ", ".join(f"{a:.3g}" for a in s["residual_modal_amplitude"])
-                  + " kg^0.5 m after the slew"),
-        ("jitter", f"{s['jitter_peak_arcsec']:.4g} arcsec peak, {s['jitter_rms_arcsec']:.4g} arcsec RMS, rate "
-                   f"{s['rate_jitter_peak_arcsec_per_s']:.4g} arcsec/s peak (rigid body: "
-                   f"{s['rigid_pointing_error_arcsec']:.2g} arcsec)"),
-    ],
-)
-
-_register(
-    "slosh", "tumble.slosh:demo_slosh",
-    """Fuel slosh turns a minor-axis spinner into a flat spin (pendulum analogue, docs/slosh.md).
-
-    The nutation angle grows exponentially at the rate of the linearised steady spin while the
-    sloshing fuel dissipates energy at constant |H|, until the spacecraft spins about its major
-    axis. Writes slosh.nc and slosh.png in the directory.
-    """,
-    lambda s: [
-        ("nutation", f"{s['nutation_initial_deg']:.3g} deg -> {s['nutation_final_deg']:.4g} deg"),
-        ("growth", f"time constant {s['growth_time_constant_s']:.4g} s (simulation), "
-                   f"{s['growth_time_constant_linear_s']:.4g} s (linearised steady spin)"),
-        ("energy", f"{s['energy_change']:+.1%}, final {s['energy_final']:.7g} J vs flat spin "
-                   f"{s['energy_flat_spin']:.7g} J, monotonic: {s['energy_monotonic']}"),
-        ("|H|", f"largest relative drift {s['momentum_norm_drift']:.1e}"),
-    ],
-)
-
-_register(
-    "gyro", "tumble.ins.demo:demo_gyroscope",
-    """A mechanical gyroscope: precession under a torque, nutation, and drift from imbalance and friction.
-
-    A rotor on a pivot simulated with Euler's equations (docs/ins.md): precession rate
-    torque/(I_s w_s) and nutation period against theory. Writes ins_gyro_precession.png and
-    ins_gyro_drift.png in the directory.
-    """,
-    lambda s: [
-        ("precession", f"{s['precession_rate_measured']:.9g} rad/s (simulated), "
-                       f"{s['precession_rate']:.9g} rad/s (torque/(I_s w_s))"),
-        ("nutation", f"period {s['nutation_period_s_measured']:.9g} s (simulated), "
-                     f"{s['nutation_period_s_exact']:.9g} s (exact heavy top), "
-                     f"{s['nutation_period_s']:.9g} s (2 pi I_t/(I_s w_s))"),
-        ("drift", f"against the laws: imbalance {s['imbalance_drift_error_rad']:.2g} rad, spin drag "
-                  f"{s['spin_drag_drift_error_rad']:.2g} rad, pivot friction {s['pivot_tilt_error_rad']:.2g} rad"),
-    ],
-)
-
-_register(
-    "coning", "tumble.ins.demo:demo_coning",
-    """The classic coning test of strapdown attitude algorithms (alpha = 0.01 rad, Omega = 2 pi rad/s).
-
-    Drift rate about the cone axis of the uncompensated, one-, two- and three-sample
-    algorithms against their laws (docs/ins.md): 1/2 sin^2(alpha) Omega (1 - sin(Omega T)/(Omega T))
-    uncompensated, alpha^2 Omega (Omega T)^4/60 one-sample, alpha^2 Omega (Omega T)^4/960 two-sample and
-    alpha^2 Omega (Omega T)^6/204120 three-sample. Writes ins_coning.png in the directory.
-    """,
-    lambda s: [(algorithm, f"measured drift within {s[algorithm]['max_relative_deviation']:.1%} of its law")
-               for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
-)
-
-_register(
-    "ins", "tumble.ins.demo:demo_ins",
-    """End to end: a tumbling body, a gyro with errors, strapdown integration, attitude error.
-
-    The exact torque-free motion is sampled by a 200 Hz gyro (error-free, angle random walk only,
-    all error terms) and integrated back with the three-sample algorithm for 60 s; the same gyro
-    at rest gives an Allan deviation from which N and B are recovered (docs/ins.md). Writes
-    ins_error.png and ins_allan.png in the directory.
-    """,
-    lambda s: [
-        *[(name, f"attitude error after {s['duration_s']:g} s: {s[name]['final_rad']:.2g} rad")
-          for name in ("error-free", "angle random walk", "all error terms")],
-        ("ARW", f"prediction N sqrt(3t) = {s['arw_prediction_rad']:.2g} rad"),
-        ("Allan", f"N {s['white_noise']:.3g} -> recovered "
-                  + ", ".join(f"{v:.3g}" for v in s["white_noise_recovered"])
-                  + f"; B {s['bias_instability']:.3g} -> recovered "
-                  + ", ".join(f"{v:.3g}" for v in s["bias_instability_recovered"])),
-    ],
-)
-
-_register(
-    "explorer1", "tumble.spacecraft.passive:demo_explorer1",
-    """Explorer 1 (1958): a spin about the minor axis decays into a flat spin about the major axis.
-
-    The satellite (750 rpm about its long, minor axis) dissipates energy in a spherical viscous
-    damper standing in for its whip antennas; the nutation angle grows to 90 deg at constant |L|
-    with the energy-sink time constant (docs/passive_stability.md). Writes explorer1.nc and
-    explorer1.png in the directory.
-    """,
-    lambda s: [
-        ("time", f"constant {s['time_constant_s']:.4g} s (simulation), {s['time_constant_estimate_s']:.4g} s "
-                 "(energy-sink estimate)"),
-        ("nutation", f"final {s['final_nutation_deg']:.4f} deg: a flat spin about the major axis"),
-        ("energy", f"{s['energy_initial_J']:.4g} J -> {s['energy_final_J']:.4g} J, "
-                   + ("falling at every sample" if s["max_energy_increase"] < 0.0 else
-                      f"rising by up to {s['max_energy_increase']:.1e} (relative) between samples")),
-        ("|L|", f"largest relative drift {s['momentum_drift']:.1e} (magnitude), {s['momentum_vector_drift']:.1e} "
-                "(inertial vector), hub and damper together"),
-    ],
-)
-
-_register(
-    "gravity-gradient", "tumble.spacecraft.passive:demo_gravity_gradient",
-    """A gravity-gradient-stabilised satellite librating about the local-vertical frame (LVLH).
-
-    Classifies the spacecraft in the (k_R, k_Y) plane (Lagrange and DeBra-Delp regions),
-    simulates its libration on a circular orbit and draws both (docs/passive_stability.md).
-    """,
-    lambda s: [
-        ("region", f"{s['region']} (k_R = {s['k_roll']:.4g}, k_Y = {s['k_yaw']:.4g})"),
-        ("frequency", f"pitch {s['pitch_frequency']:.5g} n, roll/yaw "
-                      + ", ".join(f"{f:.5g}" for f in s["roll_yaw_frequencies"])
-                      + f" n (orbit period {s['orbit_period_s']:.6g} s)"),
-        ("libration", f"largest roll/pitch/yaw angle {s['max_angle_deg']:.3g} deg"),
-    ],
-)
+        Classifies the spacecraft in the (k_R, k_Y) plane (Lagrange and DeBra-Delp regions),
+        simulates its libration on a circular orbit and draws both (docs/passive_stability.md).
+        """,
+        lambda s: [
+            ("region", f"{s['region']} (k_R = {s['k_roll']:.4g}, k_Y = {s['k_yaw']:.4g})"),
+            ("frequency", f"pitch {s['pitch_frequency']:.5g} n, roll/yaw "
+                          + ", ".join(f"{f:.5g}" for f in s["roll_yaw_frequencies"])
+                          + f" n (orbit period {s['orbit_period_s']:.6g} s)"),
+            ("libration", f"largest roll/pitch/yaw angle {s['max_angle_deg']:.3g} deg"),
+        ],
+    ),
+}

@@ -1,9 +1,11 @@
-"""The ``tumble`` command: run scenario files, the tennis-racket demo, inspect results.
+"""The ``tumble`` command: run scenario files, the demos, inspect results.
 
     tumble run SCENARIO.toml -o out.nc [--plot out.png] [--quiet]
     tumble demo racket [-o racket.nc] [--plot racket.png] [--duration 20]
     tumble demo polhode [-o polhode.png]
     tumble demo top [-o DIRECTORY] [--duration 1.5]
+    tumble demo NAME [-o DIRECTORY]        (the demos of tumble._demos.DEMOS: diver, flexible, ...)
+    tumble robot torques ROBOT_FILE --q ...
     tumble info out.nc
     tumble --version
 
@@ -16,7 +18,7 @@ Documented in ``docs/cli.md``.
 
 from __future__ import annotations
 
-import tomllib
+import importlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -28,12 +30,14 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 import tumble
+from tumble import scenario as scenarios
+from tumble._demos import DEMOS, Demo
 from tumble._validate import ValidationError, require_positive
 from tumble.analysis import flip_times, intermediate_rate
 from tumble.analytic._stability import flip_interval, stability
 from tumble.body import RigidBody
 from tumble.integrate import SolverError
-from tumble.scenario import load_scenario
+from tumble.robot.cli import app as robot_app
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory, load, write_atomic
 
@@ -49,6 +53,7 @@ app = typer.Typer(
 )
 demo_app = typer.Typer(help="Built-in demonstrations.", no_args_is_help=True, rich_markup_mode="markdown")
 app.add_typer(demo_app, name="demo")
+app.add_typer(robot_app, name="robot", help="Robot arms (serial chains from DH tables or URDF): joint torques.")
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILURE = 1
@@ -98,31 +103,20 @@ def run(
     plot: Annotated[Path | None, typer.Option("--plot", help="Also write a PNG figure of the trajectory.")] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
-    """Validate and simulate a scenario, write the trajectory (NetCDF) and optionally a figure (PNG).
+    """Validate and simulate a scenario of any kind, write the trajectory (NetCDF) and optionally a figure (PNG).
 
     A bad scenario is reported on stderr (file, key, rule) with exit code 2, and nothing is written.
     """
     with _exit_codes():
-        if _has_table(scenario, "spacecraft"):  # a spacecraft with actuators: tumble.spacecraft.scenario
-            from tumble.spacecraft.scenario import load_spacecraft_scenario
-
-            spec = load_spacecraft_scenario(scenario)
-            _check_outputs(output, plot, inputs=(scenario,))
-            with _progress_bar("simulating", enabled=not quiet) as progress:
-                traj = spec.run(progress=progress)
-            figure = spec.figure(traj) if plot is not None else None
-            extra_rows = _spacecraft_rows(traj)
-        else:
-            spec = load_scenario(scenario)
-            problem = spec.build()  # every rule of the file is checked before anything runs
-            _check_outputs(output, plot, inputs=(scenario,))
-            with _progress_bar("simulating", enabled=not quiet) as progress:
-                traj = problem.simulate(progress=progress)
-            figure = traj.plot(title=spec.name) if plot is not None else None
-            extra_rows = []
+        spec = scenarios.load(scenario)  # the file is read and parsed once; its kind picks the model
+        problem = spec.build()  # every rule of the file is checked before anything runs
+        _check_outputs(output, plot, inputs=(scenario,))
+        with _progress_bar("simulating", enabled=not quiet) as progress:
+            traj = problem.simulate(progress=progress)
+        figure = spec.figure(traj) if plot is not None else None
         _save(traj, output, figure, plot)
     _print_rows([("scenario", f"{scenario}" + (f" ({spec.name})" if spec.name else "")),
-                 *_summary(traj), *extra_rows, ("wrote", _written(output, plot))])
+                 *_summary(traj), *spec.rows(traj), ("wrote", _written(output, plot))])
 
 
 @demo_app.command("racket")
@@ -221,6 +215,28 @@ def top(
                  "the upright top is stable above it)"),
         ("wrote", f"{summary['nc']}, {summary['png']}"),
     ])
+
+
+def _demo_command(demo: Demo) -> Callable[..., None]:
+    """The ``tumble demo NAME`` command of a row of :data:`tumble._demos.DEMOS`: call its function on the
+    output directory, print its rows and the files it wrote."""
+    module, function = demo.target.split(":")
+
+    def command(
+        output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write the files in.")]
+        = Path("."),
+    ) -> None:
+        with _exit_codes():
+            summary = getattr(importlib.import_module(module), function)(output)
+        written = [str(v) for v in summary.values() if isinstance(v, (str, Path)) and str(v).endswith((".png", ".nc"))]
+        _print_rows([*demo.rows(summary), ("wrote", ", ".join(written))])
+
+    command.__doc__ = demo.help
+    return command
+
+
+for _name, _demo in DEMOS.items():
+    demo_app.command(_name)(_demo_command(_demo))
 
 
 @app.command()
@@ -347,28 +363,6 @@ def _summary(traj: Trajectory) -> list[tuple[str, str]]:
     return rows
 
 
-def _has_table(path: Path, name: str) -> bool:
-    """True when the TOML file ``path`` has a top-level table ``name`` (False if unreadable: the loader says why)."""
-    try:
-        return isinstance(tomllib.loads(path.read_text(encoding="utf-8")).get(name), dict)
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
-        return False
-
-
-def _spacecraft_rows(traj: Trajectory) -> list[tuple[str, str]]:
-    """Rows for a spacecraft run: final rate, wheels (peak speed, saturation), total momentum drift."""
-    rows = [("rate", f"final |omega| {np.linalg.norm(traj.omega[-1]):.3g} rad/s")]
-    if "wheel_speed" in traj.extras:
-        speed = np.abs(traj.extras["wheel_speed"].data)
-        saturated = "wheel_saturated" in traj.extras and bool(np.any(traj.extras["wheel_saturated"].data > 0))
-        rows.append(("wheels", f"peak speed {speed.max():.4g} rad/s" + (", SATURATED" if saturated else "")))
-    if "total_momentum_inertial" in traj.extras:
-        h = traj.extras["total_momentum_inertial"].data
-        change = np.linalg.norm(h - h[0], axis=-1).max()
-        rows.append(("momentum", f"total (hub + actuators), inertial: largest change {change:.3g} N m s"))
-    return rows
-
-
 def _written(output: Path, plot: Path | None) -> str:
     return ", ".join(str(p) for p in (output, plot) if p is not None)
 
@@ -376,12 +370,3 @@ def _written(output: Path, plot: Path | None) -> str:
 def _print_rows(rows: list[tuple[str, str]]) -> None:
     for label, value in rows:
         typer.echo(f"{label:<10}{value}" if len(label) < 10 else f"{label} {value}")
-
-
-# The extension packages' demos (tumble demo diver, ...): registered on demo_app.
-from tumble import _demos  # noqa: E402  (imported for its registrations)
-from tumble.robot.cli import app as _robot_app  # noqa: E402
-
-del _demos
-
-app.add_typer(_robot_app, name="robot", help="Robot arms (serial chains from DH tables or URDF): joint torques.")

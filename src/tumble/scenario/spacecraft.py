@@ -1,4 +1,4 @@
-"""Spacecraft scenario files: a controlled spacecraft described as data, in TOML.
+"""Scenario kind ``"spacecraft"``: a controlled spacecraft (:class:`tumble.spacecraft.Spacecraft`).
 
 A file with a ``[spacecraft]`` table (SI units, body axes; angles of the
 orbit in degrees)::
@@ -31,36 +31,36 @@ orbit in degrees)::
     dt = 0.1
 
 The tables and keys are the arguments of :class:`tumble.spacecraft.Spacecraft`
-and of its parts (``docs/spacecraft.md`` lists them). Validation reuses
-the rules and messages of :mod:`tumble.scenario`: unknown keys are refused,
-and every problem is a :class:`tumble.scenario.ScenarioError` naming the
-file, the key and the rule.
+and of its parts (``docs/spacecraft.md`` lists them); ``[initial]``,
+``[time]``, ``[solver]`` and ``[spacecraft.orbit]`` are the shared tables
+(:mod:`tumble.scenario.tables`, :mod:`tumble.scenario.orbit`).
 """
 
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Callable
-from pathlib import Path
-from typing import Annotated, Literal, Union
+from dataclasses import dataclass
+from typing import Annotated, ClassVar, Literal, Union
 
 import numpy as np
-import pydantic
-from pydantic import Field, PrivateAttr, field_validator
+from pydantic import Field, model_validator
 
 from tumble.body import RigidBody
-from tumble.scenario import (EulerAngles, Initial, ScenarioError, Solver, Time, _blame, _Bool, _describe, _Matrix,
-                             _Number, _Positive, _Quaternion, _Table, _toml_problem, _Vector)
+from tumble.scenario._base import Scenario
+from tumble.scenario._errors import ScenarioError, in_file, keyed
+from tumble.scenario._values import _Bool, _Limit, _Matrix, _Number, _Positive, _Quaternion, _Table, _Vector
+from tumble.scenario.orbit import OrbitTable
+from tumble.scenario.tables import EulerAngles, Initial, Solver, Time
 from tumble.spacecraft import actuators, control
 from tumble.spacecraft.environment import DipoleField
-from tumble.spacecraft.model import METHODS, Spacecraft, simulate
-from tumble.spacecraft.orbit import Orbit
+from tumble.spacecraft.model import METHODS, Spacecraft
+from tumble.spacecraft.model import simulate as spacecraft_simulate
 from tumble.trajectory import Trajectory
 
-__all__ = ["SpacecraftScenario", "load_spacecraft_scenario", "parse_spacecraft_scenario", "run_spacecraft_scenario"]
+__all__ = ["SpacecraftProblem", "SpacecraftScenario"]
 
-_Limit = Annotated[float, Field(strict=True, gt=0.0)]  # inf allowed: TOML's inf means "no limit"
+_MAGIC_SKEW = math.degrees(math.atan(math.sqrt(2.0)))  # deg: the pyramid whose four axes are equally spaced
 
 
 class Wheel(_Table):
@@ -84,7 +84,7 @@ class WheelPyramid(_Table):
     ``position`` and ``transverse_inertia``, as every other key, apply to each of the four."""
 
     inertia: _Positive
-    skew: _Positive = math.degrees(math.atan(math.sqrt(2.0)))
+    skew: _Positive = _MAGIC_SKEW
     max_torque: _Limit = math.inf
     max_speed: _Limit = math.inf
     viscous: _Number = 0.0
@@ -108,6 +108,12 @@ class HubTable(_Table):
     mass: _Positive
     com: _Vector | None = None
 
+    @model_validator(mode="after")
+    def _one_description(self):
+        if (self.inertia is None) == (self.moments is None):
+            raise ValueError("give exactly one of inertia or moments")
+        return self
+
     def argument_keys(self, prefix: str) -> dict[str, str]:
         keys = super().argument_keys(prefix)
         if self.inertia is None:
@@ -115,15 +121,13 @@ class HubTable(_Table):
         return keys
 
     def build(self) -> RigidBody:
-        if (self.inertia is None) == (self.moments is None):
-            raise ScenarioError("", [("spacecraft.hub", "give exactly one of inertia or moments")])
         inertia = self.inertia if self.inertia is not None else np.diag(self.moments)
         return RigidBody(inertia, mass=self.mass, com=self.com)
 
 
 class CMGPyramid(_Table):
     momentum: _Positive
-    skew: _Positive = math.degrees(math.atan(math.sqrt(2.0)))
+    skew: _Positive = _MAGIC_SKEW
     max_gimbal_rate: _Positive = 1.0
     robust_gain: _Number = 0.01
     robust_decay: _Number = 10.0
@@ -159,37 +163,19 @@ class MagnetorquerTable(_Table):
         return actuators.Magnetorquers(self.max_dipole)
 
 
-class OrbitTable(_Table):
-    """A circular orbit (``altitude``) or an ellipse (``semi_major_axis``, ``eccentricity``); angles in degrees."""
-
-    altitude: _Number | None = None
-    semi_major_axis: _Positive | None = None
-    eccentricity: _Number = 0.0
-    inclination: _Number = 0.0
-    raan: _Number = 0.0
-    arg_periapsis: _Number = 0.0
-    mean_anomaly: _Number = 0.0
-
-    def build(self) -> Orbit:
-        if (self.altitude is None) == (self.semi_major_axis is None):
-            raise ScenarioError("", [("spacecraft.orbit", "give exactly one of altitude or semi_major_axis (m)")])
-        angles = {k: math.radians(getattr(self, k)) for k in ("inclination", "raan", "arg_periapsis", "mean_anomaly")}
-        if self.altitude is not None:
-            return Orbit.circular(self.altitude, angles["inclination"], raan=angles["raan"],
-                                  arg_latitude=angles["mean_anomaly"] + angles["arg_periapsis"])
-        return Orbit(self.semi_major_axis, self.eccentricity, **angles)
-
-
 class FieldTable(_Table):
     """``model = "dipole"`` (tilted dipole, IGRF-13 2020) or ``uniform = [Bx, By, Bz]`` (T, inertial)."""
 
     model: Literal["dipole"] | None = None
     uniform: _Vector | None = None
 
-    def build(self):
+    @model_validator(mode="after")
+    def _one_field(self):
         if (self.model is None) == (self.uniform is None):
-            rule = "give exactly one of model = \"dipole\" or uniform"
-            raise ScenarioError("", [("spacecraft.magnetic_field", rule)])
+            raise ValueError("give exactly one of model = \"dipole\" or uniform")
+        return self
+
+    def build(self):
         return DipoleField() if self.model == "dipole" else np.array(self.uniform)
 
 
@@ -201,6 +187,12 @@ class PDTable(_Table):
     target_euler: EulerAngles | None = None
     max_rate: _Limit = math.inf
     max_torque: _Limit = math.inf
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        if self.target_euler is not None:
+            keys.update(self.target_euler.argument_keys(f"{prefix}.target_euler"))
+        return keys
 
     def build(self):
         target = (self.target_euler.quaternion() if self.target_euler is not None
@@ -246,6 +238,12 @@ _Controller = Annotated[Union[PDTable, RateDampingTable, ConstantTorqueTable, BD
                         Field(discriminator="kind")]
 
 
+def _built(table: _Table, key: str):
+    """``table.build()``, a refusal by the library reported against the key behind the argument."""
+    with keyed(table.argument_keys(key), key):
+        return table.build()
+
+
 class SpacecraftTable(_Table):
     """``[spacecraft]``: mass properties (``inertia`` or ``moments``: the total, wheels included; or a
     ``hub`` table: the hub without the wheels, which then need mass properties), actuators, environment
@@ -266,42 +264,41 @@ class SpacecraftTable(_Table):
     controller: list[_Controller] = []
     control_period: _Positive | None = None
 
-    def build(self, source: str) -> Spacecraft:
+    @model_validator(mode="after")
+    def _one_description(self):
         given = [key for key in ("inertia", "moments", "hub") if getattr(self, key) is not None]
         if len(given) != 1:
-            rule = ("give exactly one of inertia, moments (the total, wheels included) or hub (a [spacecraft.hub] "
-                    "table: the hub without the wheels)" + (f"; got {' and '.join(given)}" if given else ""))
-            raise ScenarioError(source, [("spacecraft", rule)])
+            raise ValueError("give exactly one of inertia, moments (the total, wheels included) or hub (a "
+                             "[spacecraft.hub] table: the hub without the wheels)"
+                             + (f"; got {' and '.join(given)}" if given else ""))
         if self.wheels and self.wheel_pyramid is not None:
-            raise ScenarioError(source, [("spacecraft", "give wheels or wheel_pyramid, not both")])
-        parts = {}
-        for key in ("wheels", "thrusters", "controller"):
-            items = []
-            for i, entry in enumerate(getattr(self, key)):
-                with _blame(source, f"spacecraft.{key}[{i}]", entry.argument_keys(f"spacecraft.{key}[{i}]")):
-                    items.append(entry.build())
-            parts[key] = items
+            raise ValueError("give wheels or wheel_pyramid, not both")
+        return self
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        if self.moments is not None:
+            keys["inertia"] = f"{prefix}.moments"
+        return keys
+
+    def build(self) -> Spacecraft:
+        """The :class:`~tumble.spacecraft.Spacecraft`; a refusal is reported against its key."""
+        parts = {key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
+                 for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "orbit", "magnetic_field"):
             entry = getattr(self, key)
-            try:
-                with _blame(source, f"spacecraft.{key}", entry.argument_keys(f"spacecraft.{key}") if entry else {}):
-                    parts[key] = None if entry is None else entry.build()
-            except ScenarioError as exc:
-                raise ScenarioError(source, list(exc.problems)) from None
-        if parts.pop("wheel_pyramid") is not None:
-            parts["wheels"] = actuators.pyramid_wheels(**self.wheel_pyramid.model_dump())
+            parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
+        pyramid = parts.pop("wheel_pyramid")
+        if pyramid is not None:
+            parts["wheels"] = pyramid
         if self.hub is not None:
-            self._check_wheel_mass_properties(source)
-        inertia = (self.inertia if self.inertia is not None
-                   else np.diag(self.moments) if self.moments is not None else None)
-        keys = {"inertia": "spacecraft.inertia" if self.inertia is not None else "spacecraft.moments",
-                "hub": "spacecraft.hub",
-                "control_period": "spacecraft.control_period", "gravity_gradient": "spacecraft.gravity_gradient"}
-        with _blame(source, "spacecraft", keys):
+            self._check_wheel_mass_properties()
+        inertia = self.inertia if self.inertia is not None else None if self.moments is None else np.diag(self.moments)
+        with keyed(self.argument_keys("spacecraft"), "spacecraft"):
             return Spacecraft(inertia=inertia, gravity_gradient=self.gravity_gradient,
                               control_period=self.control_period, **parts)
 
-    def _check_wheel_mass_properties(self, source: str):
+    def _check_wheel_mass_properties(self):
         """With a ``hub``, every wheel needs ``mass``, ``position`` and ``transverse_inertia`` (the rule of
         :meth:`tumble.spacecraft.ReactionWheel.part`, reported here against each wheel's key)."""
         tables = ([("spacecraft.wheel_pyramid", self.wheel_pyramid)] if self.wheel_pyramid is not None
@@ -310,55 +307,83 @@ class SpacecraftTable(_Table):
                 "mass, position and transverse_inertia")
         problems = [(f"{where}.mass", rule) for where, wheel in tables if wheel.mass is None]
         if problems:
-            raise ScenarioError(source, problems)
+            raise ScenarioError("", problems)
 
 
 class SpacecraftInitial(Initial):
-    """``[initial]``: ``omega``, ``q`` or ``euler`` as in rigid-body scenarios, plus ``wheel_speeds`` (rad/s,
-    relative to the hub) and ``gimbal_angles`` (rad)."""
+    """``[initial]``: ``omega``, ``q`` or ``euler`` as in every kind, plus ``wheel_speeds`` (rad/s, relative
+    to the hub) and ``gimbal_angles`` (rad)."""
 
     wheel_speeds: list[_Number] | None = None
     gimbal_angles: list[_Number] | None = None
 
 
 class SpacecraftSolver(Solver):
-    """``[solver]``: ``rk4`` (``dt``) or ``dop853`` (``rtol``, ``atol``; continuous control only)."""
+    """``[solver]``: ``rk4`` (``dt``; the default) or ``dop853`` (``rtol``, ``atol``; continuous control only)."""
+
+    methods: ClassVar[tuple[str, ...]] = METHODS
+    model_name: ClassVar[str] = "spacecraft"
 
     method: Annotated[str, Field(strict=True)] = "rk4"
 
-    @field_validator("method")
-    @classmethod
-    def _spacecraft_method(cls, method):
-        if method not in METHODS:
-            raise ValueError(f"must be one of {', '.join(map(repr, METHODS))} for a spacecraft, got {method!r}")
-        return method
+
+# Where the run's arguments come from in the file, besides [initial]'s (key x → initial value x0).
+_RUN_KEYS = {"t": "time", "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
+             "dt": "solver.dt"}
 
 
-class SpacecraftScenario(_Table):
-    """A validated spacecraft scenario; :meth:`run` simulates it."""
+@dataclass(frozen=True)
+class SpacecraftProblem:
+    """A spacecraft scenario turned into a run: the ``spacecraft``, its ``initial`` state by name
+    (``omega0``, ``q0``, ``wheel_speeds0``, ``gimbal_angles0``: the keywords of the simulation), output
+    times ``t`` (s), ``method`` and ``options``, ``keys`` (argument → scenario key) and ``source``."""
 
-    name: Annotated[str, Field(strict=True)] | None = None
-    description: Annotated[str, Field(strict=True)] | None = None
+    spacecraft: Spacecraft
+    initial: dict[str, np.ndarray]
+    t: np.ndarray
+    method: str
+    options: dict[str, float]
+    keys: dict[str, str]
+    source: str = "<scenario>"
+
+    @property
+    def model(self) -> Spacecraft:
+        return self.spacecraft
+
+    def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
+        """Simulate; an argument the library refuses is reported against its scenario key."""
+        with in_file(self.source), keyed(self.keys, ""):
+            return _simulate_spacecraft(self, progress)
+
+
+def _simulate_spacecraft(problem: SpacecraftProblem, progress) -> Trajectory:
+    """A spacecraft, integrated by today's entry point :func:`tumble.spacecraft.model.simulate`.
+
+    SWITCH TO tumble.simulate HERE: once :class:`~tumble.spacecraft.Spacecraft`
+    is a tumble.simulate model, ``spacecraft_simulate`` becomes
+    ``tumble.simulate`` with the same arguments — a one-line change.
+    """
+    return spacecraft_simulate(problem.spacecraft, t=problem.t, method=problem.method, progress=progress,
+                               **problem.initial, **problem.options)
+
+
+class SpacecraftScenario(Scenario):
+    """A validated spacecraft scenario (``kind = "spacecraft"``, or any file with a ``[spacecraft]`` table)."""
+
     spacecraft: SpacecraftTable
     initial: SpacecraftInitial
     time: Time
     solver: SpacecraftSolver = SpacecraftSolver(dt=0.1)
 
-    _source: str = PrivateAttr("<scenario>")
-
-    def run(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-        source = self._source
-        craft = self.spacecraft.build(source)
-        with _blame(source, "initial", {"q": "initial.q", "seq": "initial.euler.seq"}):
-            q0 = self.initial.quaternion()
-        keys = {"omega0": "initial.omega", "wheel_speeds0": "initial.wheel_speeds",
-                "gimbal_angles0": "initial.gimbal_angles", "dt": "solver.dt", "method": "solver.method",
-                "rtol": "solver.rtol", "atol": "solver.atol", "t": "time"}
-        with _blame(source, "", keys):
-            return simulate(craft, self.initial.omega, t=self.time.times(), q0=q0,
-                            wheel_speeds0=self.initial.wheel_speeds, gimbal_angles0=self.initial.gimbal_angles,
-                            method=self.solver.method, progress=progress, **self.solver.options())
-
+    def build(self) -> SpacecraftProblem:
+        """Build the spacecraft and its initial state; a refusal by the library names the key."""
+        with in_file(self.source):
+            craft = self.spacecraft.build()
+            keys = {**self.initial.argument_keys("initial"), **_RUN_KEYS}
+            with keyed(keys, "initial"):
+                initial = self.initial.state()
+            return SpacecraftProblem(spacecraft=craft, initial=initial, t=self.time.times(), method=self.solver.method,
+                                     options=self.solver.options(), keys=keys, source=self.source)
 
     def target(self) -> np.ndarray | None:
         """The attitude commanded by the scenario's quaternion PD law, if it has one (for figures)."""
@@ -373,41 +398,15 @@ class SpacecraftScenario(_Table):
 
         return spacecraft_figure(traj, target=self.target(), title=self.name)
 
-
-def parse_spacecraft_scenario(text: str, *, source: str = "<string>") -> SpacecraftScenario:
-    """Parse and validate a spacecraft scenario from TOML ``text``."""
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(source, [_toml_problem(exc)]) from None
-    try:
-        scenario = SpacecraftScenario.model_validate(data)
-    except pydantic.ValidationError as exc:
-        raise ScenarioError(source, [_describe(_untagged(error)) for error in exc.errors()]) from None
-    scenario._source = source
-    return scenario
-
-
-# The ``kind`` values of the controller tables: pydantic puts them in error locations, the file has no such key.
-_TAGS = {cls.model_fields["kind"].annotation.__args__[0] for cls in _Controller.__origin__.__args__}
-
-
-def _untagged(error: dict) -> dict:
-    return {**error, "loc": tuple(part for part in error["loc"] if part not in _TAGS)}
-
-
-def load_spacecraft_scenario(path) -> SpacecraftScenario:
-    """Read and validate the spacecraft scenario file ``path`` (UTF-8 TOML)."""
-    source = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(source, [("", f"cannot read the file ({exc.strerror or exc})")]) from None
-    return parse_spacecraft_scenario(text, source=source)
-
-
-def run_spacecraft_scenario(scenario, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-    """Simulate a spacecraft scenario (a :class:`SpacecraftScenario` or the path of a file)."""
-    if not isinstance(scenario, SpacecraftScenario):
-        scenario = load_spacecraft_scenario(scenario)
-    return scenario.run(progress=progress)
+    def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
+        """Final rate, wheels (peak speed, saturation), drift of the total momentum (hub + actuators)."""
+        rows = [("rate", f"final |omega| {np.linalg.norm(traj.omega[-1]):.3g} rad/s")]
+        if "wheel_speed" in traj.extras:
+            speed = np.abs(traj.extras["wheel_speed"].data)
+            saturated = "wheel_saturated" in traj.extras and bool(np.any(traj.extras["wheel_saturated"].data > 0))
+            rows.append(("wheels", f"peak speed {speed.max():.4g} rad/s" + (", SATURATED" if saturated else "")))
+        if "total_momentum_inertial" in traj.extras:
+            h = traj.extras["total_momentum_inertial"].data
+            change = np.linalg.norm(h - h[0], axis=-1).max()
+            rows.append(("momentum", f"total (hub + actuators), inertial: largest change {change:.3g} N m s"))
+        return rows

@@ -1,0 +1,57 @@
+"""Reading a scenario: the file is read once, parsed once (``tomllib``), its kind picked, its tables validated."""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Callable
+from pathlib import Path
+
+import pydantic
+
+from tumble.scenario._base import Scenario
+from tumble.scenario._errors import ScenarioError, describe, in_file, toml_problem
+from tumble.scenario.kinds import kind_of, scenario_class
+from tumble.trajectory import Trajectory
+
+__all__ = ["load", "parse", "run_scenario"]
+
+
+def parse(text: str, *, source: str = "<string>") -> Scenario:
+    """Parse and validate a scenario from TOML ``text``: the :class:`Scenario` of its kind
+    (:data:`tumble.scenario.KINDS`); ``source`` names it in error messages.
+
+    Raises :class:`ScenarioError` with every schema problem of the file.
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioError(source, [toml_problem(exc)]) from None
+    with in_file(source):
+        kind = kind_of(data)
+    cls = scenario_class(kind)
+    try:
+        scenario = cls.model_validate({**data, "kind": kind})
+    except pydantic.ValidationError as exc:
+        raise ScenarioError(source, [describe(error, cls) for error in exc.errors()]) from None
+    scenario._source = source
+    return scenario
+
+
+def load(path) -> Scenario:
+    """Read and validate the scenario file ``path`` (UTF-8 TOML); raises :class:`ScenarioError`."""
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError(source, [("", f"cannot read the file ({exc.strerror or exc})")]) from None
+    except UnicodeDecodeError as exc:
+        rule = f"not UTF-8 text, as TOML requires ({exc.reason} at byte {exc.start})"
+        raise ScenarioError(source, [("", rule)]) from None
+    return parse(text, source=source)
+
+
+def run_scenario(scenario, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
+    """Simulate a scenario (a :class:`Scenario`, or the path of a scenario file): ``load(path).run(progress=...)``."""
+    if not isinstance(scenario, Scenario):
+        scenario = load(scenario)
+    return scenario.run(progress=progress)

@@ -1,0 +1,42 @@
+"""Value types of scenario files and the base of every table.
+
+Numbers are strict: a TOML integer or float, never a string or a boolean,
+and finite (``nan`` and ``inf`` are refused) unless a type says otherwise.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+_Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # a TOML integer is accepted too
+_Positive = Annotated[_Number, Field(gt=0.0)]
+_Limit = Annotated[float, Field(strict=True, gt=0.0)]  # inf allowed: TOML's inf means "no limit"
+_Vector = Annotated[list[_Number], Field(min_length=3, max_length=3)]
+_Matrix = Annotated[list[_Vector], Field(min_length=3, max_length=3)]
+_Quaternion = Annotated[list[_Number], Field(min_length=4, max_length=4)]
+_Bool = Annotated[bool, Field(strict=True)]
+_Text = Annotated[str, Field(strict=True)]
+_Axis = Literal["x", "y", "z"]
+
+
+class _Table(BaseModel):
+    """A TOML table: unknown keys are refused, values are immutable once validated.
+
+    A table feeds the arguments of a library constructor; :meth:`argument_keys`
+    says which key of the file is behind each argument, so that a
+    :class:`tumble.ValidationError` naming an argument (its ``.field``) is
+    reported against the key (:func:`tumble.scenario._errors.keyed`).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    #: Library argument name → key of this table, where the two differ.
+    renamed: ClassVar[dict[str, str]] = {}
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        """Map each library argument this table feeds to its full key path under ``prefix``."""
+        keys = {name: f"{prefix}.{name}" for name in type(self).model_fields}
+        keys.update({arg: f"{prefix}.{key}" for arg, key in self.renamed.items()})
+        return keys

@@ -1,0 +1,307 @@
+"""The tables every scenario kind shares: ``[body]``, ``[initial]``, ``[time]``, ``[solver]``.
+
+SI units; ``omega`` in body axes; ``q = [w, x, y, z]`` scalar first, body →
+inertial (``docs/scenarios.md``). The ``orbit`` table is in
+:mod:`tumble.scenario.orbit`, the ``[[torque]]`` tables in
+:mod:`tumble.scenario.torques`.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal, Union
+
+import numpy as np
+from pydantic import BaseModel, Discriminator, Field, Tag, field_validator
+
+from tumble import attitude, integrate
+from tumble.body import RigidBody
+from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, _Quaternion, _Table, _Text,
+                                     _Vector)
+
+__all__ = ["Body", "EulerAngles", "Initial", "MAX_SAMPLES", "Solver", "Time"]
+
+# Most output times a scenario may ask for (10⁷ samples of t, q and ω are
+# 640 MB): a guard against a typo such as step = 1e-9 exhausting memory.
+MAX_SAMPLES = 10_000_000
+# The output times of [time] step reach `stop` when (stop - start)/step is a
+# whole number to within this many steps (floating-point rounding of the ratio).
+_STEP_ROUNDING = 1e-9
+
+
+# --------------------------------------------------------------------------
+# [body]: exactly one of inertia, moments or shape
+# --------------------------------------------------------------------------
+
+
+class InertiaBody(_Table):
+    """``inertia``: the 3×3 tensor about the centre of mass, kg m², body axes."""
+
+    inertia: _Matrix
+    mass: _Number | None = None
+    check_triangle: _Bool = True
+
+    def build(self) -> RigidBody:
+        return RigidBody(self.inertia, mass=self.mass, check_triangle=self.check_triangle)
+
+
+class MomentsBody(_Table):
+    """``moments``: principal moments about the body x, y, z axes, kg m² (inertia = diag(moments))."""
+
+    moments: _Vector
+    mass: _Number | None = None
+    check_triangle: _Bool = True
+    renamed: ClassVar[dict[str, str]] = {"inertia": "moments"}
+
+    def build(self) -> RigidBody:
+        return RigidBody(np.diag(self.moments), mass=self.mass, check_triangle=self.check_triangle)
+
+
+class _Shape(_Table):
+    """A homogeneous solid: its keys are the arguments of ``RigidBody.<shape>(...)``."""
+
+    def build(self) -> RigidBody:
+        constructor = getattr(RigidBody, self.shape)
+        return constructor(**self.model_dump(exclude={"shape"}, exclude_none=True))
+
+
+class SphereBody(_Shape):
+    shape: Literal["sphere"]
+    mass: _Number
+    radius: _Number
+
+
+class HollowSphereBody(_Shape):
+    shape: Literal["hollow_sphere"]
+    mass: _Number
+    radius: _Number
+
+
+class CylinderBody(_Shape):
+    shape: Literal["cylinder"]
+    mass: _Number
+    radius: _Number
+    length: _Number
+    axis: _Axis | None = None
+
+
+class HollowCylinderBody(_Shape):
+    shape: Literal["hollow_cylinder"]
+    mass: _Number
+    inner_radius: _Number
+    outer_radius: _Number
+    length: _Number
+    axis: _Axis | None = None
+
+
+class BoxBody(_Shape):
+    shape: Literal["box"]
+    mass: _Number
+    size: _Vector
+
+
+class EllipsoidBody(_Shape):
+    shape: Literal["ellipsoid"]
+    mass: _Number
+    semi_axes: _Vector
+
+
+class PointMassesBody(_Shape):
+    shape: Literal["point_masses"]
+    masses: Annotated[list[_Number], Field(min_length=1)]
+    positions: Annotated[list[_Vector], Field(min_length=1)]
+    check_triangle: _Bool | None = None
+
+
+class THandleBody(_Shape):
+    shape: Literal["t_handle"]
+    handle_mass: _Number | None = None
+    handle_length: _Number | None = None
+    bar_mass: _Number | None = None
+    bar_length: _Number | None = None
+    radius: _Number | None = None
+
+
+_ShapeBody = Annotated[
+    Union[SphereBody, HollowSphereBody, CylinderBody, HollowCylinderBody, BoxBody, EllipsoidBody,
+          PointMassesBody, THandleBody],
+    Field(discriminator="shape"),
+]
+
+_BODY_DESCRIPTIONS = {"inertia": "InertiaBody", "moments": "MomentsBody", "shape": "_Shape"}
+
+
+def _body_kind(table) -> str | None:
+    """The class of a [body] table: ``"InertiaBody"``, ``"MomentsBody"`` or ``"_Shape"`` (any shape).
+
+    ``None`` (refused) unless exactly one of ``inertia``, ``moments``, ``shape``
+    is given. Anything but a table is sent to :class:`InertiaBody`, whose
+    validation then says "must be a table".
+    """
+    if isinstance(table, BaseModel):
+        table = table.model_dump()
+    if not isinstance(table, dict):
+        return "InertiaBody"
+    given = [key for key in _BODY_DESCRIPTIONS if key in table]
+    return _BODY_DESCRIPTIONS[given[0]] if len(given) == 1 else None
+
+
+#: ``[body]``: a rigid body, by its tensor, its principal moments or a shape (``.build()`` → RigidBody).
+Body = Annotated[
+    Union[Annotated[InertiaBody, Tag("InertiaBody")], Annotated[MomentsBody, Tag("MomentsBody")],
+          Annotated[_ShapeBody, Tag("_Shape")]],
+    Discriminator(_body_kind, custom_error_type="body_description",
+                  custom_error_message="give exactly one of inertia, moments or shape"),
+]
+
+
+# --------------------------------------------------------------------------
+# [initial]
+# --------------------------------------------------------------------------
+
+
+class EulerAngles(_Table):
+    """Euler angles of an attitude, as in :func:`tumble.attitude.from_euler`."""
+
+    seq: _Text
+    angles: _Vector
+    degrees: _Bool = True
+
+    def quaternion(self) -> np.ndarray:
+        return attitude.from_euler(self.seq, self.angles, degrees=self.degrees)
+
+
+class Initial(_Table):
+    """``[initial]``: the body rate ``omega`` (rad/s, body axes) and attitude (``q`` or ``euler``; default
+    identity). A kind whose model has more initial state adds its keys in a subclass: key ``x`` is the
+    initial value ``x0`` of :func:`tumble.simulate`."""
+
+    omega: _Vector
+    q: _Quaternion | None = None
+    euler: EulerAngles | None = None
+
+    @field_validator("euler")
+    @classmethod
+    def _one_attitude(cls, euler, info):
+        if euler is not None and info.data.get("q") is not None:
+            raise ValueError("give the initial attitude as q or as euler, not both")
+        return euler
+
+    def quaternion(self) -> np.ndarray:
+        """``q0``: unit quaternion ``[w, x, y, z]``, body → inertial (``q`` is normalised)."""
+        if self.euler is not None:
+            return self.euler.quaternion()
+        return attitude.identity() if self.q is None else attitude.normalize(self.q)
+
+    def state(self) -> dict[str, np.ndarray]:
+        """The initial state by name, as keywords of :func:`tumble.simulate`: ``x0`` for each key ``x`` given
+        (``q0`` from ``q`` or ``euler``)."""
+        values = {f"{key}0": np.array(value) for key, value in self if key not in ("q", "euler") and value is not None}
+        return {**values, "q0": self.quaternion()}
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        keys.update({f"{key}0": f"{prefix}.{key}" for key in type(self).model_fields})
+        keys.update({key: f"{prefix}.euler.{key}" for key in EulerAngles.model_fields})
+        return keys
+
+
+# --------------------------------------------------------------------------
+# [time]
+# --------------------------------------------------------------------------
+
+
+class Time(_Table):
+    """Output times, s: ``samples`` evenly spaced from ``start`` to ``stop``, or every ``step``."""
+
+    start: _Number = 0.0
+    stop: _Number
+    samples: Annotated[int, Field(strict=True, ge=2, le=MAX_SAMPLES)] | None = None
+    step: _Positive | None = Field(None, validate_default=True)
+
+    @field_validator("stop")
+    @classmethod
+    def _after_start(cls, stop, info):
+        start = info.data.get("start")
+        if start is not None and not stop > start:
+            raise ValueError(f"must be greater than start = {start} s, got {stop}")
+        return stop
+
+    @field_validator("step")
+    @classmethod
+    def _samples_or_step(cls, step, info):
+        if "samples" not in info.data:  # samples itself is invalid: reported there
+            return step
+        if (info.data["samples"] is None) == (step is None):
+            raise ValueError("give exactly one of samples (number of output times) or step (s between them)")
+        if step is not None and {"start", "stop"} <= info.data.keys():
+            n = _step_count(info.data["start"], info.data["stop"], step) + 1
+            if n > MAX_SAMPLES:
+                raise ValueError(f"makes {n} output times, more than the limit {MAX_SAMPLES}; use a larger step")
+        return step
+
+    def times(self) -> np.ndarray:
+        """The output times: ``linspace(start, stop, samples)``, or ``start + k step`` up to ``stop``."""
+        if self.samples is not None:
+            return np.linspace(self.start, self.stop, self.samples)
+        n = _step_count(self.start, self.stop, self.step)
+        end = self.start + n * self.step
+        if abs(end - self.stop) <= _STEP_ROUNDING * self.step:
+            end = self.stop  # land exactly on stop despite rounding
+        return np.linspace(self.start, end, n + 1)
+
+
+def _step_count(start: float, stop: float, step: float) -> int:
+    """Number of whole steps from ``start`` that stay within ``stop`` (to rounding)."""
+    return int(np.floor((stop - start) / step + _STEP_ROUNDING))
+
+
+# --------------------------------------------------------------------------
+# [solver]
+# --------------------------------------------------------------------------
+
+
+class Solver(_Table):
+    """Integration method (one of :data:`tumble.integrate.METHODS`) and its options.
+
+    Adaptive methods take ``rtol``/``atol`` (defaults: those of
+    :func:`tumble.simulate`); fixed-step methods need ``dt`` (s). An option the
+    method does not use is refused rather than ignored. A kind whose model
+    integrates with fewer methods narrows ``methods`` (and ``model_name``, for
+    the message) in a subclass.
+    """
+
+    #: The methods this kind's model integrates with (None: every one of tumble.integrate.METHODS).
+    methods: ClassVar[tuple[str, ...] | None] = None
+    model_name: ClassVar[str] = ""
+
+    method: _Text = "dop853"
+    rtol: _Positive | None = None
+    atol: _Positive | None = None
+    dt: _Positive | None = Field(None, validate_default=True)
+
+    @field_validator("method")
+    @classmethod
+    def _known_method(cls, method):
+        allowed = cls.methods or tuple(integrate.METHODS)
+        if method not in allowed:
+            model = f" for a {cls.model_name}" if cls.methods else ""
+            raise ValueError(f"must be one of {', '.join(map(repr, allowed))}{model}, got {method!r}")
+        return method
+
+    @field_validator("rtol", "atol", "dt")
+    @classmethod
+    def _used_by_method(cls, value, info):
+        method = integrate.METHODS.get(info.data.get("method"))
+        if method is None:  # the method itself is invalid: reported there
+            return value
+        reads = [name for name in method.options if name in cls.model_fields]
+        if info.field_name == "dt" and "dt" in reads and value is None:
+            raise ValueError(f"required by method {method.name!r} (fixed step, s)")
+        if value is not None and info.field_name not in reads:
+            takes = " and ".join(reads) or "no solver options"
+            raise ValueError(f"not used by method {method.name!r}, which takes {takes}")
+        return value
+
+    def options(self) -> dict[str, float]:
+        """The options given, as keyword arguments of :func:`tumble.simulate`."""
+        return self.model_dump(include={"rtol", "atol", "dt"}, exclude_none=True)
