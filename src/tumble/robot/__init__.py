@@ -14,7 +14,7 @@ compiled and batched::
 See ``docs/robot.md`` for the conventions (frames, DH variants, units).
 """
 
-from tumble.robot.chain import Link, SerialChain, load
+from tumble.robot.chain import SerialChain, load
 from tumble.robot.dynamics import (
     coriolis,
     forward_dynamics,
@@ -25,6 +25,7 @@ from tumble.robot.dynamics import (
     potential_energy,
     rnea,
 )
+from tumble.robot.link import Link
 from tumble.robot.simulate import JointTrajectory, simulate
 
 __all__ = [
