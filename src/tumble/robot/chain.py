@@ -30,6 +30,7 @@ from tumble._inertia import as_shape, frozen, parallel_axis
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import featherstone as _kernels
 from tumble.robot.link import Link
+from tumble.robot.motion import ChainMotion
 from tumble.robot.urdf import links_from_urdf
 
 __all__ = ["SerialChain", "load"]
@@ -85,16 +86,25 @@ def _dh_link(row: Mapping, k: int, modified: bool, check_triangle: bool) -> Link
                 name=row.get("name", f"joint{k + 1}"), check_triangle=check_triangle)
 
 
-class SerialChain:
+class SerialChain(ChainMotion):
     """An immutable, validated serial chain of rigid links on a fixed base.
 
     ``SerialChain(links, *, gravity=(0, 0, -9.81), name=None)``
 
     ``links`` is a sequence of :class:`Link` (base to tip); ``gravity`` is the
-    gravitational acceleration in the base frame (m/s²), the default of every
-    algorithm of :mod:`tumble.robot`. Built also by :meth:`from_dh`,
-    :meth:`from_urdf` and :func:`load`. The chain's arrays for the compiled
-    algorithms are built once, here.
+    gravitational acceleration in the base frame (m/s²), part of the model as
+    in Pinocchio and MuJoCo: the default of every algorithm of
+    :mod:`tumble.robot` and the gravity of ``tumble.simulate(chain, ...)``
+    (:meth:`with_gravity` gives the same chain under another). Built also by
+    :meth:`from_dh`, :meth:`from_urdf` and :func:`load`. The chain's arrays
+    for the compiled algorithms are built once, here.
+
+    A chain is a model of :func:`tumble.simulate` (:class:`~tumble.robot.motion.ChainMotion`)::
+
+        tumble.simulate(chain, q0=q0, qd0=qd0, t=t, torque=None)
+
+    with ``q0`` the initial joint vector (rad or m, not a quaternion) and
+    ``qd0`` the joint rates (rad/s or m/s, default 0).
     """
 
     __slots__ = ("_links", "_gravity", "_name", "_params", "_lower", "_upper", "_no_wrench", "_no_wrenches",
@@ -172,6 +182,14 @@ class SerialChain:
     def gravity(self) -> np.ndarray:
         """(3,) gravitational acceleration in the base frame, m/s² (a copy)."""
         return self._gravity.copy()
+
+    def with_gravity(self, gravity) -> SerialChain:
+        """The same chain under the gravitational acceleration ``gravity`` (3,), m/s², base frame.
+
+        E.g. ``chain.with_gravity((0, 0, -1.62))`` on the Moon, or ``(0, 0, 0)`` to see the
+        arm's motion without gravity.
+        """
+        return SerialChain(self._links, gravity=gravity, name=self._name)
 
     @property
     def name(self) -> str | None:
