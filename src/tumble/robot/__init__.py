@@ -1,4 +1,4 @@
-"""Robot manipulators: serial chains from DH tables and URDF, inverse and forward dynamics.
+"""Robot manipulators: serial chains from DH tables and URDF, inverse and forward dynamics, simulation.
 
 A :class:`SerialChain` is an immutable, validated model (built with
 :meth:`SerialChain.from_dh`, :meth:`SerialChain.from_urdf` or :func:`load`);
@@ -9,12 +9,14 @@ compiled and batched::
     tau = tumble.robot.rnea(chain, q, qd, qdd)          # inverse dynamics (N·m)
     M = tumble.robot.mass_matrix(chain, q)              # joint-space inertia
     qdd = tumble.robot.forward_dynamics(chain, q, qd, tau)
-    run = tumble.robot.simulate(chain, q0, qd0, t=t, method="rk4", dt=1e-3)
+    run = tumble.simulate(chain, q0=q, qd0=qd, t=t)     # the front door: a tumble.Trajectory
 
 See ``docs/robot.md`` for the conventions (frames, DH variants, units).
 """
 
-from tumble.robot.chain import Link, SerialChain, load
+import warnings
+
+from tumble.robot.chain import SerialChain, load
 from tumble.robot.dynamics import (
     coriolis,
     forward_dynamics,
@@ -25,11 +27,32 @@ from tumble.robot.dynamics import (
     potential_energy,
     rnea,
 )
-from tumble.robot.simulate import JointTrajectory, simulate
+from tumble.robot.link import Link
 
 __all__ = [
     "Link", "SerialChain", "load",
     "rnea", "gravity_torques", "coriolis", "mass_matrix", "forward_dynamics",
     "link_poses", "kinetic_energy", "potential_energy",
-    "simulate", "JointTrajectory",
+    "simulate",
 ]
+
+
+def simulate(chain, q0, qd0, *, t, torque=None, method="rk4", dt=None, rtol=1e-10, atol=1e-12, gravity=None,
+             max_steps=10**9):
+    """Deprecated: use ``tumble.simulate(chain, q0=q0, qd0=qd0, t=t, ...)``, which this forwards to.
+
+    ``gravity`` (m/s², base frame) runs ``chain.with_gravity(gravity)``; of
+    ``dt``, ``rtol``, ``atol`` and ``max_steps`` only those ``method`` reads
+    are passed on. Returns a :class:`tumble.Trajectory`.
+    """
+    import tumble
+    from tumble.integrate import METHODS
+
+    warnings.warn("tumble.robot.simulate is deprecated: use tumble.simulate(chain, q0=..., qd0=..., t=...)",
+                  DeprecationWarning, stacklevel=2)
+    if gravity is not None:
+        chain = chain.with_gravity(gravity)
+    given = {"dt": dt, "rtol": rtol, "atol": atol, "max_steps": max_steps}
+    reads = METHODS[method].options if method in METHODS else ()
+    return tumble.simulate(chain, q0=q0, qd0=qd0, t=t, torque=torque, method=method,
+                           **{name: given[name] for name in reads})

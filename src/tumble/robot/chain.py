@@ -1,22 +1,9 @@
-"""Serial chains: links, joints, Denavit–Hartenberg tables.
+"""Serial chains: a fixed base and links in a row, from Denavit–Hartenberg tables, URDF or robot files.
 
-Conventions (``docs/robot.md``): SI units (m, rad, kg, kg·m²). Frame 0 is the
-fixed base; link frame i is attached to link i, the body moved by joint i
-(i = 1…n, stored 0-based). Each :class:`Link` gives
+Conventions (``docs/robot.md``): SI units (m, rad, kg, kg·m²); the frames of
+a link are those of :mod:`tumble.robot.link`:
+link frame i = link frame i−1 · (R_o, p_o) · joint(q_i) · (R_f, p_f).
 
-* the pose of its *joint frame* (before motion) in the previous link frame:
-  ``origin_position`` p_o and ``origin_rotation`` R_o (columns: joint axes in
-  the previous link axes, ``v_prev = R_o v_joint + p_o``);
-* the joint: ``"revolute"`` (rotation ``θ = q + offset`` about ``axis``) or
-  ``"prismatic"`` (translation ``d = q + offset`` along ``axis``), ``axis``
-  a unit vector in the joint frame (any direction, including negative ones);
-* the pose of the *link frame* in the moved joint frame, ``frame_position``
-  p_f and ``frame_rotation`` R_f (identity for URDF and modified DH; the
-  ``Tz(d) Tx(a) Rx(α)`` of standard DH);
-* its mass (kg, ≥ 0), centre of mass ``com`` (m) and inertia tensor about the
-  centre of mass (kg·m², 3×3), both in the link frame.
-
-So link frame i = link frame i−1 · (R_o, p_o) · joint(q_i) · (R_f, p_f).
 Standard DH (Denavit & Hartenberg 1955; Spong, Hutchinson & Vidyasagar,
 *Robot Modeling and Control*, 2006, §3.2)::
 
@@ -35,80 +22,20 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from tumble._inertia import as_shape, frozen, parallel_axis
 from tumble._validate import ValidationError, as_array
-from tumble._inertia import as_rotation, as_shape, frozen, parallel_axis, principal_axes
 from tumble.kernels import featherstone as _kernels
+from tumble.robot.link import Link
+from tumble.robot.motion import ChainMotion
+from tumble.robot.urdf import links_from_urdf
 
-__all__ = ["Link", "SerialChain", "load"]
+__all__ = ["SerialChain", "load"]
 
-JOINT_TYPES = ("revolute", "prismatic")
 DEFAULT_GRAVITY = (0.0, 0.0, -9.81)
-# A joint axis is normalised; one shorter than this (m or 1) is refused as undefined.
-_MIN_AXIS_NORM = 1e-9
-
-
-@dataclass(frozen=True, slots=True, eq=False, kw_only=True)
-class Link:
-    """One joint and the rigid link it moves (see the module docstring for the frames).
-
-    ``inertia`` must be symmetric and positive semi-definite (a massless or
-    slender link is allowed; the chain's mass matrix must still be positive
-    definite), with principal moments that satisfy the triangle inequality
-    unless ``check_triangle=False`` (published link inertias sometimes break
-    it): the rules of :func:`tumble.body.principal_axes`. ``lower`` ≤
-    ``upper`` are the joint limits (rad or m, on ``q``; ±inf when unlimited).
-    """
-
-    joint: str = "revolute"
-    axis: np.ndarray = (0.0, 0.0, 1.0)
-    origin_position: np.ndarray = (0.0, 0.0, 0.0)
-    origin_rotation: np.ndarray | None = None
-    frame_position: np.ndarray = (0.0, 0.0, 0.0)
-    frame_rotation: np.ndarray | None = None
-    offset: float = 0.0
-    mass: float = 0.0
-    com: np.ndarray = (0.0, 0.0, 0.0)
-    inertia: np.ndarray = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-    lower: float = -math.inf
-    upper: float = math.inf
-    name: str | None = None
-    check_triangle: bool = True
-
-    def __post_init__(self):
-        where = "link" if self.name is None else f"link {self.name!r}"
-        set_ = object.__setattr__
-        if self.joint not in JOINT_TYPES:
-            raise ValidationError(f"{where}.joint: must be one of {JOINT_TYPES}, got {self.joint!r}")
-        axis = as_shape(self.axis, f"{where}.axis", (3,))
-        norm = float(np.linalg.norm(axis))
-        if norm < _MIN_AXIS_NORM:
-            raise ValidationError(f"{where}.axis: must be a non-zero vector, got {axis.tolist()}")
-        set_(self, "axis", frozen(axis / norm))
-        for field in ("origin", "frame"):
-            set_(self, f"{field}_position", frozen(as_shape(getattr(self, f"{field}_position"),
-                                                              f"{where}.{field}_position", (3,))))
-            set_(self, f"{field}_rotation", frozen(as_rotation(getattr(self, f"{field}_rotation"),
-                                                                 f"{where}.{field}_rotation")))
-        set_(self, "offset", float(as_shape(self.offset, f"{where}.offset", ())))
-        mass = float(as_shape(self.mass, f"{where}.mass", ()))
-        if mass < 0.0:
-            raise ValidationError(f"{where}.mass: must be >= 0 kg, got {mass}")
-        set_(self, "mass", mass)
-        set_(self, "com", frozen(as_shape(self.com, f"{where}.com", (3,))))
-        inertia = as_shape(self.inertia, f"{where}.inertia", (3, 3))
-        inertia, _, _ = principal_axes(inertia, f"{where}.inertia", definite=False,
-                                       check_triangle=self.check_triangle)
-        set_(self, "inertia", frozen(inertia))
-        lower, upper = float(self.lower), float(self.upper)
-        if math.isnan(lower) or math.isnan(upper) or lower > upper:
-            raise ValidationError(f"{where}.lower/upper: must satisfy lower <= upper, got {lower} and {upper}")
-        set_(self, "lower", lower)
-        set_(self, "upper", upper)
 
 
 def _rx(angle):
@@ -159,16 +86,25 @@ def _dh_link(row: Mapping, k: int, modified: bool, check_triangle: bool) -> Link
                 name=row.get("name", f"joint{k + 1}"), check_triangle=check_triangle)
 
 
-class SerialChain:
+class SerialChain(ChainMotion):
     """An immutable, validated serial chain of rigid links on a fixed base.
 
     ``SerialChain(links, *, gravity=(0, 0, -9.81), name=None)``
 
     ``links`` is a sequence of :class:`Link` (base to tip); ``gravity`` is the
-    gravitational acceleration in the base frame (m/s²), the default of every
-    algorithm of :mod:`tumble.robot`. Built also by :meth:`from_dh`,
-    :meth:`from_urdf` and :func:`load`. The chain's arrays for the compiled
-    algorithms are built once, here.
+    gravitational acceleration in the base frame (m/s²), part of the model as
+    in Pinocchio and MuJoCo: the default of every algorithm of
+    :mod:`tumble.robot` and the gravity of ``tumble.simulate(chain, ...)``
+    (:meth:`with_gravity` gives the same chain under another). Built also by
+    :meth:`from_dh`, :meth:`from_urdf` and :func:`load`. The chain's arrays
+    for the compiled algorithms are built once, here.
+
+    A chain is a model of :func:`tumble.simulate` (:class:`~tumble.robot.motion.ChainMotion`)::
+
+        tumble.simulate(chain, q0=q0, qd0=qd0, t=t, torque=None)
+
+    with ``q0`` the initial joint vector (rad or m, not a quaternion) and
+    ``qd0`` the joint rates (rad/s or m/s, default 0).
     """
 
     __slots__ = ("_links", "_gravity", "_name", "_params", "_lower", "_upper", "_no_wrench", "_no_wrenches",
@@ -219,8 +155,6 @@ class SerialChain:
     @classmethod
     def from_urdf(cls, source, *, check_triangle: bool = True, gravity=DEFAULT_GRAVITY) -> SerialChain:
         """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`."""
-        from tumble.robot.urdf import links_from_urdf
-
         name, links = links_from_urdf(source, check_triangle=check_triangle)
         return cls(links, gravity=gravity, name=name)
 
@@ -248,6 +182,14 @@ class SerialChain:
     def gravity(self) -> np.ndarray:
         """(3,) gravitational acceleration in the base frame, m/s² (a copy)."""
         return self._gravity.copy()
+
+    def with_gravity(self, gravity) -> SerialChain:
+        """The same chain under the gravitational acceleration ``gravity`` (3,), m/s², base frame.
+
+        E.g. ``chain.with_gravity((0, 0, -1.62))`` on the Moon, or ``(0, 0, 0)`` to see the
+        arm's motion without gravity.
+        """
+        return SerialChain(self._links, gravity=gravity, name=self._name)
 
     @property
     def name(self) -> str | None:

@@ -30,7 +30,7 @@ from defusedxml import ElementTree
 
 from tumble._validate import ValidationError
 from tumble._inertia import parallel_axis, principal_axes
-from tumble.robot.chain import Link
+from tumble.robot.link import Link
 
 __all__ = ["links_from_urdf"]
 
