@@ -154,6 +154,7 @@ def test_totals_are_the_energy_and_momentum_of_hub_and_slosh_mass():
     r = np.array([0.3, -0.2, 0.4]) + 0.5 * s0
     v = np.cross(OMEGA0, r) + 0.5 * np.cross(nu0, s0)
     mu = 2.0 * 10.0 / 12.0
+    # the same sums in another order: rounding
     assert traj.energy[0] == pytest.approx(0.5 * OMEGA0 @ HUB.inertia @ OMEGA0 + 0.5 * mu * v @ v, rel=1e-14)
     np.testing.assert_allclose(traj.momentum_body[0], HUB.inertia @ OMEGA0 + mu * np.cross(r, v), rtol=1e-14)
     assert sbody.invariants(traj).keys() == {"momentum_inertial"}   # damped: the energy is not kept
