@@ -100,7 +100,8 @@ def test_gyroscope_validation():
         Gyroscope(spin=10.0, tilt=0.0, **ROTOR)
     with pytest.raises(ValidationError, match="offset"):
         Gyroscope(spin=10.0, **{**ROTOR, "offset": 0.0}).heavy_top()
-    with pytest.raises(ValidationError, match="released: a Gyroscope has no initial state 'released'; it takes precession_rate0"):
+    with pytest.raises(ValidationError,
+                       match="released: a Gyroscope has no initial state 'released'; it takes precession_rate0"):
         tumble.simulate(Gyroscope(spin=10.0, **ROTOR), t=[0.0, 1.0], released=False)
 
 

@@ -43,6 +43,10 @@ unconstrained (free-free) frequencies are the roots of
 ``det(diag(Ωₖ²) − σ² (1 − Dᵀ I⁻¹ D)) = 0``; for one mode
 ``σ = Ω / √(1 − δᵀ I⁻¹ δ)``, above the cantilever
 frequency ``Ω``. :meth:`FlexibleBody.free_frequencies`.
+
+A :class:`FlexibleBody` is a model of :func:`tumble.simulate` (its compiled
+right-hand side: :mod:`tumble.kernels.flexible`); the trajectory's totals are
+``E`` and ``h``.
 """
 
 from __future__ import annotations

@@ -49,6 +49,10 @@ spin plane at (Routh reduction of the planar motion; a centrifugal pendulum for
     σ² = Ω² (ρ / l) (C + μ (ρ + l)²) / C
 
 relative to the hub: :func:`in_plane_frequency`.
+
+A :class:`SloshBody` is a model of :func:`tumble.simulate` (its compiled
+right-hand side: :mod:`tumble.kernels.slosh`); the trajectory's totals are
+``T`` and ``H``.
 """
 
 from __future__ import annotations

@@ -216,7 +216,7 @@ class VariableBody(Model):
         return _kernel.build(self, torques.as_torque_model(torque))
 
     def initial_states(self, kernel, values, t0):
-        """``[q, L_N, t₀]`` (N, 8) with ``L_N = R(q₀) (I(t₀) ω₀ + A(t₀))``: the state of :mod:`tumble.kernels.variable`."""
+        """``[q, L_N, t₀]`` (N, 8), ``L_N = R(q₀) (I(t₀) ω₀ + A(t₀))``: the state of :mod:`tumble.kernels.variable`."""
         q0 = values["q0"]
         momentum = dynamics.angular_momentum(self.inertia(t0), values["omega0"]) + self.shape_momentum(t0)
         return np.concatenate([q0, attitude.rotate(q0, momentum), np.full((q0.shape[0], 1), t0)], axis=1)

@@ -11,7 +11,7 @@ __all__ = ["simulate_variable"]
 
 
 def simulate_variable(body, omega0=None, **options) -> Trajectory:
-    """Deprecated: ``tumble.simulate(body, omega0, **options)``, which it calls (see :class:`~tumble.variable.VariableBody`)."""
+    """Deprecated: ``tumble.simulate(body, omega0, **options)``, which it calls (see ``VariableBody``)."""
     warnings.warn("tumble.variable.simulate_variable is deprecated: call tumble.simulate(body, omega0, t=..., ...)",
                   DeprecationWarning, stacklevel=2)
     return tumble.simulate(body, omega0, **options)
