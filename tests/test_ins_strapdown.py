@@ -225,7 +225,7 @@ def test_docs_example(capsys, monkeypatch):
     """The CSV example of docs/ins.md runs, and its errors are the coning laws times 2 s (within 5 %)."""
     root = Path(__file__).resolve().parents[1]
     text = (root / "docs" / "ins.md").read_text(encoding="utf-8")
-    start = text.index("```python") + len("```python")
+    start = text.index("```python", text.index("**Input from a file.**")) + len("```python")
     monkeypatch.chdir(root)
     exec(compile(text[start:text.index("```", start)], "docs/ins.md", "exec"), {})  # the project's own text
     printed = dict(line.split(" ", 1) for line in capsys.readouterr().out.splitlines())

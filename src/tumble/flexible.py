@@ -43,29 +43,31 @@ unconstrained (free-free) frequencies are the roots of
 ``det(diag(Ωₖ²) − σ² (1 − Dᵀ I⁻¹ D)) = 0``; for one mode
 ``σ = Ω / √(1 − δᵀ I⁻¹ δ)``, above the cantilever
 frequency ``Ω``. :meth:`FlexibleBody.free_frequencies`.
+
+A :class:`FlexibleBody` is a model of :func:`tumble.simulate` (its compiled
+right-hand side: :mod:`tumble.kernels.flexible`); the trajectory's totals are
+``E`` and ``h``.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from tumble import attitude, integrate, torques
-from tumble.kernels import flexible as _flexible
+import tumble
+from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
-from tumble._validate import output_times as _output_times
-from tumble.simulate import simulate as simulate_rigid
+from tumble.kernels import flexible as _kernel
+from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory, write_atomic
 
 __all__ = ["Mode", "FlexibleBody", "simulate", "energy", "momentum_body", "slew_torque", "demo_flexible"]
-
-#: Methods that integrate a flexible body (the others are built from the rigid body's exact motion).
-METHODS = ("dop853", "rk4", "cf4")
 
 
 @dataclass(frozen=True)
@@ -96,8 +98,8 @@ class Mode:
 
 
 @dataclass(frozen=True)
-class FlexibleBody:
-    """A hub with flexible appendages: the undeformed body and its modes.
+class FlexibleBody(Model):
+    """A hub with flexible appendages: the undeformed body and its modes; a model of :func:`tumble.simulate`.
 
     body  : RigidBody (or (3, 3) inertia, kg·m², body axes): the whole spacecraft with its
             appendages undeformed, about its centre of mass (``I`` in the equations)
@@ -105,10 +107,22 @@ class FlexibleBody:
 
     Refused unless ``I − Σₖ δₖδₖᵀ`` (the inertia of what stays rigid) is positive
     definite: the appendages cannot carry more inertia than the whole body.
+
+    ``tumble.simulate(fbody, omega0=..., t=..., q0=..., eta0=..., eta_rate0=..., torque=...)``
+    integrates the equations of the module docstring (``dop853``, ``rk4`` or ``cf4``).
+    Initial state: ``omega0`` (3,) hub rate, rad/s, body axes (required); ``q0`` (4,) hub
+    attitude, body → inertial (default identity); ``eta0``, ``eta_rate0`` (m,) modal
+    coordinates (kg^½·m) and rates (kg^½·m/s), default zero; each with an optional leading
+    batch axis. The :class:`~tumble.Trajectory` holds ``q``, ``omega`` of the hub,
+    ``inertia`` = the undeformed ``I``, the extras ``modal_coordinate`` and ``modal_rate``
+    (n, [N,] m), and the totals of the whole spacecraft: ``energy`` ``E`` (:func:`energy`)
+    and ``momentum_body`` ``h`` (:func:`momentum_body`).
     """
 
     body: RigidBody
     modes: tuple
+
+    torque = "external torque on the hub, body axes (N·m): a tumble.torques model or f(t, q, omega)"
 
     def __post_init__(self):
         body = self.body if isinstance(self.body, RigidBody) else RigidBody(self.body)
@@ -157,11 +171,23 @@ class FlexibleBody:
         modal_mass = np.eye(D.shape[1]) - D.T @ np.linalg.solve(self.body.inertia, D)
         return np.sqrt(eigh(np.diag(self.frequencies**2), modal_mass, eigvals_only=True))
 
-    def model(self, torque=None) -> _flexible.FlexibleModel:
-        """The compiled model (:class:`tumble.kernels.flexible.FlexibleModel`) under a torque model (body axes)."""
+    # -- the model interface (tumble.simulate.Model) ----------------------------------
+
+    def state_fields(self) -> tuple[StateField, ...]:
+        m = len(self.modes)
+        return (
+            StateField("omega0", 3, "initial hub rate, rad/s, body axes"),
+            StateField("q0", 4, "initial hub attitude, unit quaternion [w, x, y, z], body → inertial",
+                       default=attitude.identity(), quaternion=True),
+            StateField("eta0", m, f"initial modal coordinates η ({m}), kg^½·m", default=np.zeros(m)),
+            StateField("eta_rate0", m, f"initial modal rates dη/dt ({m}), kg^½·m/s", default=np.zeros(m)),
+        )
+
+    def compile(self, torque, t0: float) -> _kernel.FlexibleModel:
+        """The compiled model (:class:`tumble.kernels.flexible.FlexibleModel`) under a torque on the hub (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         w = self.frequencies
-        return _flexible.FlexibleModel(
+        return _kernel.FlexibleModel(
             inertia=np.ascontiguousarray(self.body.inertia),
             inverse_hub=np.linalg.inv(self.hub_inertia),
             participation=np.ascontiguousarray(self.participation.T),
@@ -171,115 +197,65 @@ class FlexibleBody:
             codes=codes,
         )
 
+    def initial_states(self, kernel, values, t0):
+        """``[q, ω, η, η̇]`` (N, 7 + 2m): the state of :mod:`tumble.kernels.flexible`."""
+        return np.concatenate([values["q0"], values["omega0"], values["eta0"], values["eta_rate0"]], axis=1)
 
-def initial_states(parts) -> tuple[np.ndarray, bool]:
-    """Stack initial values into states (N, n) and say whether any was batched.
+    def outputs(self, kernel, t, states) -> Outputs:
+        m = len(self.modes)
+        omega, eta, rate = states[..., 4:7], states[..., 7:7 + m], states[..., 7 + m:]
+        extras = {
+            "modal_coordinate": Extra(eta, ("mode",), "kg^(1/2) m",
+                                      "modal coordinate eta_k of the appendages (mass-normalised)"),
+            "modal_rate": Extra(rate, ("mode",), "kg^(1/2) m/s", "modal rate deta_k/dt"),
+        }
+        totals = {"energy": _energy(self, omega, eta, rate), "momentum_body": _momentum(self, omega, rate)}
+        return Outputs(q=states[..., :4], omega=omega, inertia=self.body.inertia, extras=extras, totals=totals,
+                       info={"modes": m})
 
-    ``parts`` is a list of (name, array_like, size); each part has shape (size,) or
-    (N, size), with one N for all the batched parts. Shared with :mod:`tumble.slosh`.
-    """
-    arrays, sizes = [], {}
-    for name, value, size in parts:
-        arr = as_array(value, name, tail=(size,))
-        if arr.ndim > 2:
-            raise ValidationError(f"{name}: a batch has one leading axis, got shape {arr.shape}")
-        if arr.ndim == 2:
-            sizes[name] = arr.shape[0]
-        arrays.append(arr)
-    if len(set(sizes.values())) > 1:
-        raise ValidationError(f"batch sizes disagree: {sizes}")
-    n = next(iter(sizes.values()), 1)
-    return np.concatenate([np.broadcast_to(a, (n, a.shape[-1])) for a in arrays], axis=1), bool(sizes)
-
-
-def integrate_model(model, y0, times, *, method, rtol, atol, dt, max_steps, torque):
-    """Integrate a model that is not a rigid body (states ``y0`` (N, size), ``q`` first) under ``torque``.
-
-    Checks the method and normalises the initial quaternions, then runs :func:`tumble.integrate.solve`
-    (one core when the torque calls back into Python). Returns the states (n, N, size) and the
-    ``Trajectory.info`` dict. Shared with :mod:`tumble.slosh`.
-    """
-    if method not in METHODS:
-        raise ValidationError(f"method: must be one of {list(METHODS)} for a body that is not rigid "
-                              f"(the others are built from the rigid body's exact motion), got {method!r}")
-    m = integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
-    q0 = y0[:, :4]
-    if np.any(np.linalg.norm(q0, axis=-1) == 0.0):
-        raise ValidationError("q0: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
-    y0[:, :4] = attitude.normalize(q0)
-    solution = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
-    states, stats = solution.states, solution.statistics()
-    info = {"torque": repr(torque) if torque is not None else "none", **stats}
-    info.update(dict(rtol=float(rtol), atol=float(atol)) if m.adaptive else dict(dt=float(dt)))
-    return states, info
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
+        """Without torque the inertial momentum ``R(q) h``; without damping too, the energy ``E``."""
+        if traj.info.get("torque") != "none":
+            return {}
+        kept = {"momentum_inertial": traj.momentum_inertial}
+        if not np.any(self.damping_ratios):
+            kept["energy"] = traj.energy
+        return kept
 
 
-def simulate(fbody: FlexibleBody, omega0, *, t, q0=None, eta0=None, eta_rate0=None, torque=None,
-             method: str = "dop853", rtol: float = 1e-10, atol: float = 1e-12, dt: float | None = None,
-             max_steps: int = 10**9) -> Trajectory:
-    """Integrate a hub with flexible appendages through the output times ``t`` (module docstring).
+def simulate(fbody: FlexibleBody, omega0=None, **options) -> Trajectory:
+    """Deprecated: ``tumble.simulate(fbody, omega0, **options)``, which it calls (see :class:`FlexibleBody`)."""
+    warnings.warn("tumble.flexible.simulate is deprecated: call tumble.simulate(fbody, omega0, t=..., ...)",
+                  DeprecationWarning, stacklevel=2)
+    return tumble.simulate(fbody, omega0, **options)
 
-    Parameters
-    ----------
-    fbody : FlexibleBody
-    omega0 : (3,) or (N, 3) array_like
-        Initial body rate, rad/s, body axes; a leading axis integrates N initial states.
-    t : (n,) array_like
-        Output times, s, strictly increasing.
-    q0 : (4,) or (N, 4), optional
-        Initial attitude, body → inertial, scalar first (default identity).
-    eta0, eta_rate0 : (m,) or (N, m), optional
-        Initial modal coordinates (kg^½·m) and rates (kg^½·m/s); default zero.
-    torque : TorqueModel or callable ``f(t, q, omega)``, optional
-        External torque on the hub, body axes (N·m): e.g. ``torques.ConstantBody``,
-        a ``torques.Tabulated`` profile or :func:`slew_torque`.
-    method : ``"dop853"`` (adaptive, ``rtol``, ``atol``), ``"rk4"`` or ``"cf4"`` (fixed step ``dt``, s)
 
-    Returns
-    -------
-    Trajectory
-        ``q``, ``omega`` of the hub (body axes), ``inertia`` = the undeformed ``I``, and
-        ``extras["modal_coordinate"]``, ``extras["modal_rate"]`` of shape (n, [N,] m).
-        Totals: :func:`energy`, :func:`momentum_body`.
-    """
-    if not isinstance(fbody, FlexibleBody):
-        raise ValidationError(f"fbody: must be a tumble.flexible.FlexibleBody, got {type(fbody).__name__}")
-    times = _output_times(t)
-    m = len(fbody.modes)
-    zero = np.zeros(m)
-    y0, batched = initial_states([
-        ("q0", attitude.identity() if q0 is None else q0, 4),
-        ("omega0", omega0, 3),
-        ("eta0", zero if eta0 is None else eta0, m),
-        ("eta_rate0", zero if eta_rate0 is None else eta_rate0, m),
-    ])
-    torque = torques.as_torque_model(torque)
-    states, info = integrate_model(fbody.model(torque), y0, times, method=method, rtol=rtol, atol=atol,
-                                   dt=dt, max_steps=max_steps, torque=torque)
-    if not batched:
-        states = states[:, 0]
-    extras = {
-        "modal_coordinate": Extra(states[..., 7:7 + m], ("mode",), "kg^(1/2) m",
-                                  "modal coordinate eta_k of the appendages (mass-normalised)"),
-        "modal_rate": Extra(states[..., 7 + m:], ("mode",), "kg^(1/2) m/s", "modal rate deta_k/dt"),
-    }
-    return Trajectory(t=times, q=states[..., :4], omega=states[..., 4:7], inertia=fbody.body.inertia,
-                      method=method, info={"model": "flexible", "modes": m, **info}, extras=extras)
+def _momentum(fbody: FlexibleBody, omega, rate) -> np.ndarray:
+    """``h = I ω + Σₖ δₖ η̇ₖ`` (N·m·s, body axes) from ω (…, 3) and η̇ (…, m)."""
+    return dynamics.angular_momentum(fbody.body.inertia, omega) + np.einsum("ik,...k->...i", fbody.participation, rate)
+
+
+def _energy(fbody: FlexibleBody, omega, eta, rate) -> np.ndarray:
+    """``E`` (J) from ω (…, 3), η and η̇ (…, m): see :func:`energy`."""
+    coupling = np.einsum("...i,ik,...k->...", omega, fbody.participation, rate)
+    modal = 0.5 * np.sum(rate**2 + fbody.frequencies**2 * eta**2, axis=-1)
+    return dynamics.kinetic_energy(fbody.body.inertia, omega) + coupling + modal
 
 
 def momentum_body(fbody: FlexibleBody, trajectory: Trajectory) -> np.ndarray:
-    """Total angular momentum ``h = I ω + Σₖ δₖ η̇ₖ`` (N·m·s, body axes), shape (n, [N,] 3)."""
-    rate = trajectory.extras["modal_rate"].data
-    return trajectory.omega @ fbody.body.inertia.T + rate @ fbody.participation.T
+    """Total angular momentum ``h = I ω + Σₖ δₖ η̇ₖ`` (N·m·s, body axes) along a trajectory, (n, [N,] 3).
+
+    ``trajectory.momentum_body`` of a run of ``fbody`` holds the same numbers.
+    """
+    return _momentum(fbody, trajectory.omega, trajectory.modal_rate)
 
 
 def energy(fbody: FlexibleBody, trajectory: Trajectory) -> np.ndarray:
-    """Total energy ``½ ω·Iω + Σₖ (δₖ·ω) η̇ₖ + ½ Σₖ (η̇ₖ² + Ωₖ² ηₖ²)`` (J), shape (n, [N])."""
-    omega = trajectory.omega
-    eta, rate = trajectory.extras["modal_coordinate"].data, trajectory.extras["modal_rate"].data
-    kinetic = 0.5 * np.einsum("...i,ij,...j->...", omega, fbody.body.inertia, omega)
-    coupling = np.einsum("...k,...k->...", omega @ fbody.participation, rate)
-    return kinetic + coupling + 0.5 * np.sum(rate**2 + fbody.frequencies**2 * eta**2, axis=-1)
+    """Total energy ``½ ω·Iω + Σₖ (δₖ·ω) η̇ₖ + ½ Σₖ (η̇ₖ² + Ωₖ² ηₖ²)`` (J) along a trajectory, (n, [N]).
+
+    ``trajectory.energy`` of a run of ``fbody`` holds the same numbers.
+    """
+    return _energy(fbody, trajectory.omega, trajectory.modal_coordinate, trajectory.modal_rate)
 
 
 def slew_torque(axis, angle: float, *, duration: float, inertia: float, ramp: float = 0.0,
@@ -353,12 +329,12 @@ def demo_flexible(out_dir) -> dict:
     torque = slew_torque([0.0, 0.0, 1.0], inertia=fbody.body.inertia[2, 2], **_DEMO_SLEW)
     t = np.linspace(0.0, T + _DEMO_SETTLE, int(20 * (T + _DEMO_SETTLE)) + 1)
     options = dict(t=t, torque=torque, method="dop853", rtol=_DEMO_TOLERANCE, atol=_DEMO_TOLERANCE)
-    flexible = simulate(fbody, np.zeros(3), **options)
-    rigid = simulate_rigid(fbody.body, np.zeros(3), **options)
+    flexible = tumble.simulate(fbody, np.zeros(3), **options)
+    rigid = tumble.simulate(fbody.body, np.zeros(3), **options)
 
     after = t >= T
     error = (slew_angle(flexible.q) - _DEMO_SLEW["angle"])[after] / _ARCSEC
-    eta = flexible.extras["modal_coordinate"].data[after]
+    eta = flexible.modal_coordinate[after]
     summary = {
         "peak_torque": float(np.abs(torque.torque).max()),
         "residual_modal_amplitude": np.abs(eta).max(axis=0).tolist(),
@@ -366,7 +342,7 @@ def demo_flexible(out_dir) -> dict:
         "jitter_rms_arcsec": float(np.sqrt(np.mean((error - error.mean()) ** 2))),
         "rate_jitter_peak_arcsec_per_s": float(np.abs(flexible.omega[after, 2]).max() / _ARCSEC),
         "rigid_pointing_error_arcsec": float(abs(slew_angle(rigid.q[-1]) - _DEMO_SLEW["angle"]) / _ARCSEC),
-        "residual_momentum": float(np.linalg.norm(momentum_body(fbody, flexible)[after], axis=-1).max()),
+        "residual_momentum": float(np.linalg.norm(flexible.momentum_body[after], axis=-1).max()),
     }
     figure = slew_figure(flexible, rigid, T, _DEMO_SLEW["angle"])
     nc_path, png_path = os.path.join(out_dir, "flexible.nc"), os.path.join(out_dir, "flexible.png")
@@ -389,7 +365,7 @@ def slew_figure(flexible: Trajectory, rigid: Trajectory, end: float, target: flo
     b.plot(t, np.degrees(rigid.omega[:, 2]), "k--", label="rigid")
     b.plot(t, np.degrees(flexible.omega[:, 2]), label="flexible hub")
     b.set(xlabel="t (s)", ylabel="ω_z (deg/s)", title="(b) body rate")
-    eta = flexible.extras["modal_coordinate"].data
+    eta = flexible.modal_coordinate
     for k in range(eta.shape[1]):
         c.plot(t, eta[:, k], label=f"mode {k + 1}")
     c.set(xlabel="t (s)", ylabel="η (kg^½ m)", title="(c) modal coordinates")

@@ -51,7 +51,8 @@ class StateField:
     """One named part of a model's initial state: a keyword of :func:`simulate`.
 
     name        : the keyword, e.g. ``"omega0"``
-    size        : number of components; a value has shape (size,) or (N, size) (a batch)
+    size        : number of components; a value has shape (size,) or (N, size) (a batch);
+                  a field of size 1 also takes a plain number
     description : what it is, with units and frame (used in messages and the docs)
     default     : array_like, a function of the values of the fields before it
                   (``dict`` name → (N, size) array) returning one, or None for a required field
@@ -282,7 +283,10 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
             if f.default is None:
                 raise ValidationError(f"{f.name}: a {type(model).__name__} needs it: {f.description}")
             value = f.default(_broadcast(arrays, sizes)) if callable(f.default) else f.default
-        arr = as_array(value, f.name, tail=(f.size,))
+        scalar = f.size == 1 and np.ndim(value) == 0  # a number for a field of one component
+        arr = as_array(value, f.name, tail=() if scalar else (f.size,))
+        if scalar:
+            arr = arr.reshape(1)
         if arr.ndim > 2:
             raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
         if f.quaternion and np.any(np.linalg.norm(arr, axis=-1) == 0.0):

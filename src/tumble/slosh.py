@@ -49,27 +49,31 @@ spin plane at (Routh reduction of the planar motion; a centrifugal pendulum for
     σ² = Ω² (ρ / l) (C + μ (ρ + l)²) / C
 
 relative to the hub: :func:`in_plane_frequency`.
+
+A :class:`SloshBody` is a model of :func:`tumble.simulate` (its compiled
+right-hand side: :mod:`tumble.kernels.slosh`); the trajectory's totals are
+``T`` and ``H``.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from tumble import attitude, torques
-from tumble.kernels import slosh as _slosh
+import tumble
+from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError, as_array, require_non_negative, require_positive
 from tumble.body import RigidBody
-from tumble.flexible import initial_states, integrate_model
-from tumble._validate import output_times as _output_times
+from tumble.kernels import slosh as _kernel
+from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory, write_atomic
 
 __all__ = ["Pendulum", "SloshBody", "simulate", "energy", "momentum_body", "nutation_angle",
            "in_plane_frequency", "flat_spin_energy", "growth_time_constant", "steady_spin_eigenvalues", "demo_slosh"]
-
 
 
 @dataclass(frozen=True)
@@ -101,11 +105,25 @@ class Pendulum:
 
 
 @dataclass(frozen=True)
-class SloshBody:
-    """A hub (RigidBody with its mass: inertia about its own centre of mass, body axes) and a slosh pendulum."""
+class SloshBody(Model):
+    """A hub (RigidBody with its mass: inertia about its own centre of mass, body axes) and a slosh pendulum.
+
+    A model of :func:`tumble.simulate`: ``tumble.simulate(sbody, omega0=..., t=..., direction0=...)``
+    integrates the equations of the module docstring (``dop853``, ``rk4`` or ``cf4``). Initial state:
+    ``omega0`` (3,) hub rate, rad/s, body axes (required); ``q0`` (4,) hub attitude, body → inertial
+    (default identity); ``direction0`` (3,) direction of the rod from the hinge, body axes (required,
+    normalised); ``rate0`` (3,) angular velocity of the rod relative to the hub, rad/s, body axes
+    (default zero; its component along the rod is removed); each with an optional leading batch
+    axis. The :class:`~tumble.Trajectory` holds ``q``, ``omega`` and ``inertia`` of the hub, the
+    extras ``pendulum_direction`` and ``pendulum_rate`` (n, [N,] 3), and the totals of the whole
+    system about its centre of mass: ``energy`` ``T`` (:func:`energy`) and ``momentum_body``
+    ``H`` (:func:`momentum_body`).
+    """
 
     body: RigidBody
     pendulum: Pendulum
+
+    torque = "external torque on the hub, body axes (N·m): a tumble.torques model or f(t, q, omega)"
 
     def __post_init__(self):
         if not isinstance(self.body, RigidBody) or self.body.mass is None:
@@ -119,97 +137,97 @@ class SloshBody:
         m, M = self.pendulum.mass, self.body.mass
         return m * M / (m + M)
 
-    def model(self, torque=None) -> _slosh.SloshModel:
-        """The compiled model (:class:`tumble.kernels.slosh.SloshModel`) under a torque model (body axes)."""
+    # -- the model interface (tumble.simulate.Model) ----------------------------------
+
+    def state_fields(self) -> tuple[StateField, ...]:
+        return (
+            StateField("omega0", 3, "initial hub rate, rad/s, body axes"),
+            StateField("q0", 4, "initial hub attitude, unit quaternion [w, x, y, z], body → inertial",
+                       default=attitude.identity(), quaternion=True),
+            StateField("direction0", 3, "initial direction of the pendulum rod from its hinge, body axes "
+                       "(normalised)"),
+            StateField("rate0", 3, "initial angular velocity of the rod relative to the hub, rad/s, body axes "
+                       "(its component along the rod is removed)", default=np.zeros(3)),
+        )
+
+    def compile(self, torque, t0: float) -> _kernel.SloshModel:
+        """The compiled model (:class:`tumble.kernels.slosh.SloshModel`) under a torque on the hub (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         p = self.pendulum
-        return _slosh.SloshModel(
+        return _kernel.SloshModel(
             inertia=np.ascontiguousarray(self.body.inertia), inverse=np.linalg.inv(self.body.inertia),
             hinge=p.hinge.copy(), constants=np.array([self.reduced_mass, p.length, p.damping]),
             params=params[None, :], codes=codes,
         )
 
+    def initial_states(self, kernel, values, t0):
+        """``[q, ω, s, ν]`` (N, 13) with ``s`` normalised and ``ν ⊥ s``: the state of :mod:`tumble.kernels.slosh`."""
+        direction = values["direction0"]
+        norm = np.linalg.norm(direction, axis=-1, keepdims=True)
+        if np.any(norm == 0.0):
+            raise ValidationError("direction0: must be a non-zero vector (it is normalised here)")
+        s0 = direction / norm
+        rate = values["rate0"]
+        nu0 = rate - np.sum(rate * s0, axis=-1, keepdims=True) * s0
+        return np.concatenate([values["q0"], values["omega0"], s0, nu0], axis=1)
 
-def simulate(sbody: SloshBody, omega0, *, t, direction0, rate0=None, q0=None, torque=None,
-             method: str = "dop853", rtol: float = 1e-10, atol: float = 1e-12, dt: float | None = None,
-             max_steps: int = 10**9) -> Trajectory:
-    """Integrate a hub with a slosh pendulum through the output times ``t`` (module docstring).
+    def outputs(self, kernel, t, states) -> Outputs:
+        omega, s, nu = states[..., 4:7], states[..., 7:10], states[..., 10:13]
+        extras = {
+            "pendulum_direction": Extra(s, ("body_axis",), "1",
+                                        "unit direction of the slosh pendulum from its hinge, body axes"),
+            "pendulum_rate": Extra(nu, ("body_axis",), "rad/s",
+                                   "angular velocity of the slosh pendulum relative to the hub, body axes"),
+        }
+        kinetic, momentum = _totals(self, omega, s, nu)
+        return Outputs(q=states[..., :4], omega=omega, inertia=self.body.inertia, extras=extras,
+                       totals={"energy": kinetic, "momentum_body": momentum}, info={})
 
-    Parameters
-    ----------
-    sbody : SloshBody
-    omega0 : (3,) or (N, 3) array_like
-        Initial hub rate, rad/s, body axes; a leading axis integrates N initial states.
-    t : (n,) array_like
-        Output times, s, strictly increasing.
-    direction0 : (3,) or (N, 3)
-        Initial direction of the rod from the hinge, body axes (normalised here).
-    rate0 : (3,) or (N, 3), optional
-        Initial angular velocity of the rod relative to the hub, rad/s, body axes (default
-        zero); its component along the rod is removed.
-    q0 : (4,) or (N, 4), optional
-        Initial hub attitude, body → inertial, scalar first (default identity).
-    torque : TorqueModel or callable ``f(t, q, omega)``, optional
-        External torque on the hub, body axes (N·m).
-    method : ``"dop853"`` (adaptive, ``rtol``, ``atol``), ``"rk4"`` or ``"cf4"`` (fixed step ``dt``, s)
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
+        """Without torque the inertial momentum ``R(q) H``; without hinge damping too, the energy ``T``."""
+        if traj.info.get("torque") != "none":
+            return {}
+        kept = {"momentum_inertial": traj.momentum_inertial}
+        if self.pendulum.damping == 0.0:
+            kept["energy"] = traj.energy
+        return kept
 
-    Returns
-    -------
-    Trajectory
-        ``q``, ``omega`` and ``inertia`` of the hub, and ``extras["pendulum_direction"]``,
-        ``extras["pendulum_rate"]`` (n, [N,] 3). Totals: :func:`energy`, :func:`momentum_body`.
+
+def simulate(sbody: SloshBody, omega0=None, **options) -> Trajectory:
+    """Deprecated: ``tumble.simulate(sbody, omega0, **options)``, which it calls (see :class:`SloshBody`)."""
+    warnings.warn("tumble.slosh.simulate is deprecated: call tumble.simulate(sbody, omega0, t=..., direction0=..., "
+                  "...)", DeprecationWarning, stacklevel=2)
+    return tumble.simulate(sbody, omega0, **options)
+
+
+def _totals(sbody: SloshBody, omega, s, nu) -> tuple[np.ndarray, np.ndarray]:
+    """``T`` (J) and ``H`` (N·m·s, body axes) from the hub rate ω and the rod's ``s`` and ``ν`` (…, 3).
+
+    With ``r = b + l s`` and its inertial velocity ``ṙ = ω × r + l ν × s`` (body axes):
+    ``T = ½ ω·I_B ω + ½ μ |ṙ|²``, ``H = I_B ω + μ r × ṙ`` (module docstring).
     """
-    if not isinstance(sbody, SloshBody):
-        raise ValidationError(f"sbody: must be a tumble.slosh.SloshBody, got {type(sbody).__name__}")
-    times = _output_times(t)
-    y0, batched = initial_states([
-        ("q0", attitude.identity() if q0 is None else q0, 4),
-        ("omega0", omega0, 3),
-        ("direction0", direction0, 3),
-        ("rate0", np.zeros(3) if rate0 is None else rate0, 3),
-    ])
-    norm = np.linalg.norm(y0[:, 7:10], axis=-1, keepdims=True)
-    if np.any(norm == 0.0):
-        raise ValidationError("direction0: must be a non-zero vector (it is normalised here)")
-    s0 = y0[:, 7:10] / norm
-    y0[:, 7:10] = s0
-    y0[:, 10:13] -= np.sum(y0[:, 10:13] * s0, axis=-1, keepdims=True) * s0
-    torque = torques.as_torque_model(torque)
-    states, info = integrate_model(sbody.model(torque), y0, times, method=method, rtol=rtol, atol=atol,
-                                   dt=dt, max_steps=max_steps, torque=torque)
-    if not batched:
-        states = states[:, 0]
-    extras = {
-        "pendulum_direction": Extra(states[..., 7:10], ("body_axis",), "1",
-                                    "unit direction of the slosh pendulum from its hinge, body axes"),
-        "pendulum_rate": Extra(states[..., 10:13], ("body_axis",), "rad/s",
-                               "angular velocity of the slosh pendulum relative to the hub, body axes"),
-    }
-    return Trajectory(t=times, q=states[..., :4], omega=states[..., 4:7], inertia=sbody.body.inertia,
-                      method=method, info={"model": "slosh", **info}, extras=extras)
-
-
-def _relative_motion(sbody: SloshBody, trajectory: Trajectory):
-    """``r`` and its inertial velocity ``ω × r + l ν × s`` (body axes), (n, [N,] 3) each."""
     p = sbody.pendulum
-    s = trajectory.extras["pendulum_direction"].data
-    nu = trajectory.extras["pendulum_rate"].data
     r = p.hinge + p.length * s
-    return r, np.cross(trajectory.omega, r) + p.length * np.cross(nu, s)
+    v = np.cross(omega, r) + p.length * np.cross(nu, s)
+    mu = sbody.reduced_mass
+    kinetic = dynamics.kinetic_energy(sbody.body.inertia, omega) + 0.5 * mu * np.sum(v * v, axis=-1)
+    return kinetic, dynamics.angular_momentum(sbody.body.inertia, omega) + mu * np.cross(r, v)
 
 
 def momentum_body(sbody: SloshBody, trajectory: Trajectory) -> np.ndarray:
-    """Total angular momentum about the system centre of mass, ``I_B ω + μ r × ṙ`` (N·m·s, body axes)."""
-    r, v = _relative_motion(sbody, trajectory)
-    return trajectory.omega @ sbody.body.inertia.T + sbody.reduced_mass * np.cross(r, v)
+    """Total angular momentum about the system centre of mass, ``I_B ω + μ r × ṙ`` (N·m·s, body axes).
+
+    ``trajectory.momentum_body`` of a run of ``sbody`` holds the same numbers.
+    """
+    return _totals(sbody, trajectory.omega, trajectory.pendulum_direction, trajectory.pendulum_rate)[1]
 
 
 def energy(sbody: SloshBody, trajectory: Trajectory) -> np.ndarray:
-    """Total kinetic energy ``½ ω·I_B ω + ½ μ |ṙ|²`` (J), shape (n, [N])."""
-    _, v = _relative_motion(sbody, trajectory)
-    omega = trajectory.omega
-    return (0.5 * np.einsum("...i,ij,...j->...", omega, sbody.body.inertia, omega)
-            + 0.5 * sbody.reduced_mass * np.sum(v * v, axis=-1))
+    """Total kinetic energy ``½ ω·I_B ω + ½ μ |ṙ|²`` (J), shape (n, [N]).
+
+    ``trajectory.energy`` of a run of ``sbody`` holds the same numbers.
+    """
+    return _totals(sbody, trajectory.omega, trajectory.pendulum_direction, trajectory.pendulum_rate)[0]
 
 
 def nutation_angle(sbody: SloshBody, trajectory: Trajectory, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
@@ -247,14 +265,14 @@ def steady_spin_eigenvalues(sbody: SloshBody, omega, direction) -> np.ndarray:
     scale = float(np.linalg.norm(omega))
     if omega.ndim != 1 or direction.ndim != 1 or scale == 0.0 or not np.linalg.norm(direction) > 0.0:
         raise ValidationError("omega, direction: must be non-zero vectors of shape (3,)")
-    model = sbody.model()
-    state = np.zeros(_slosh.STATE_SIZE)
+    model = sbody.compile(None, 0.0)
+    state = np.zeros(_kernel.STATE_SIZE)
     state[0], state[4:7], state[7:10] = 1.0, omega, direction / np.linalg.norm(direction)
 
     def rate(x):
-        y, out = state.copy(), np.empty(_slosh.STATE_SIZE)
+        y, out = state.copy(), np.empty(_kernel.STATE_SIZE)
         y[4:] = x
-        _slosh.derivative(model, 0.0, y, out)
+        _kernel.derivative(model, 0.0, y, out)
         return out[4:]
 
     x0 = state[4:].copy()
@@ -319,11 +337,11 @@ def demo_slosh(out_dir) -> dict:
         raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
     sbody = DEMO_BODY
     t = np.linspace(0.0, _DEMO_DURATION, int(4 * _DEMO_DURATION) + 1)
-    trajectory = simulate(sbody, [_DEMO_WOBBLE, 0.0, _DEMO_SPIN], t=t, direction0=[1.0, 0.0, 0.0],
-                          method="dop853", rtol=_DEMO_TOLERANCE, atol=_DEMO_TOLERANCE)
+    trajectory = tumble.simulate(sbody, [_DEMO_WOBBLE, 0.0, _DEMO_SPIN], t=t, direction0=[1.0, 0.0, 0.0],
+                                 method="dop853", rtol=_DEMO_TOLERANCE, atol=_DEMO_TOLERANCE)
     angle = nutation_angle(sbody, trajectory)
-    h = np.linalg.norm(momentum_body(sbody, trajectory), axis=-1)
-    e = energy(sbody, trajectory)
+    h = trajectory.momentum_norm
+    e = trajectory.energy
     summary = {
         "nutation_initial_deg": math.degrees(angle[0]),
         "nutation_final_deg": math.degrees(angle[-1]),

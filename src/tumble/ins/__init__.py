@@ -1,10 +1,10 @@
 """Gyroscopes and strapdown inertial navigation.
 
 ================================  ==============================================================
-``Gyroscope``                     a spinning rotor on a pivot (``tumble.simulate``): precession
+``Gyroscope``                     a spinning rotor on a pivot (a model of ``tumble.simulate``): precession
                                   ``τ/(I_s ω_s)``, nutation ``I_s ω_s/I_t``, imbalance and friction drift
 ``GimbaledGyro``                  a rotor in a two-axis gimbal with gimbal inertia (Lagrange's
-                                  equations on the model protocol, ``tumble.integrate.solve``)
+                                  equations; a model of ``tumble.simulate``)
 ``Increments``                    angle (and velocity) increments over uniform sample intervals;
 ``from_trajectory``               exact increments of a true motion; ``read_csv`` / ``write_csv``
 ``SensorErrors``, ``Imu``         bias, ARW N, bias instability B, RRW K, scale factor,
@@ -25,7 +25,7 @@ body → inertial, rates and increments in body axes. See ``docs/ins.md``.
 from tumble.ins.allan import FLICKER_FACTOR, AllanDeviation, allan_deviation, allan_figure, gauss_markov_adev
 from tumble.ins.coning import Coning, drift_law, measure_drift
 from tumble.ins.demo import demo_coning, demo_gyroscope, demo_ins
-from tumble.ins.gimbal import GimbaledGyro, GimbalMotion
+from tumble.ins.gimbal import GimbaledGyro
 from tumble.ins.gyroscope import Gyroscope
 from tumble.ins.increments import Increments, from_trajectory, read_csv, write_csv
 from tumble.ins.sensors import Imu, SensorErrors
@@ -36,7 +36,6 @@ __all__ = [
     "FLICKER_FACTOR",
     "AllanDeviation",
     "Coning",
-    "GimbalMotion",
     "GimbaledGyro",
     "Gyroscope",
     "Imu",

@@ -60,6 +60,7 @@ DEMO_GYRO_ERRORS = SensorErrors(
 CONING_RANGES = {"none": (0.05, 1.0), "one-sample": (0.05, 0.5), "two-sample": (0.05, 1.0),
                  "three-sample": (0.3, 1.0)}
 
+_GYRO_TOLERANCE = 1e-12            # rtol = atol of the gyroscope runs (dop853)
 _CONING_HALF_ANGLE = 0.01           # rad
 _CONING_FREQUENCY = 2.0 * math.pi   # rad/s
 
@@ -73,6 +74,12 @@ def _check_dir(out_dir) -> str:
 def _save(figure, path):
     write_atomic(path, lambda tmp: figure.savefig(tmp, format="png", dpi=120))
     return path
+
+
+def _steady(gyro: Gyroscope, t):
+    """``gyro`` started in steady precession, simulated through ``t`` (s)."""
+    return simulate(gyro, t=t, precession_rate0=gyro.steady_precession_rate, rtol=_GYRO_TOLERANCE,
+                    atol=_GYRO_TOLERANCE)
 
 
 def demo_gyroscope(out_dir) -> dict:
@@ -97,7 +104,7 @@ def demo_gyroscope(out_dir) -> dict:
     period = 2.0 * math.pi / gyro.nutation_frequency
     cycles = 8
     t = np.linspace(0.0, cycles * period, cycles * 100 + 1)
-    released = gyro.simulate(t)
+    released = simulate(gyro, t=t, rtol=_GYRO_TOLERANCE, atol=_GYRO_TOLERANCE)   # released at rest
     axis = gyro.axis(released)
     rate = (axis.phi[-1] - axis.phi[0]) / t[-1]
     nutation = measure_nutation(released, com=[0.0, 0.0, gyro.offset], g=[0.0, 0.0, -gyro.g])
@@ -117,13 +124,13 @@ def demo_gyroscope(out_dir) -> dict:
 
     spin_drag, pivot_drag = 2e-3, 1e-5
     t = np.linspace(0.0, 20.0, 401)
-    steady = gyro.axis(gyro.simulate(t, released=False))
+    steady = gyro.axis(_steady(gyro, t))
     dragged_gyro = replace(gyro, spin_friction=spin_drag)
-    dragged = dragged_gyro.axis(dragged_gyro.simulate(t, released=False))
+    dragged = dragged_gyro.axis(_steady(dragged_gyro, t))
     spin_t = gyro.spin - spin_drag * t / gyro.spin_inertia
     dragged_law = gyro.imbalance_torque / spin_drag * np.log(gyro.spin / spin_t)
     pivot_gyro = replace(gyro, pivot_friction=pivot_drag)
-    tilted = pivot_gyro.axis(pivot_gyro.simulate(t, released=False))
+    tilted = pivot_gyro.axis(_steady(pivot_gyro, t))
     tilt_law = pivot_drag / gyro.momentum * t
 
     figure = Figure(figsize=(6.4, 5.0), layout="constrained")

@@ -20,137 +20,59 @@ the vertical. With the rotor's absolute spin ``ω₃ = ψ̇ + φ̇ cos θ``::
 Generalised forces: ``τ_θ`` (a torquer on the inner gimbal axis), ``τ_φ − c_φ φ̇``
 (a torquer and viscous friction on the outer axis), ``−c_s ψ̇`` (viscous
 spin-bearing friction, on the rotor's rate relative to the inner gimbal).
-Lagrange's equations::
+Lagrange's equations (the compiled model: :mod:`tumble.kernels.gimbal`)::
 
     I_s ω̇₃ = −c_s ψ̇,                                        ψ̇ = ω₃ − φ̇ cos θ
     P θ̈ = ½ Q'(θ) φ̇² − I_s ω₃ φ̇ sin θ + m g l sin θ + τ_θ,   Q' = 2 (B + I_t − C) sin θ cos θ
     Q φ̈ = τ_φ − c_φ φ̇ − Q' θ̇ φ̇ − I_s ω̇₃ cos θ + I_s ω₃ θ̇ sin θ
 
 With massless gimbals (A = B = C = J = 0) these are the heavy top's
-(Goldstein §5.7; tested against ``tumble.simulate``). At ``θ = π/2`` a
-steady precession under the torquer has ``φ̇ = τ_θ / (I_s ω₃)`` exactly, the
-gimbal inertia notwithstanding; linearised about it, the nutation frequency is
+(Goldstein §5.7; tested against ``tumble.simulate`` of the :class:`Gyroscope`).
+At ``θ = π/2`` a steady precession under the torquer has ``φ̇ = τ_θ / (I_s ω₃)``
+exactly, the gimbal inertia notwithstanding; linearised about it, the nutation
+frequency is
 
     ω_n = I_s ω₃ / √(P Q(π/2)) = I_s ω₃ / √((A + I_t)(J + B + I_t)).
 
-State for the integrators (:mod:`tumble._protocol`): ``[q_G (4), φ̇, θ̇, ω₃, ψ]``,
-``q_G`` the attitude of the inner gimbal (``q̇_G = ½ q_G ⊗ ω_G``), from
-which ``sin θ = R_G[2, 1]``, ``cos θ = R_G[2, 2]``, ``φ = atan2(R_G[1, 0], R_G[0, 0])``.
+**Invariants.** ``Ė = τ_θ θ̇ + (τ_φ − c_φ φ̇) φ̇ − c_s ψ̇²`` for ``E = T + V``:
+the energy is conserved without torquers and friction. ``φ`` is cyclic, so
+its momentum ``p_φ = ∂T/∂φ̇ = Q φ̇ + I_s ω₃ cos θ`` (the vertical component of
+the angular momentum of rotor and gimbals, N·m·s) obeys ``ṗ_φ = τ_φ − c_φ φ̇``:
+it is conserved without the outer torquer and friction.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
-from numba import njit
-from numba.extending import overload
 
-from tumble import _protocol, _quat, attitude, integrate
+import tumble
+from tumble import attitude
 from tumble._validate import ValidationError, require_non_negative, require_positive
-from tumble.trajectory import Trajectory
+from tumble.integrate import METHODS
+from tumble.kernels import gimbal as _kernel
+from tumble.simulate import Model, Outputs, StateField
+from tumble.trajectory import Extra, Trajectory
 
-__all__ = ["GimbalMotion", "GimbaledGyro"]
+__all__ = ["GimbaledGyro"]
 
-STATE_SIZE = 8
-# parameter row: I_t, I_s, A, B, C, J, m g l, τ_θ, τ_φ, c_φ, c_s
-_N_PARAMS = 11
-
-
-class GimbalModel(NamedTuple):
-    """Compiled parameters of a gimbaled gyro: ``params`` (1, 11) = I_t, I_s, A, B, C, J, m g l, τ_θ, τ_φ, c_φ, c_s."""
-
-    params: np.ndarray
-
-    @property
-    def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side."""
-        return frozenset({"rhs"})
-
-    @property
-    def calls_python(self) -> bool:
-        """False: the gimbal equations run compiled."""
-        return False
-
-
-@njit(inline="always")
-def _derivative(p, qw, qx, qy, qz, phi_dot, theta_dot, spin):
-    """d/dt of the state (the equations of the module docstring); ψ does not enter."""
-    It, Is, A, B, C, J, mgl, tau_theta, tau_phi, c_phi, c_spin = (
-        p[0, 0], p[0, 1], p[0, 2], p[0, 3], p[0, 4], p[0, 5], p[0, 6], p[0, 7], p[0, 8], p[0, 9], p[0, 10])
-    n2 = qw * qw + qx * qx + qy * qy + qz * qz
-    s = 2.0 * (qy * qz + qw * qx) / n2           # R_G[2, 1] = sin θ
-    c = 1.0 - 2.0 * (qx * qx + qy * qy) / n2     # R_G[2, 2] = cos θ
-    psi_dot = spin - phi_dot * c
-    spin_dot = -c_spin * psi_dot / Is
-    P = A + It
-    Q = J + (B + It) * s * s + C * c * c
-    dQ = 2.0 * (B + It - C) * s * c
-    theta_ddot = (0.5 * dQ * phi_dot * phi_dot - Is * spin * phi_dot * s + mgl * s + tau_theta) / P
-    phi_ddot = (tau_phi - c_phi * phi_dot - dQ * theta_dot * phi_dot - Is * spin_dot * c
-                + Is * spin * theta_dot * s) / Q
-    d = _quat.qmul(qw, qx, qy, qz, 0.0, theta_dot, phi_dot * s, phi_dot * c)
-    return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], phi_ddot, theta_ddot, spin_dot, psi_dot
-
-
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
-def _gimbal_rhs(model, b0, t, Y, OUT):
-    if not _protocol.is_type(model, GimbalModel):
-        return None
-    if Y.ndim == 1:
-
-        def impl(model, b0, t, Y, OUT):
-            (OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6], OUT[7]) = _derivative(
-                model.params, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6])
-
-    else:
-
-        def impl(model, b0, t, Y, OUT):
-            for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j], OUT[7, j]) = (
-                    _derivative(model.params, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]))
-
-    return impl
-
-
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
-def _gimbal_project(model, b0, t, Y):
-    if not _protocol.is_type(model, GimbalModel):
-        return None
-    return _protocol.quaternion_projection(Y)
-
-
-@overload(_protocol.state_size, jit_options={"cache": True})
-def _gimbal_state_size(model):
-    if not _protocol.is_type(model, GimbalModel):
-        return None
-    return lambda model: STATE_SIZE
+# Extras of the trajectory: name, units, description.
+_ANGLES = (
+    ("phi", "rad", "outer gimbal angle phi about the upward vertical (unwrapped)"),
+    ("theta", "rad", "inner gimbal angle theta: the spin axis from the upward vertical"),
+    ("psi", "rad", "rotor angle psi about the spin axis, relative to the inner gimbal"),
+    ("phi_dot", "rad/s", "outer gimbal rate dphi/dt"),
+    ("theta_dot", "rad/s", "inner gimbal rate dtheta/dt"),
+    ("spin", "rad/s", "absolute spin of the rotor omega_3 = dpsi/dt + dphi/dt cos(theta)"),
+)
 
 
 @dataclass(frozen=True)
-class GimbalMotion:
-    """A simulated gimbaled gyro: gimbal angles and rates (rad, rad/s) at ``t`` (s), and the rotor's motion.
-
-    ``rotor`` is a Trajectory of the rotor (attitude ``R_G R_z(ψ)``, body rate in
-    rotor axes, inertia ``diag(I_t, I_t, I_s)`` about the gimbal centre).
-    """
-
-    t: np.ndarray
-    phi: np.ndarray
-    theta: np.ndarray
-    psi: np.ndarray
-    phi_dot: np.ndarray
-    theta_dot: np.ndarray
-    spin: np.ndarray
-    rotor: Trajectory
-
-
-
-@dataclass(frozen=True)
-class GimbaledGyro:
-    """A symmetric rotor in a two-axis gimbal (module docstring); SI units.
+class GimbaledGyro(Model):
+    """A symmetric rotor in a two-axis gimbal (module docstring); SI units; a model of :func:`tumble.simulate`.
 
     spin_inertia, transverse_inertia : I_s, I_t of the rotor about the gimbal centre, kg·m²
     inner_gimbal : (A, B, C), moments of the inner ring in G axes, kg·m² (A about its pivot axis)
@@ -158,6 +80,20 @@ class GimbaledGyro:
     imbalance : m g l, gravity torque of the rotor's offset centre of mass on a horizontal axis, N·m
     inner_torque, outer_torque : τ_θ, τ_φ, torquers on the inner and outer gimbal axes, N·m
     outer_friction, spin_friction : c_φ, c_s, viscous coefficients, N·m·s
+
+    ``tumble.simulate(gyro, t=..., spin=..., theta0=..., phi_dot0=..., theta_dot0=...)``
+    integrates Lagrange's equations from ``φ = ψ = 0`` (``dop853`` or ``rk4``; the
+    torquers are parameters, so ``torque=`` is refused). Initial state, each a number
+    or a batch (N, 1): ``spin`` ω₃ (rad/s, non-zero, required), ``theta0`` (rad,
+    default π/2: the spin axis horizontal), ``phi_dot0``, ``theta_dot0`` (rad/s,
+    default 0; ``phi_dot0=gyro.precession_rate(spin)`` starts a horizontal axis in
+    steady precession). The :class:`~tumble.Trajectory` is the rotor's: ``q`` =
+    ``R_G R_z(ψ)``, ``omega`` its body rate in rotor axes, ``inertia`` =
+    ``diag(I_t, I_t, I_s)`` about the gimbal centre; extras ``phi``, ``theta``,
+    ``psi``, ``phi_dot``, ``theta_dot``, ``spin``; total ``energy`` ``E = T + V`` of
+    rotor and gimbals. (The total angular momentum is not given: its horizontal
+    part needs the outer gimbal's products of inertia, which the model does not
+    have; ``momentum_body`` is the rotor's ``I ω``.)
     """
 
     spin_inertia: float
@@ -169,6 +105,8 @@ class GimbaledGyro:
     outer_torque: float = 0.0
     outer_friction: float = 0.0
     spin_friction: float = 0.0
+
+    torque = None  # the torquers are the parameters inner_torque and outer_torque
 
     def __post_init__(self):
         for name in ("spin_inertia", "transverse_inertia"):
@@ -195,37 +133,76 @@ class GimbaledGyro:
         """Steady precession of a horizontal spin axis, ``(τ_θ + m g l) / (I_s ω₃)`` (rad/s, about +z)."""
         return (self.inner_torque + self.imbalance) / (self.spin_inertia * spin)
 
-    def simulate(self, t, *, spin: float, theta0: float = math.pi / 2, phi_dot0: float = 0.0,
-                 theta_dot0: float = 0.0, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
-                 dt: float | None = None) -> GimbalMotion:
-        """Integrate from ``φ = ψ = 0``, ``θ = theta0`` with rates ``phi_dot0``, ``theta_dot0`` and spin ω₃.
-
-        Runs on :func:`tumble.integrate.solve` (any method that takes a torque).
-        """
-        times = np.asarray(t, dtype=np.float64)
-        spin = float(spin)
-        if not math.isfinite(spin) or spin == 0.0:
-            raise ValidationError(f"spin: must be a finite non-zero rate (rad/s), got {spin}")
+    def energy(self, theta, phi_dot, theta_dot, spin) -> np.ndarray:
+        """``E = ½ P θ̇² + ½ Q(θ) φ̇² + ½ I_s ω₃² + m g l cos θ`` (J) of rotor and gimbals, broadcast."""
         A, B, C = self.inner_gimbal
-        params = np.array([[self.transverse_inertia, self.spin_inertia, A, B, C, self.outer_gimbal,
-                            self.imbalance, self.inner_torque, self.outer_torque, self.outer_friction,
-                            self.spin_friction]])
-        y0 = np.zeros((1, STATE_SIZE))
-        y0[0, :4] = attitude.from_euler("ZXZ", [0.0, float(theta0), 0.0])
-        y0[0, 4:7] = phi_dot0, theta_dot0, spin
-        solution = integrate.solve(GimbalModel(params), y0, times, method=method, dt=dt, rtol=rtol,
-                                        atol=atol)
-        states, stats = solution.states, solution.statistics()
-        y = states[:, 0]
-        R = attitude.to_matrix(y[:, :4])
-        phi = np.unwrap(np.arctan2(R[:, 1, 0], R[:, 0, 0]))
-        theta = np.arctan2(R[:, 2, 1], R[:, 2, 2])
-        psi = y[:, 7]
+        s, c = np.sin(theta), np.cos(theta)
+        Q = self.outer_gimbal + (B + self.transverse_inertia) * s * s + C * c * c
+        return (0.5 * (A + self.transverse_inertia) * theta_dot**2 + 0.5 * Q * phi_dot**2
+                + 0.5 * self.spin_inertia * spin**2 + self.imbalance * c)
+
+    def vertical_momentum(self, theta, phi_dot, spin) -> np.ndarray:
+        """``p_φ = Q(θ) φ̇ + I_s ω₃ cos θ`` (N·m·s): the vertical angular momentum of rotor and gimbals, broadcast."""
+        _, B, C = self.inner_gimbal
+        s, c = np.sin(theta), np.cos(theta)
+        Q = self.outer_gimbal + (B + self.transverse_inertia) * s * s + C * c * c
+        return Q * phi_dot + self.spin_inertia * spin * c
+
+    # -- the model interface (tumble.simulate.Model) ----------------------------------
+
+    def state_fields(self) -> tuple[StateField, ...]:
+        return (
+            StateField("spin", 1, "absolute spin of the rotor omega_3, rad/s (non-zero)"),
+            StateField("theta0", 1, "initial angle of the spin axis from the upward vertical, rad",
+                       default=math.pi / 2),
+            StateField("phi_dot0", 1, "initial outer gimbal rate (precession about the vertical), rad/s", default=0.0),
+            StateField("theta_dot0", 1, "initial inner gimbal rate, rad/s", default=0.0),
+        )
+
+    def compile(self, torque, t0: float) -> _kernel.GimbalModel:
+        A, B, C = self.inner_gimbal
+        return _kernel.GimbalModel(np.array([[self.transverse_inertia, self.spin_inertia, A, B, C, self.outer_gimbal,
+                                              self.imbalance, self.inner_torque, self.outer_torque,
+                                              self.outer_friction, self.spin_friction]]))
+
+    def initial_states(self, kernel, values, t0):
+        """``[q_G, φ̇, θ̇, ω₃, ψ = 0]`` (N, 8) with ``q_G`` the z-x-z rotation (0, θ₀, 0)."""
+        spin = values["spin"][:, 0]
+        if not np.all(np.isfinite(spin) & (spin != 0.0)):
+            raise ValidationError(f"spin: must be a finite non-zero rate (rad/s), got {spin.tolist()}")
+        theta0 = values["theta0"][:, 0]
+        y0 = np.zeros((theta0.size, _kernel.STATE_SIZE))
+        y0[:, :4] = attitude.from_euler("ZXZ", np.stack([np.zeros_like(theta0), theta0, np.zeros_like(theta0)], -1))
+        y0[:, 4], y0[:, 5], y0[:, 6] = values["phi_dot0"][:, 0], values["theta_dot0"][:, 0], spin
+        return y0
+
+    def outputs(self, kernel, t, states) -> Outputs:
+        R = attitude.to_matrix(states[..., :4])
+        phi = np.unwrap(np.arctan2(R[..., 1, 0], R[..., 0, 0]), axis=0)
+        theta = np.arctan2(R[..., 2, 1], R[..., 2, 2])
+        phi_dot, theta_dot, spin, psi = states[..., 4], states[..., 5], states[..., 6], states[..., 7]
         q_spin = attitude.from_rotvec(np.stack([np.zeros_like(psi), np.zeros_like(psi), psi], axis=-1))  # R_z(ψ)
-        omega_g = np.stack([y[:, 5], y[:, 4] * np.sin(theta), y[:, 6]], axis=-1)  # rotor rate in G axes
-        rotor = Trajectory(t=times, q=attitude.multiply(y[:, :4], q_spin),
-                           omega=attitude.rotate_inverse(q_spin, omega_g),
-                           inertia=np.diag([self.transverse_inertia, self.transverse_inertia, self.spin_inertia]),
-                           method=method, info=dict(stats))
-        return GimbalMotion(t=times, phi=phi, theta=theta, psi=psi, phi_dot=y[:, 4], theta_dot=y[:, 5],
-                            spin=y[:, 6], rotor=rotor)
+        omega_g = np.stack([theta_dot, phi_dot * np.sin(theta), spin], axis=-1)  # rotor rate in G axes
+        values = dict(phi=phi, theta=theta, psi=psi, phi_dot=phi_dot, theta_dot=theta_dot, spin=spin)
+        extras = {name: Extra(values[name], (), units, description) for name, units, description in _ANGLES}
+        return Outputs(q=attitude.multiply(states[..., :4], q_spin), omega=attitude.rotate_inverse(q_spin, omega_g),
+                       inertia=np.diag([self.transverse_inertia, self.transverse_inertia, self.spin_inertia]),
+                       extras=extras, totals={"energy": self.energy(theta, phi_dot, theta_dot, spin)}, info={})
+
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
+        """``E`` without torquers and friction; ``p_φ`` without the outer torquer and friction (module docstring)."""
+        kept = {}
+        if not (self.outer_torque or self.outer_friction):
+            kept["momentum_vertical"] = self.vertical_momentum(traj.theta, traj.phi_dot, traj.spin)
+            if not (self.inner_torque or self.spin_friction):
+                kept["energy"] = traj.energy
+        return kept
+
+    def simulate(self, t, *, spin: float, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
+                 dt: float | None = None, **initial_state) -> Trajectory:
+        """Deprecated: ``tumble.simulate(gyro, t=t, spin=spin, method=..., ...)``, which it calls."""
+        warnings.warn("GimbaledGyro.simulate is deprecated: call tumble.simulate(gyro, t=..., spin=..., ...)",
+                      DeprecationWarning, stacklevel=2)
+        options = {name: value for name, value in dict(rtol=rtol, atol=atol, dt=dt).items()
+                   if method not in METHODS or name in METHODS[method].options}
+        return tumble.simulate(self, t=t, spin=spin, method=method, **options, **initial_state)

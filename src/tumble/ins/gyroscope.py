@@ -36,20 +36,34 @@ gravity ``(0, 0, −g)``; body z is the spin axis from the pivot; Euler angles
 ``(φ, θ, ψ)`` intrinsic z-x-z, ``θ`` the angle of the axis from the upward
 vertical, so ``θ = π/2`` is a horizontal axis; the axis points along
 ``(sin θ sin φ, −sin θ cos φ, cos θ)``. ``tumble.analytic.axis_motion``
-reads ``φ(t)``, ``θ(t)`` off a simulation.
+reads ``φ(t)``, ``θ(t)`` off a simulation (:meth:`Gyroscope.axis`).
+
+A :class:`Gyroscope` is a model of :func:`tumble.simulate`: the rigid rotor
+``diag(I_t, I_t, I_s)`` about the pivot under its own torques (the
+compiled torque models above), from the initial state named
+``precession_rate0``.
+
+**Invariants.** With no friction and no other torque the energy
+``E = ½ ω·Iω + m g l cos θ`` (kinetic about the pivot plus the imbalance's
+potential), the vertical angular momentum ``L_N·ẑ`` (gravity acts about
+horizontal axes) and the axial momentum ``I_s ω₃`` (a symmetric rotor) are
+conserved.
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from tumble import attitude, torques
+import tumble
+from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError, require_non_negative, require_positive
 from tumble.analytic import AxisMotion, HeavyTop, axis_motion
-from tumble.simulate import simulate
+from tumble.rigid import RigidBodies
+from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Trajectory
 
 __all__ = ["Gyroscope"]
@@ -57,10 +71,9 @@ __all__ = ["Gyroscope"]
 STANDARD_GRAVITY = 9.80665
 
 
-
 @dataclass(frozen=True)
-class Gyroscope:
-    """A symmetric rotor on a pivot (a two-degree-of-freedom free gyroscope) and its initial state.
+class Gyroscope(Model):
+    """A symmetric rotor on a pivot (a two-degree-of-freedom free gyroscope); a model of :func:`tumble.simulate`.
 
     spin_inertia : I_s, axial moment, kg·m²
     transverse_inertia : I_t, transverse moment *about the pivot*, kg·m²
@@ -71,6 +84,16 @@ class Gyroscope:
     spin_friction : Coulomb drag torque on the spin axis, N·m (≥ 0)
     pivot_friction : torque about the vertical opposing the precession, N·m (≥ 0)
     tilt : initial θ, the axis from the upward vertical, rad (default π/2: horizontal)
+
+    ``tumble.simulate(gyro, t=..., precession_rate0=...)`` integrates the rotor from
+    azimuth φ = 0, θ = ``tilt``, ψ = 0, θ̇ = 0 and spin ``spin`` (dop853 at a
+    tight tolerance suits it: ``rtol=atol=1e-12``). ``precession_rate0`` is the
+    initial azimuth rate φ̇ (rad/s, about the upward vertical; a number or a batch
+    (N, 1)): 0 (the default) releases the axis at rest, and it nutates;
+    ``gyro.steady_precession_rate`` starts it in steady precession, with no
+    nutation. ``torque=`` adds an external torque to gravity and friction. The
+    :class:`~tumble.Trajectory` is that of the rotor (``inertia`` about the
+    pivot); its total ``energy`` is ``½ ω·Iω + m g l cos θ``.
     """
 
     spin_inertia: float
@@ -82,6 +105,9 @@ class Gyroscope:
     spin_friction: float = 0.0
     pivot_friction: float = 0.0
     tilt: float = math.pi / 2
+
+    torque = ("external torque on the rotor in addition to its gravity and friction, body axes (N·m): "
+              "a tumble.torques model or f(t, q, omega)")
 
     def __post_init__(self):
         for name in ("spin_inertia", "transverse_inertia", "mass", "g"):
@@ -116,16 +142,18 @@ class Gyroscope:
         """``ω_n = I_s ω_s / I_t`` (rad/s), the fast-top nutation frequency."""
         return abs(self.momentum) / self.transverse_inertia
 
-    def heavy_top(self, *, released: bool = True) -> HeavyTop:
-        """The exact heavy top of this rotor (needs ``offset > 0``): released at rest, or in steady precession."""
+    def heavy_top(self, *, precession_rate0: float = 0.0) -> HeavyTop:
+        """The exact heavy top of this rotor (needs ``offset > 0``) started with the azimuth rate
+        ``precession_rate0`` (rad/s): 0 releases it at rest, :attr:`steady_precession_rate` is steady precession."""
         if self.offset == 0.0:
             raise ValidationError("offset: a heavy top needs a centre of mass off the pivot (offset > 0)")
-        phi_dot0 = 0.0 if released else self._steady_rate()
         return HeavyTop(self.transverse_inertia, self.spin_inertia, self.mass, self.offset, self.g,
-                        self.tilt, 0.0, phi_dot0, self.spin)
+                        self.tilt, 0.0, float(precession_rate0), self.spin)
 
-    def _steady_rate(self) -> float:
-        """The slow root of ``I_t Ω² cos θ − I_s ω_s Ω + m g l = 0`` (exactly ``m g l / (I_s ω_s)`` at θ = π/2).
+    @property
+    def steady_precession_rate(self) -> float:
+        """The azimuth rate (rad/s) of steady precession at ``tilt``: the slow root of
+        ``I_t Ω² cos θ − I_s ω_s Ω + m g l = 0`` (exactly ``m g l / (I_s ω_s)`` at θ = π/2).
 
         Written as ``2c / (b + sign(b) √(b² − 4ac))``, which keeps full
         precision when ``4ac ≪ b²`` (a fast rotor) and is ``c/b`` at ``a = 0``.
@@ -138,8 +166,8 @@ class Gyroscope:
                                   "rad (I_s² ω_s² < 4 I_t m g l cos θ)")
         return 2.0 * c / (b + math.copysign(math.sqrt(discriminant), b))
 
-    def torque(self) -> torques.TorqueModel | None:
-        """The torque model: gravity on the imbalance + spin-bearing drag + pivot friction (those non-zero)."""
+    def torque_model(self) -> torques.TorqueModel | None:
+        """The rotor's own torques: gravity on the imbalance + spin-bearing drag + pivot friction (those non-zero)."""
         model = None
         if self.offset:
             model = torques.Gravity(self.mass, [0.0, 0.0, self.offset], [0.0, 0.0, -self.g])
@@ -150,17 +178,50 @@ class Gyroscope:
             model = torques.ConstantInertial([0.0, 0.0, -sense * self.pivot_friction]) + model
         return model
 
-    def simulate(self, t, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
-        """Simulate with ``tumble.simulate`` (dop853) from azimuth φ = 0, θ = ``tilt``, ψ = 0.
+    # -- the model interface (tumble.simulate.Model) ----------------------------------
 
-        ``released=True``: the axis starts at rest (φ̇ = θ̇ = 0) and nutates;
-        ``False``: it starts in steady precession (φ̇ = the slow root), with no nutation.
-        """
-        phi_dot0 = 0.0 if released else self._steady_rate()
-        omega0 = np.array([0.0, phi_dot0 * math.sin(self.tilt), self.spin])
-        body = np.diag([self.transverse_inertia, self.transverse_inertia, self.spin_inertia])
-        return simulate(body, omega0, q0=attitude.from_euler("ZXZ", [0.0, self.tilt, 0.0]), t=t,
-                        torque=self.torque(), method="dop853", rtol=rtol, atol=atol)
+    def _rotor(self) -> RigidBodies:
+        """The rotor as a rigid body, inertia ``diag(I_t, I_t, I_s)`` about the pivot."""
+        return RigidBodies.of(np.diag([self.transverse_inertia, self.transverse_inertia, self.spin_inertia]))
+
+    def state_fields(self) -> tuple[StateField, ...]:
+        return (StateField("precession_rate0", 1, "initial azimuth rate of the spin axis about the upward vertical, "
+                           "rad/s (0: released at rest; gyro.steady_precession_rate: steady precession)",
+                           default=0.0),)
+
+    def compile(self, torque, t0: float):
+        extra = torques.as_torque_model(torque)
+        return self._rotor().compile(self.torque_model() if extra is None else extra + self.torque_model(), t0)
+
+    def initial_states(self, kernel, values, t0):
+        """The rotor at φ = 0, θ = ``tilt``, ψ = 0 with body rate ``(0, φ̇₀ sin θ, ω_s)`` (θ̇ = 0)."""
+        phi_dot0 = values["precession_rate0"][:, 0]
+        omega0 = np.stack([np.zeros_like(phi_dot0), phi_dot0 * math.sin(self.tilt), np.full_like(phi_dot0, self.spin)],
+                          axis=-1)
+        q0 = np.broadcast_to(attitude.from_euler("ZXZ", [0.0, self.tilt, 0.0]), (phi_dot0.size, 4))
+        return self._rotor().initial_states(kernel, {"omega0": omega0, "q0": q0}, t0)
+
+    def outputs(self, kernel, t, states) -> Outputs:
+        out = self._rotor().outputs(kernel, t, states)
+        height = attitude.rotate(out.q, [0.0, 0.0, 1.0])[..., 2]   # cos θ
+        energy = dynamics.kinetic_energy(out.inertia, out.omega) + self.imbalance_torque * height
+        return out._replace(totals={"energy": energy})
+
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
+        """Without friction and another torque: ``E``, ``L_N·ẑ`` and ``I_s ω₃`` (module docstring)."""
+        if traj.info.get("torque") != "none" or self.spin_friction or self.pivot_friction:
+            return {}
+        return {"energy": traj.energy, "momentum_vertical": traj.momentum_inertial[..., 2],
+                "momentum_axial": traj.momentum_body[..., 2]}
+
+    def simulate(self, t, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
+        """Deprecated: ``tumble.simulate(gyro, t=t, precession_rate0=..., rtol=rtol, atol=atol)``, which it calls
+        (``released=False``: ``precession_rate0=gyro.steady_precession_rate``)."""
+        warnings.warn("Gyroscope.simulate is deprecated: call tumble.simulate(gyro, t=..., precession_rate0=...) "
+                      "(0: released at rest; gyro.steady_precession_rate: steady precession)",
+                      DeprecationWarning, stacklevel=2)
+        return tumble.simulate(self, t=t, precession_rate0=0.0 if released else self.steady_precession_rate,
+                               rtol=rtol, atol=atol)
 
     def axis(self, trajectory: Trajectory) -> AxisMotion:
         """Azimuth φ, tilt θ, their rates and the spin of the axis along a simulation (``analytic.axis_motion``)."""

@@ -1,4 +1,4 @@
-"""A body that changes shape: its inertia ``I(t)`` and shape momentum ``A(t)`` as functions of time.
+"""A body that changes shape: its inertia ``I(t)`` and shape momentum ``A(t)``, and its rotation.
 
 The angular momentum of a deformable body about its centre of mass, in the
 axes of a body frame B that moves with it (the trunk of a diver, the hub of a
@@ -17,6 +17,23 @@ interpolation error is ``O(h⁴)`` for a grid step ``h`` (de Boor, *A Practical
 Guide to Splines*, 2001, ch. V: ``‖f − s‖∞ ≤ (5/384) h⁴ ‖f⁗‖∞`` for the
 complete spline), so a compiled right-hand side evaluates them without
 calling back into Python.
+
+:class:`VariableBody` is a model of :func:`tumble.simulate`, which solves
+the equations of a deformable body in B::
+
+    L_B = I(t) ω + A(t),        dL_B/dt + ω × L_B = τ_B,        q̇ = ½ q ⊗ [0, ω]
+
+(Euler's law ``dL/dt = τ`` for the angular momentum about the centre of mass,
+written in the rotating axes of B), as the compiled model of
+:mod:`tumble.kernels.variable`: the state holds ``L`` in inertial axes, which
+no integrator changes when there is no torque, so ``|L|`` is conserved to
+rounding. The rotational energy ``T = ½ ω·Iω`` is *not* conserved: the
+muscles (or actuators) that change the shape work on the body at the rate
+
+    dT/dt = −ω·Ȧ − ½ ω·İ ω + ω·τ                (see :func:`shape_power`)
+
+which is why a skater who pulls in the arms (İ < 0, A = 0) spins faster and
+has more energy.
 """
 
 from __future__ import annotations
@@ -26,17 +43,21 @@ from collections.abc import Callable
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from tumble._validate import ValidationError, as_array, require_positive
+from tumble import attitude, dynamics, torques
 from tumble._inertia import frozen, principal_axes
+from tumble._validate import ValidationError, as_array, require_positive
+from tumble.kernels import variable as _kernel
+from tumble.simulate import Model, Outputs, StateField
+from tumble.trajectory import Extra, Trajectory
 
-__all__ = ["VariableBody"]
+__all__ = ["VariableBody", "angular_velocity", "shape_power"]
 
 # I components in the spline channels: xx, yy, zz, xy, xz, yz; then A_x, A_y, A_z.
 _ROWS = np.array([0, 1, 2, 0, 0, 1])
 _COLS = np.array([0, 1, 2, 1, 2, 2])
 
 
-class VariableBody:
+class VariableBody(Model):
     """Inertia ``I(t)`` and shape momentum ``A(t)`` of a deformable body, interpolated from samples.
 
     ``VariableBody(t, inertia, shape_momentum=None, *, check_triangle=True)``
@@ -56,6 +77,17 @@ class VariableBody:
     refused. Between samples ``I`` and ``A`` are cubic splines (error
     ``O(h⁴)``); the splines are checked to stay positive definite at the
     samples only, so sample a shape change finely enough to resolve it.
+
+    ``tumble.simulate(body, omega0=..., t=..., q0=..., torque=...)`` integrates
+    its rotation (module docstring; ``dop853``, ``rk4`` or ``cf4``); the output
+    times must lie in :attr:`t_span`. Initial state: ``omega0`` (3,), the rate of B
+    relative to inertial, rad/s, B axes (then ``L_B(t₀) = I(t₀) ω₀ + A(t₀)``),
+    required; ``q0`` (4,), the attitude of B, body → inertial (default identity);
+    each with an optional leading batch axis (N motions of the same body). The
+    :class:`~tumble.Trajectory` holds ``q``, ``omega``, ``inertia`` = ``I(t₀)``,
+    the extras ``inertia_t`` ``I(t)`` (n, [N,] 3, 3), ``shape_momentum`` ``A(t)``,
+    ``angular_momentum`` ``L_B`` and ``energy_rotational`` ``½ ω·I(t)ω`` (J), and
+    the totals ``energy`` = ``½ ω·I(t)ω`` and ``momentum_body`` = ``L_B``.
     """
 
     __slots__ = ("_t", "_inertia", "_shape_momentum", "_spline")
@@ -164,7 +196,82 @@ class VariableBody:
 
     def __repr__(self) -> str:
         t0, t1 = self.t_span
-        return f"VariableBody(t=[{t0:g}, {t1:g}] s, samples={self._t.size})"
+        return f"{type(self).__name__}(t=[{t0:g}, {t1:g}] s, samples={self._t.size})"
+
+    # -- the model interface (tumble.simulate.Model) ----------------------------------
+
+    def state_fields(self) -> tuple[StateField, ...]:
+        return (
+            StateField("omega0", 3, "initial angular velocity of the body frame B, rad/s, B axes"),
+            StateField("q0", 4, "initial attitude of B, unit quaternion [w, x, y, z], B → inertial",
+                       default=attitude.identity(), quaternion=True),
+        )
+
+    def check_run(self, method, t, dt) -> None:
+        """Refuse output times outside :attr:`t_span` (the splines are not extrapolated)."""
+        self.check_times(t)
+
+    def compile(self, torque, t0: float) -> _kernel.VariableModel:
+        """The compiled model (:class:`tumble.kernels.variable.VariableModel`) under an external torque (B axes)."""
+        return _kernel.build(self, torques.as_torque_model(torque))
+
+    def initial_states(self, kernel, values, t0):
+        """``[q, L_N, t₀]`` (N, 8), ``L_N = R(q₀) (I(t₀) ω₀ + A(t₀))``: the state of :mod:`tumble.kernels.variable`."""
+        q0 = values["q0"]
+        momentum = dynamics.angular_momentum(self.inertia(t0), values["omega0"]) + self.shape_momentum(t0)
+        return np.concatenate([q0, attitude.rotate(q0, momentum), np.full((q0.shape[0], 1), t0)], axis=1)
+
+    def outputs(self, kernel, t, states) -> Outputs:
+        q = states[..., :4]
+        momentum_body = attitude.rotate_inverse(q, states[..., 4:7])              # (n, N, 3)
+        inertia_t = np.broadcast_to(self.inertia(t)[:, None], momentum_body.shape + (3,))
+        shape_momentum = np.broadcast_to(self.shape_momentum(t)[:, None], momentum_body.shape)
+        omega = angular_velocity(inertia_t, shape_momentum, momentum_body)
+        energy = dynamics.kinetic_energy(inertia_t, omega)
+        extras = {
+            "inertia_t": Extra(inertia_t, ("row", "col"), "kg m2", "inertia tensor I(t) about the centre of mass, "
+                               "body axes"),
+            "shape_momentum": Extra(shape_momentum, ("vec",), "kg m2 s-1", "angular momentum A(t) of the shape "
+                                    "change relative to the body frame, body axes"),
+            "angular_momentum": Extra(momentum_body, ("vec",), "kg m2 s-1", "angular momentum L = I(t) omega + "
+                                      "A(t) about the centre of mass, body axes"),
+            "energy_rotational": Extra(energy, (), "J", "rotational energy 0.5 omega.I(t) omega of the body frozen "
+                                       "in its current shape"),
+        }
+        return Outputs(q=q, omega=omega, inertia=self.inertia(t[0]), extras=extras,
+                       totals={"energy": energy, "momentum_body": momentum_body}, info={})
+
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
+        """Without torque the inertial angular momentum ``R(q) L_B`` (not the energy: the shape change works)."""
+        if traj.info.get("torque") != "none":
+            return {}
+        return {"momentum_inertial": traj.momentum_inertial}
+
+
+def angular_velocity(inertia, shape_momentum, momentum_body) -> np.ndarray:
+    """``ω = I⁻¹ (L_B − A)`` (rad/s, body axes) from ``I`` (…, 3, 3), ``A`` and ``L_B`` (…, 3), broadcast."""
+    rhs = np.asarray(momentum_body) - np.asarray(shape_momentum)
+    inertia = np.broadcast_to(inertia, rhs.shape + (3,))
+    return np.linalg.solve(inertia, rhs[..., None])[..., 0]
+
+
+def shape_power(body: VariableBody, t, omega) -> np.ndarray:
+    """Power of the shape change on the rotation, W: ``dT/dt = −ω·Ȧ − ½ ω·İ ω`` (torque-free).
+
+    ``T = ½ ω·Iω`` is the rotational energy of the body frozen in its current
+    shape. Derivation: with ``u = L_B − A = I ω`` and ``dL_B/dt = −ω × L_B``
+    (no torque), ``T = ½ u·I⁻¹u`` gives
+    ``dT/dt = ω·(−ω × L_B − Ȧ) − ½ ω·İ ω = −ω·Ȧ − ½ ω·İ ω``.
+    ``t`` (n,) s and ``omega`` (n, [N,] 3) rad/s (body axes) as in a Trajectory.
+    """
+    t = body.check_times(t)
+    omega = np.asarray(omega, dtype=np.float64)
+    inertia_rate = body.inertia(t, 1)
+    shape_rate = body.shape_momentum(t, 1)
+    if omega.ndim == 3:
+        inertia_rate, shape_rate = inertia_rate[:, None], shape_rate[:, None]
+    return -np.einsum("...i,...i->...", omega, shape_rate) - 0.5 * np.einsum("...i,...ij,...j->...", omega,
+                                                                              inertia_rate, omega)
 
 
 def _check_tensors(t, inertia, check_triangle):

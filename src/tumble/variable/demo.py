@@ -92,19 +92,15 @@ def figure_dive(human: Human, dive: diver.Dive, title: str):
     ax_turns.set_title("somersault φ and twist ψ (Yeadon's angles about L)", loc="left")
     ax_tilt = fig.add_subplot(grid[2], sharex=ax_turns)
     ax_tilt.plot(t, np.degrees(angles.tilt), label="tilt θ", color="C2")
-    joints = traj.extras["joint_angles"].data
+    joints = traj.joint_angles
     for name, style in (("left_shoulder_abduction", "-"), ("right_shoulder_abduction", "--")):
         k = human.dofs.index(name)
         ax_tilt.plot(t, np.degrees(joints[:, k]) / 10.0, style, color="0.5", label=f"{name} / 10")
     ax_tilt.set_ylabel("deg")
     ax_tilt.set_title("tilt of the long axis and the arm angles (shoulder abduction, scaled by 1/10)", loc="left")
     ax_energy = fig.add_subplot(grid[3], sharex=ax_turns)
-    omega = traj.omega
-    shape = traj.extras["shape_momentum"].data
-    rotational = traj.extras["energy_rotational"].data
-    total = rotational + np.einsum("ni,ni->n", omega, shape) + traj.extras["shape_energy"].data
-    ax_energy.plot(t, total, label="kinetic energy ½ω·Iω + ω·A + T_shape")
-    ax_energy.plot(t, rotational, label="½ω·I(t)ω")
+    ax_energy.plot(t, traj.energy, label="kinetic energy ½ω·Iω + ω·A + T_shape")
+    ax_energy.plot(t, traj.energy_rotational, label="½ω·I(t)ω")
     ax_energy.set_ylabel("J")
     ax_energy.set_xlabel("time t (s)")
     ax_energy.set_title(f"energy (the muscles do work); |L| drift {dive.momentum_drift:.1e}", loc="left")

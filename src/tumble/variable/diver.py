@@ -42,9 +42,9 @@ import numpy as np
 from tumble import analytic, attitude, simulate
 from tumble._validate import ValidationError, as_array
 from tumble.body import RigidBody
-from tumble.trajectory import Extra, Trajectory
+from tumble.trajectory import Trajectory
+from tumble.variable.body import angular_velocity
 from tumble.variable.human import Human, Motion
-from tumble.variable.simulate import simulate_variable
 
 __all__ = ["Dive", "OrientationAngles", "dive_513xd", "orientation_angles", "simulate_dive", "twist_rule",
            "twist_rule_sweep", "twisting_somersault"]
@@ -103,7 +103,8 @@ def twist_rule(tilt, somersault_inertia, long_inertia):
 
 
 class Dive(NamedTuple):
-    """A simulated flight: the trajectory (extras: joint angles, shape energy), its angles and counts."""
+    """A simulated flight: the trajectory of a :class:`~tumble.variable.MovingHuman` (extras: joint angles, shape
+    energy; energy: the whole kinetic energy), its angles and counts."""
 
     trajectory: Trajectory
     angles: OrientationAngles
@@ -125,39 +126,27 @@ class Dive(NamedTuple):
 
 
 def simulate_dive(human: Human, angles: Mapping | None, *, momentum: float, t, tilt: float = 0.0,
-                  method: str = "dop853", rtol: float = 1e-10, atol: float = 1e-10, dt=None,
-                  sample_dt: float = 2e-3) -> Dive:
+                  method: str = "dop853", sample_dt: float = 2e-3, **solver) -> Dive:
     """The flight of ``human`` moving its joints through ``angles``, torque-free.
 
     The angular momentum ``L_N = (momentum, 0, 0)`` (kg·m²/s; inertial x, the
     initial somersault axis); at ``t[0]`` the trunk is upright but tilted by
     ``tilt`` (rad) about its antero-posterior axis. ``I(t)``, ``A(t)`` are
-    sampled every ``sample_dt`` (s); ``method``/``rtol``/``atol``/``dt`` as
-    in :func:`~tumble.variable.simulate_variable`.
+    sampled every ``sample_dt`` (s) (:meth:`Human.moving`); the flight is
+    ``tumble.simulate`` of that :class:`~tumble.variable.MovingHuman` with
+    ``method`` and the ``solver`` options it reads (``rtol``, ``atol`` for
+    ``"dop853"``, default 1e-10 both; ``dt`` for a fixed step).
     """
     times = as_array(t, "t")
-    body = human.variable_body(angles, t_span=(times[0], times[-1]), dt=sample_dt)
+    body = human.moving(angles, t_span=(times[0], times[-1]), dt=sample_dt)
     q0 = attitude.from_rotvec([0.0, float(tilt), 0.0])
     momentum_inertial = np.array([float(momentum), 0.0, 0.0])
     momentum_body = attitude.rotate_inverse(q0, momentum_inertial)
-    inertia0, shape0 = body.inertia(times[0]), body.shape_momentum(times[0])
-    omega0 = np.linalg.solve(inertia0, momentum_body - shape0)
-    traj = simulate_variable(body, omega0, t=times, q0=q0, method=method, rtol=rtol, atol=atol, dt=dt)
-    kin = human.kinematics(times, angles)
-    joint_angles = np.column_stack([_angle(angles, name, times) for name in human.dofs])
-    extras = dict(traj.extras)
-    extras["joint_angles"] = Extra(joint_angles, ("joint",), "rad",
-                                   "prescribed joint angles, in the order " + ", ".join(human.dofs))
-    extras["shape_energy"] = Extra(kin.shape_energy, (), "J", "kinetic energy of the shape change relative to "
-                                   "the trunk frame")
-    traj = Trajectory(t=traj.t, q=traj.q, omega=traj.omega, inertia=traj.inertia, method=traj.method,
-                      info=traj.info, extras=extras)
+    omega0 = angular_velocity(body.inertia(times[0]), body.shape_momentum(times[0]), momentum_body)
+    if method == "dop853":
+        solver = {"rtol": 1e-10, "atol": 1e-10, **solver}
+    traj = simulate(body, omega0, q0=q0, t=times, method=method, **solver)
     return Dive(traj, orientation_angles(traj.q, momentum_inertial), float(momentum))
-
-
-def _angle(angles, name, t):
-    value = (angles or {}).get(name, 0.0)
-    return value.angle(t) if hasattr(value, "angle") else np.full(t.shape, float(value))
 
 
 def _both(prefix, motion):

@@ -31,6 +31,10 @@ The default body, :meth:`Human.de_leva`, takes segment masses, centre-of-mass
 positions and radii of gyration from P. de Leva, "Adjustments to
 Zatsiorsky–Seluyanov's segment inertia parameters", J. Biomech. 29(9) (1996)
 1223–1230, Table 4 (male, 73.0 kg, 1.741 m); see ``docs/diver.md``.
+
+A human with a schedule of joint angles is a model of :func:`tumble.simulate`:
+``tumble.simulate(human.moving(angles, t_span=(t0, t1)), omega0=..., t=...)``
+(:class:`MovingHuman`). A :class:`Human` alone has no motion to simulate.
 """
 
 from __future__ import annotations
@@ -43,9 +47,11 @@ import numpy as np
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import Part, RigidBody
+from tumble.simulate import Outputs
+from tumble.trajectory import Extra
 from tumble.variable.body import VariableBody
 
-__all__ = ["DE_LEVA_MALE", "Human", "Kinematics", "Motion", "Segment"]
+__all__ = ["DE_LEVA_MALE", "Human", "Kinematics", "Motion", "MovingHuman", "Segment"]
 
 
 # -- prescribed joint angles ---------------------------------------------------------
@@ -225,11 +231,7 @@ class Human:
         angles are zero.
         """
         t = np.atleast_1d(as_array(t, "t"))
-        angles = {} if angles is None else dict(angles)
-        unknown = sorted(set(angles) - set(self.dofs))
-        if unknown:
-            raise ValidationError(f"angles: unknown joint angles {unknown}; this body has {list(self.dofs)}")
-        profiles = {name: _profile(angles.get(name, 0.0), name) for name in self.dofs}
+        profiles = self.profiles(angles)
         n, S = t.size, len(self.segments)
         rot = np.empty((n, S, 3, 3))
         rate = np.empty((n, S, 3))
@@ -267,18 +269,80 @@ class Human:
                               + np.einsum("s,ns->n", masses, np.einsum("nsi,nsi->ns", r_dot, r_dot)))
         return Kinematics(t, inertia, shape_momentum, centre, shape_energy, rot, joint, rate, com)
 
-    def variable_body(self, angles: Mapping | None = None, *, t_span, dt: float = 2e-3) -> VariableBody:
-        """The :class:`VariableBody` of this body moving through ``angles`` over ``t_span`` (s).
+    def profiles(self, angles: Mapping | None = None) -> dict:
+        """Every joint angle of :attr:`dofs` as an object with ``angle(t)`` and ``rate(t)``.
+
+        ``angles`` maps names to a number (rad), a :class:`Motion` or any such
+        object; missing angles are zero; an unknown name is refused.
+        """
+        angles = {} if angles is None else dict(angles)
+        unknown = sorted(set(angles) - set(self.dofs))
+        if unknown:
+            raise ValidationError(f"angles: unknown joint angles {unknown}; this body has {list(self.dofs)}")
+        return {name: _profile(angles.get(name, 0.0), name) for name in self.dofs}
+
+    def moving(self, angles: Mapping | None = None, *, t_span, dt: float = 2e-3) -> MovingHuman:
+        """This body moving its joints through ``angles`` over ``t_span`` (s): a model of :func:`tumble.simulate`.
 
         ``I(t)`` and ``A(t)`` are sampled every ``dt`` (s) or less and interpolated
         by cubic splines (error ``O(dt⁴)``; measured in ``docs/diver.md``).
         """
-        k = self.kinematics(VariableBody.grid(t_span, dt), angles)
-        return VariableBody(k.t, k.inertia, k.shape_momentum)
+        return MovingHuman(self, angles, t_span=t_span, dt=dt)
 
     def inertia(self, angles: Mapping | None = None) -> np.ndarray:
         """The inertia (3, 3) about the centre of mass, body axes, kg·m², of the posture ``angles`` (held still)."""
         return self.kinematics([0.0], angles).inertia[0]
+
+
+class MovingHuman(VariableBody):
+    """A :class:`Human` moving its joints through prescribed angles: a :class:`VariableBody` made from its segments.
+
+    ``MovingHuman(human, angles=None, *, t_span, dt=2e-3)``, or :meth:`Human.moving`:
+    ``I(t)`` and ``A(t)`` of :meth:`Human.kinematics` sampled every ``dt`` (s) or
+    less over ``t_span`` (s) and interpolated by cubic splines. A model of
+    :func:`tumble.simulate` with the initial state of a :class:`VariableBody`
+    (``omega0``, ``q0``: the trunk frame B). Its trajectory adds to the extras of a
+    VariableBody the prescribed ``joint_angles`` (n, [N,] J, rad, in the order of
+    ``human.dofs``) and ``shape_energy`` ``T_shape`` (J), and its total ``energy``
+    is the whole kinetic energy about the centre of mass,
+    ``½ ω·I ω + ω·A + T_shape`` (module docstring), which the muscles change.
+    """
+
+    __slots__ = ("_human", "_angles")
+
+    def __init__(self, human: Human, angles: Mapping | None = None, *, t_span, dt: float = 2e-3):
+        if not isinstance(human, Human):
+            raise ValidationError(f"human: must be a tumble.variable.Human, got {type(human).__name__}")
+        profiles = human.profiles(angles)
+        k = human.kinematics(VariableBody.grid(t_span, dt), profiles)
+        super().__init__(k.t, k.inertia, k.shape_momentum)
+        self._human, self._angles = human, profiles
+
+    @property
+    def human(self) -> Human:
+        """The segment model."""
+        return self._human
+
+    @property
+    def angles(self) -> dict:
+        """The joint angles, name → object with ``angle(t)`` and ``rate(t)`` (rad, rad/s)."""
+        return dict(self._angles)
+
+    def outputs(self, kernel, t, states) -> Outputs:
+        out = super().outputs(kernel, t, states)
+        lead = states.shape[:2]
+        joints = np.stack([self._angles[name].angle(t) for name in self._human.dofs], axis=-1)
+        shape_energy = np.broadcast_to(self._human.kinematics(t, self._angles).shape_energy[:, None], lead)
+        extras = {
+            **out.extras,
+            "joint_angles": Extra(np.broadcast_to(joints[:, None], lead + joints.shape[-1:]), ("joint",), "rad",
+                                  "prescribed joint angles, in the order " + ", ".join(self._human.dofs)),
+            "shape_energy": Extra(shape_energy, (), "J", "kinetic energy of the shape change relative to the "
+                                  "trunk frame"),
+        }
+        coupling = np.einsum("...i,...i->...", out.omega, out.extras["shape_momentum"].data)   # ω·A
+        energy = out.totals["energy"] + coupling + shape_energy
+        return out._replace(extras=extras, totals={**out.totals, "energy": energy})
 
 
 # -- de Leva (1996), Table 4, male ---------------------------------------------------------------
