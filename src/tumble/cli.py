@@ -344,20 +344,23 @@ def _drift(drift: np.ndarray, initial: np.ndarray) -> str:
 
 
 def _summary(traj: Trajectory) -> list[tuple[str, str]]:
-    """Rows: output times, method and its settings, the largest relative change of T, |L| and L_I."""
+    """Rows: output times, method and its settings, the largest relative change of the energy, |L| and L_I
+    (the energy alone for a model without an attitude, e.g. a robot arm)."""
     options = ", ".join(f"{key} {traj.info[key]:g}" for key in ("rtol", "atol", "dt") if key in traj.info)
     steps = f", {traj.info['n_steps']} steps" if "n_steps" in traj.info else ""
     torque = traj.info.get("torque", "none")
+    drift = f"energy {_drift(traj.energy_drift, traj.energy[0])}"
+    if traj.q is not None:
+        drift += (f", |L| {_drift(traj.momentum_norm_drift, traj.momentum_norm[0])}, "
+                  f"L_I {_drift(traj.momentum_inertial_drift, traj.momentum_norm[0])}")
     rows = [
         ("times", f"{traj.t[0]:g} to {traj.t[-1]:g} s, {len(traj)} samples"),
         ("method", f"{traj.method or 'unknown'}" + (f" ({options})" if options else "") + steps),
-        ("drift", f"energy {_drift(traj.energy_drift, traj.energy[0])}, "
-                  f"|L| {_drift(traj.momentum_norm_drift, traj.momentum_norm[0])}, "
-                  f"L_I {_drift(traj.momentum_inertial_drift, traj.momentum_norm[0])} (max relative change)"),
+        ("drift", f"{drift} (max relative change)"),
     ]
     if torque != "none":
         rows.append(("", f"(torque {torque} acts: T and |L| need not be conserved)"))
-    if traj.extras:
+    if traj.extras and not traj.totals:
         rows.append(("", f"(drifts of the rigid hub alone: it exchanges momentum and energy with the model's "
                          f"{len(traj.extras)} other states, saved with it)"))
     return rows

@@ -147,7 +147,7 @@ def _locate(loc: tuple, root: type[_Table]) -> tuple[list, type[_Table] | None]:
     """Split a pydantic error location into the file's key path and the table holding its last key.
 
     Locations include the tags of union members (``"_Shape"``, ``"box"``,
-    ``"tabulated"``, ``"quaternion_pd"``: see :func:`_tags`), which are not keys of the file.
+    ``"tabulated"``, ``"quaternion_pd"``, ``"gimbal"``: see :func:`_tags`), which are not keys of the file.
     """
     path, candidates, table = [], [root], None
     for part in loc:
@@ -165,10 +165,16 @@ def _locate(loc: tuple, root: type[_Table]) -> tuple[list, type[_Table] | None]:
     return path, table
 
 
+#: The keys whose value chooses a table among the members of a union: a body's ``shape``, a torque's or a
+#: controller's ``kind``, a gyroscope's ``suspension``.
+_TAG_KEYS = ("shape", "kind", "suspension")
+
+
 def _tags(cls: type[_Table]) -> set[str]:
-    """Union tags that select ``cls``: its own and its bases' class names, its ``shape``/``kind`` value."""
+    """Union tags that select ``cls``: its own and its bases' class names, the value of the key that chooses it
+    among its siblings (:data:`_TAG_KEYS`)."""
     tags = {base.__name__ for base in cls.__mro__ if issubclass(base, _Table)}
-    for key in ("shape", "kind"):
+    for key in _TAG_KEYS:
         if key in cls.model_fields:
             tags.update(arg for arg in get_args(cls.model_fields[key].annotation) if isinstance(arg, str))
     return tags

@@ -2,7 +2,7 @@
 
 A file says its kind with a top-level ``kind = "..."``. A file without one
 keeps working: its kind is the one whose marker table it has (``[spacecraft]``
-→ ``"spacecraft"``), else ``"rigid"``.
+→ ``"spacecraft"``, ``[robot]`` → ``"robot"``, ...), else ``"rigid"``.
 
 Adding a model kind is one module (a :class:`tumble.scenario.Scenario`
 subclass with the kind's tables, ``build()`` returning a problem with
@@ -41,6 +41,20 @@ KINDS = {
     "spacecraft": Kind("tumble.scenario.spacecraft:SpacecraftScenario", "spacecraft",
                        "a spacecraft with wheels, CMGs, thrusters, magnetorquers and controllers "
                        "(tumble.spacecraft.Spacecraft)"),
+    "flexible": Kind("tumble.scenario.flexible:FlexibleScenario", "flexible",
+                     "a hub with flexible appendages: cantilever modes of the hybrid-coordinate model "
+                     "(tumble.flexible.FlexibleBody)"),
+    "slosh": Kind("tumble.scenario.slosh:SloshScenario", "slosh",
+                  "a free-floating hub with a fuel-slosh pendulum (tumble.slosh.SloshBody)"),
+    "variable": Kind("tumble.scenario.variable:VariableScenario", "variable",
+                     "a body whose inertia and shape momentum are tabulated in time (tumble.variable.VariableBody)"),
+    "human": Kind("tumble.scenario.human:HumanScenario", "human",
+                  "a human body in flight moving its joints: de Leva's segments (tumble.variable.MovingHuman)"),
+    "gyroscope": Kind("tumble.scenario.gyroscope:GyroscopeScenario", "gyroscope",
+                      "a spinning rotor on a pivot or in a two-axis gimbal (tumble.ins.Gyroscope, "
+                      "tumble.ins.GimbaledGyro)"),
+    "robot": Kind("tumble.scenario.robot:RobotScenario", "robot",
+                  "a robot arm on a fixed base from a DH table or URDF file (tumble.robot.SerialChain)"),
 }
 
 #: The kind of a file that neither says ``kind`` nor has a marker table.

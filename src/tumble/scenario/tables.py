@@ -15,10 +15,11 @@ from pydantic import BaseModel, Discriminator, Field, Tag, field_validator
 
 from tumble import attitude, integrate
 from tumble.body import RigidBody
+from tumble.scenario._errors import ScenarioError
 from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, _Quaternion, _Table, _Text,
                                      _Vector)
 
-__all__ = ["Body", "EulerAngles", "Initial", "MAX_SAMPLES", "Solver", "Time"]
+__all__ = ["Body", "EulerAngles", "Initial", "MAX_SAMPLES", "ModelState", "Solver", "Time"]
 
 # Most output times a scenario may ask for (10⁷ samples of t, q and ω are
 # 640 MB): a guard against a typo such as step = 1e-9 exhausting memory.
@@ -202,6 +203,40 @@ class Initial(_Table):
         keys = super().argument_keys(prefix)
         keys.update({f"{key}0": f"{prefix}.{key}" for key in type(self).model_fields})
         keys.update({key: f"{prefix}.euler.{key}" for key in EulerAngles.model_fields})
+        return keys
+
+
+class ModelState(_Table):
+    """The base of an ``[initial]`` table of a model without a body attitude (a robot, a gyroscope): each key
+    ``x`` given is the initial state ``x0`` of :func:`tumble.simulate` (or ``x``, where the model's state field
+    has no suffix: a gimbaled gyro's ``spin``). A subclass lists the keys of every model of its kind; the
+    model built decides which of them it takes (:meth:`state`)."""
+
+    def state(self, model, prefix: str = "initial") -> dict[str, np.ndarray]:
+        """The initial state by name, as keywords of :func:`tumble.simulate` for ``model``.
+
+        A key the model has no state field for is refused (a
+        :class:`~tumble.scenario.ScenarioError` against ``prefix.key``), naming the keys it takes.
+        """
+        fields = [f.name for f in model.state_fields()]
+        values, problems = {}, []
+        for key, value in self:
+            if value is None:
+                continue
+            name = next((name for name in (f"{key}0", key) if name in fields), None)
+            if name is None:
+                takes = ", ".join(name.removesuffix("0") for name in fields)
+                problems.append((f"{prefix}.{key}", f"not an initial state of a {type(model).__name__}, which takes: "
+                                                    f"{takes}"))
+            else:
+                values[name] = np.array(value)
+        if problems:
+            raise ScenarioError("", problems)
+        return values
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        keys.update({f"{key}0": f"{prefix}.{key}" for key in type(self).model_fields})
         return keys
 
 
