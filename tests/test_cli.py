@@ -277,10 +277,11 @@ def test_run_parses_the_file_once(tmp_path, monkeypatch, scenario):
 
 def test_run_refuses_an_unknown_kind_naming_the_kinds(tmp_path):
     bad = tmp_path / "bad.toml"
-    bad.write_text('kind = "robot"\n' + (EXAMPLES / "symmetric_top.toml").read_text(encoding="utf-8"))
+    bad.write_text('kind = "submarine"\n' + (EXAMPLES / "symmetric_top.toml").read_text(encoding="utf-8"))
     result = invoke("run", bad, "-o", tmp_path / "out.nc")
     assert result.exit_code == 2
-    assert result.stderr == f"error: {bad}: kind: must be one of 'rigid', 'spacecraft', got 'robot'\n"
+    assert result.stderr == (f"error: {bad}: kind: must be one of 'rigid', 'spacecraft', 'flexible', 'slosh', "
+                             "'variable', 'human', 'gyroscope', 'robot', got 'submarine'\n")
     assert [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
 
 

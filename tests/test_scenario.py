@@ -368,17 +368,18 @@ def test_kind_is_given_or_inferred_from_the_tables():
 def test_every_kind_of_the_table_is_a_scenario():
     from tumble.scenario.kinds import KINDS, scenario_class
 
-    assert set(KINDS) == {"rigid", "spacecraft"}
+    assert set(KINDS) == {"rigid", "spacecraft", "flexible", "slosh", "variable", "human", "gyroscope", "robot"}
     for kind in KINDS:
         assert issubclass(scenario_class(kind), Scenario)
 
 
-@pytest.mark.parametrize(("kind", "got"), [('"robot"', "'robot'"), ("3", "3")])
+@pytest.mark.parametrize(("kind", "got"), [('"submarine"', "'submarine'"), ("3", "3")])
 def test_unknown_kind_is_refused_naming_the_kinds(tmp_path, kind, got):
     path = write(tmp_path, f"kind = {kind}\n" + BASE)
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
-    assert str(info.value) == f"{path}: kind: must be one of 'rigid', 'spacecraft', got {got}"
+    assert str(info.value) == (f"{path}: kind: must be one of 'rigid', 'spacecraft', 'flexible', 'slosh', 'variable', "
+                               f"'human', 'gyroscope', 'robot', got {got}")
     assert info.value.field == "kind"
 
 

@@ -106,7 +106,8 @@ class SloshScenario(Scenario):
                        self.source)
 
     def nutation_angle(self, traj: Trajectory) -> np.ndarray:
-        """Angle (rad) between ``slosh.spin_axis`` and the total angular momentum (:func:`tumble.slosh.nutation_angle`)."""
+        """Angle (rad) between ``slosh.spin_axis`` and the total angular momentum
+        (:func:`tumble.slosh.nutation_angle`)."""
         return slosh.nutation_angle(self.build().model, traj, self.slosh.spin_axis)
 
     def figure(self, traj: Trajectory):

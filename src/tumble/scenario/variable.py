@@ -1,4 +1,5 @@
-"""Scenario kind ``"variable"``: a body whose inertia changes, tabulated in the file (:class:`tumble.variable.VariableBody`).
+"""Scenario kind ``"variable"``: a body whose inertia changes, tabulated in the file
+(:class:`tumble.variable.VariableBody`).
 
 The body's inertia ``I(t)`` about its centre of mass and the angular momentum
 ``A(t)`` of its shape change (body axes) are samples, interpolated by cubic
