@@ -287,8 +287,9 @@ def test_run_refuses_an_unknown_kind_naming_the_kinds(tmp_path):
 
 def test_cli_does_not_import_back():
     # The demo table and the scenario package are read by the CLI; neither imports it (no cycle).
-    code = ("import sys, tumble._demos, tumble.scenario, tumble.scenario.rigid, tumble.scenario.spacecraft; "
-            "print('tumble.cli' in sys.modules)")
+    kinds = ", ".join(f"tumble.scenario.{kind}" for kind in ("rigid", "spacecraft", "flexible", "slosh", "variable",
+                                                             "human", "gyroscope", "robot"))
+    code = f"import sys, tumble._demos, tumble.scenario, {kinds}; print('tumble.cli' in sys.modules)"
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr

@@ -359,7 +359,8 @@ def _summary(traj: Trajectory) -> list[tuple[str, str]]:
         ("drift", f"{drift} (max relative change)"),
     ]
     if torque != "none":
-        rows.append(("", f"(torque {torque} acts: T and |L| need not be conserved)"))
+        kept = "T and |L|" if traj.q is not None else "the energy"
+        rows.append(("", f"(torque {torque} acts: {kept} need not be conserved)"))
     if traj.extras and not traj.totals:
         rows.append(("", f"(drifts of the rigid hub alone: it exchanges momentum and energy with the model's "
                          f"{len(traj.extras)} other states, saved with it)"))

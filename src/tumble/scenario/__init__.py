@@ -1,11 +1,13 @@
 """Scenario files: a simulation described as data, in TOML, for every kind of model.
 
 One dialect for every model: a file gives its ``kind`` (a row of
-:data:`KINDS`: ``"rigid"``, ``"spacecraft"``; without ``kind``, a file with a
-``[spacecraft]`` table is a spacecraft, any other a rigid body), the model's
-tables and the shared ones — ``[initial]`` state, output ``[time]``,
-``[solver]``, and wherever an orbit is needed the one ``orbit`` table (SI
-units; ``omega`` in body axes; ``q`` scalar first, body → inertial)::
+:data:`KINDS`: ``"rigid"``, ``"spacecraft"``, ``"flexible"``, ``"slosh"``,
+``"variable"``, ``"human"``, ``"gyroscope"``, ``"robot"``; without ``kind``, the
+kind whose marker table the file has — ``[spacecraft]``, ``[robot]``, ... —
+else a rigid body), the model's tables and the shared ones — ``[initial]``
+state, output ``[time]``, ``[solver]``, ``[body]`` and ``[[torque]]`` where
+the model has them, and wherever an orbit is needed the one ``orbit`` table
+(SI units; ``omega`` in body axes; ``q`` scalar first, body → inertial)::
 
     name = "Tennis racket"
 
@@ -44,8 +46,9 @@ the library's :class:`~tumble.ValidationError` names the argument it refuses
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError
 from tumble.scenario._read import load, parse, run_scenario
+from tumble.scenario._run import Run
 from tumble.scenario.kinds import DEFAULT_KIND, KINDS, Kind
-from tumble.scenario.tables import Body, EulerAngles, Initial, Solver, Time
+from tumble.scenario.tables import Body, EulerAngles, Initial, ModelState, Solver, Time
 
 #: The names of earlier releases (``docs/scenarios.md`` keeps them).
 load_scenario = load
@@ -58,6 +61,8 @@ __all__ = [
     "EulerAngles",
     "Initial",
     "Kind",
+    "ModelState",
+    "Run",
     "Scenario",
     "ScenarioError",
     "Solver",
