@@ -128,7 +128,7 @@ class GyroscopeScenario(Scenario):
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
         """The mean precession rate of the spin axis about the vertical and the range of its angle from it,
         with the steady precession rate of the rotor's theory."""
-        model = self.build().model
+        model = self.model
         if isinstance(model, Gyroscope):
             axis = model.axis(traj)
             phi, theta, predicted = axis.phi, axis.theta, model.precession_rate

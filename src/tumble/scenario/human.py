@@ -72,8 +72,9 @@ class AngleTable(_Table):
         return Motion(self.start, [(move.begin, move.end, move.target) for move in self.moves])
 
 
-#: ``[human.angles]``: one optional :class:`AngleTable` per joint angle of the de Leva body (a missing angle is 0).
-HumanAngles = create_model("HumanAngles", __base__=_Table, __doc__=AngleTable.__doc__,
+HumanAngles = create_model("HumanAngles", __base__=_Table,
+                           __doc__="``[human.angles]``: an optional :class:`AngleTable` per joint angle of de Leva's "
+                                   "body, by its name (a missing angle is 0).",
                            **{name: (AngleTable | None, None) for name in Human.de_leva().dofs})
 
 
@@ -131,7 +132,7 @@ class HumanScenario(Scenario):
         if not np.linalg.norm(momentum[1:]) <= _ALONG_X * np.linalg.norm(momentum[0]):
             return traj.plot(title=self.name)
         dive = Dive(traj, orientation_angles(traj.q, momentum), float(momentum[0]))
-        return figure_dive(self.build().model.human, dive, self.name or "a human body in flight")
+        return figure_dive(self.human.body(), dive, self.name or "a human body in flight")
 
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
         """Somersaults and twists (Yeadon's angles about ``L``), ``|ω|`` and the energy at the start and the end."""

@@ -92,7 +92,7 @@ class RobotScenario(Scenario):
 
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
         """The energy balance ``E − W`` (constant along the exact motion) and the first joint to leave its limits."""
-        chain = self.build().model
+        chain = self.model
         balance = traj.energy - traj.work
         rows = [("balance", f"E - W changes by at most {np.abs(balance - balance[0]).max():.3g} J (exact: 0); "
                             f"the joint torques did W = {traj.work[-1]:.6g} J")]

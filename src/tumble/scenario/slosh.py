@@ -51,10 +51,10 @@ class PendulumTable(_Table):
     mass: _Number
     length: _Number
     hinge: _Vector
-    damping: _Number = 0.0
+    damping: _Number | None = None
 
     def build(self) -> slosh.Pendulum:
-        return slosh.Pendulum(**self.model_dump())
+        return slosh.Pendulum(**self.model_dump(exclude_none=True))
 
 
 class SloshTable(_Table):
@@ -108,7 +108,7 @@ class SloshScenario(Scenario):
     def nutation_angle(self, traj: Trajectory) -> np.ndarray:
         """Angle (rad) between ``slosh.spin_axis`` and the total angular momentum
         (:func:`tumble.slosh.nutation_angle`)."""
-        return slosh.nutation_angle(self.build().model, traj, self.slosh.spin_axis)
+        return slosh.nutation_angle(self.model, traj, self.slosh.spin_axis)
 
     def figure(self, traj: Trajectory):
         """:func:`tumble.slosh.nutation_figure`: the nutation angle from ``spin_axis``, the energy and ``|H|``."""
