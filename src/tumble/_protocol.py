@@ -53,9 +53,11 @@ kernel file under :mod:`tumble.kernels` and one model file above the engine
 
 from __future__ import annotations
 
+import functools
 import math
 
 from numba import njit, types
+from numba.extending import overload
 
 
 def is_type(numba_type, cls) -> bool:
@@ -64,6 +66,28 @@ def is_type(numba_type, cls) -> bool:
     Models and schemes select their overloads with it.
     """
     return isinstance(numba_type, types.BaseNamedTuple) and numba_type.instance_class is cls
+
+
+def implements(generic, cls, *, inline: bool = False, **jit_options):
+    """Decorator: register a typing function as the overload of ``generic`` for the NamedTuple type ``cls``.
+
+    The typing function receives the Numba types of a call whose first
+    argument (a kernel, or a method's scheme) is a ``cls`` — calls with other
+    types never reach it — and returns the implementation (or None where it
+    does not apply). ``inline=True`` inlines the implementation into its
+    caller at the IR level; ``jit_options`` add to ``cache=True`` (the
+    implementations are cached on disk with the integrators).
+    """
+    def register(typer):
+        @functools.wraps(typer)
+        def for_this_kernel(*args):
+            return typer(*args) if is_type(args[0], cls) else None
+
+        overload(generic, inline="always" if inline else "never",
+                 jit_options={"cache": True, **jit_options})(for_this_kernel)
+        return typer
+
+    return register
 
 
 def rhs(model, b0, t, Y, OUT):  # pragma: no cover - replaced by overloads in compiled code

@@ -309,6 +309,11 @@ def calls_python(codes: np.ndarray | None) -> bool:
     return codes is not None and bool(np.any(np.asarray(codes)[0::2] == _PYTHON))
 
 
+def program_calls_python(kernel) -> bool:
+    """``calls_python`` of a compiled model whose torque program is its field ``codes``."""
+    return calls_python(kernel.codes)
+
+
 def compile_program(model: TorqueModel | None, axes: np.ndarray, offset: int) -> tuple[np.ndarray, np.ndarray]:
     """Compile a model to a torque program in the principal axes ``axes`` (R_BP).
 

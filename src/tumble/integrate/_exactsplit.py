@@ -53,7 +53,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from tumble import _protocol
 from tumble._protocol import free_evaluate, free_setup, torque_acceleration, torque_free
@@ -79,21 +78,14 @@ BLANES_MOAN = ExactSplit(_S6.a.copy(), _S6.b.copy())
 ORDERS = {"exact_split2": 2, "exact_split4": 4}
 
 
-def _is_exact_split(scheme):
-    return _protocol.is_type(scheme, ExactSplit)
 
-
-@overload(_fixed.workspace, jit_options={"cache": True})
+@_protocol.implements(_fixed.workspace, ExactSplit)
 def _exact_split_workspace(scheme, model, Y):
-    if not _is_exact_split(scheme):
-        return None
     return lambda scheme, model, Y: ()  # every lane runs on scalars
 
 
-@overload(_fixed.advance, jit_options={"cache": True})
+@_protocol.implements(_fixed.advance, ExactSplit)
 def _exact_split_advance(scheme, model, b0, t0, h, m, Y, work):
-    if not _is_exact_split(scheme):
-        return None
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))  # one body: a block of one lane

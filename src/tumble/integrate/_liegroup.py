@@ -30,7 +30,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from tumble import _protocol, _quat
 from tumble._protocol import body_rate, rhs
@@ -75,14 +74,9 @@ def times_unit(qw, qx, qy, qz, ew, ex, ey, ez):
     return qw + dw, qx + dx, qy + dy, qz + dz
 
 
-def _is_cf4(scheme):
-    return _protocol.is_type(scheme, CF4)
 
-
-@overload(_fixed.workspace, jit_options={"cache": True})
+@_protocol.implements(_fixed.workspace, CF4)
 def _cf4_workspace(scheme, model, Y):
-    if not _is_cf4(scheme):
-        return None
 
     def impl(scheme, model, Y):
         lanes = Y.size // Y.shape[0]  # 1 for one body's state vector
@@ -93,10 +87,8 @@ def _cf4_workspace(scheme, model, Y):
     return impl
 
 
-@overload(_fixed.advance, jit_options={"cache": True})
+@_protocol.implements(_fixed.advance, CF4)
 def _cf4_advance(scheme, model, b0, t0, h, m, Y, work):
-    if not _is_cf4(scheme):
-        return None
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         K, S, W, Q2 = work

@@ -16,7 +16,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba.extending import overload, register_jitable
+from numba.extending import register_jitable
 
 from tumble import _protocol
 from tumble._protocol import project, rhs, state_size
@@ -42,22 +42,15 @@ class RK4(NamedTuple):
 SCHEME = RK4()
 
 
-def _is_rk4(scheme):
-    return _protocol.is_type(scheme, RK4)
 
-
-@overload(_fixed.workspace, jit_options={"cache": True})
+@_protocol.implements(_fixed.workspace, RK4)
 def _rk4_workspace(scheme, model, Y):
-    if not _is_rk4(scheme):
-        return None
     return lambda scheme, model, Y: (np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y),
                                      np.empty_like(Y))
 
 
-@overload(_fixed.advance, inline="always", jit_options={"cache": True})
+@_protocol.implements(_fixed.advance, RK4, inline=True)
 def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
-    if not _is_rk4(scheme):
-        return None
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         k1, k2, k3, k4, tmp = work

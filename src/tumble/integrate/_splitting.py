@@ -60,7 +60,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from tumble import _protocol, _quat
 from tumble._protocol import inverse_moments
@@ -98,14 +97,9 @@ BLANES_MOAN = Splitting(*_blanes_moan_s6(), AXES)
 ORDERS = {"splitting2": 2, "splitting4": 4}
 
 
-def _is_splitting(scheme):
-    return _protocol.is_type(scheme, Splitting)
 
-
-@overload(_fixed.workspace, jit_options={"cache": True})
+@_protocol.implements(_fixed.workspace, Splitting)
 def _splitting_workspace(scheme, model, Y):
-    if not _is_splitting(scheme):
-        return None
     # the rates of A, B and C of each lane (1/(kg·m²)), and |L|² at the start of the run
     # (negative: not yet known; set by the first advance)
     return lambda scheme, model, Y: (np.full((4, Y.size // Y.shape[0]), -1.0),)
@@ -113,10 +107,8 @@ def _splitting_workspace(scheme, model, Y):
 
 # error_model="numpy": IEEE division without Python's zero check, which measured
 # 2x in the rotation loop (no divisor below can be zero).
-@overload(_fixed.advance, jit_options={"cache": True, "error_model": "numpy"})
+@_protocol.implements(_fixed.advance, Splitting, error_model="numpy")
 def _splitting_advance(scheme, model, b0, t0, h, m, Y, work):
-    if not _is_splitting(scheme):
-        return None
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         (rates,) = work

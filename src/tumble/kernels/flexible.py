@@ -23,7 +23,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from tumble import _protocol, _quat, torques
 from tumble._vec import cross, matvec
@@ -48,15 +47,10 @@ class FlexibleModel(NamedTuple):
     params: np.ndarray
     codes: np.ndarray
 
-    @property
-    def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
-
-    @property
-    def calls_python(self) -> bool:
-        """True when the torque program calls a Python function (the batch then runs on one core)."""
-        return torques.calls_python(self.codes)
+    #: Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate.
+    provides = frozenset({"rhs", "body_rate"})
+    #: True when the torque program calls a Python function (the batch then runs on one core).
+    calls_python = property(torques.program_calls_python)
 
 
 @njit(cache=True)
@@ -87,33 +81,22 @@ def derivative(model, t, y, out):
     out[4], out[5], out[6] = a1, a2, a3
 
 
-def _is_flexible(model):
-    return _protocol.is_type(model, FlexibleModel)
 
-
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, FlexibleModel, inline=True)
 def _flexible_rhs(model, b0, t, Y, OUT):
-    if not _is_flexible(model):
-        return None
     return _protocol.lanewise_rhs(derivative, Y)
 
 
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.project, FlexibleModel, inline=True)
 def _flexible_project(model, b0, t, Y):
-    if not _is_flexible(model):
-        return None
     return _protocol.quaternion_projection(Y)
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, FlexibleModel)
 def _flexible_state_size(model):
-    if not _is_flexible(model):
-        return None
     return lambda model: 7 + 2 * model.stiffness.shape[0]
 
 
-@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.body_rate, FlexibleModel, inline=True)
 def _flexible_body_rate(model, Y, j):
-    if not _is_flexible(model):
-        return None
     return _protocol.rate_at(4, Y)

@@ -22,7 +22,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from tumble import _protocol, _quat
 
@@ -65,10 +64,8 @@ def _derivative(p, qw, qx, qy, qz, phi_dot, theta_dot, spin):
     return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], phi_ddot, theta_ddot, spin_dot, psi_dot
 
 
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, GimbalModel, inline=True)
 def _gimbal_rhs(model, b0, t, Y, OUT):
-    if not _protocol.is_type(model, GimbalModel):
-        return None
     if Y.ndim == 1:
 
         def impl(model, b0, t, Y, OUT):
@@ -85,15 +82,11 @@ def _gimbal_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.project, GimbalModel, inline=True)
 def _gimbal_project(model, b0, t, Y):
-    if not _protocol.is_type(model, GimbalModel):
-        return None
     return _protocol.quaternion_projection(Y)
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, GimbalModel)
 def _gimbal_state_size(model):
-    if not _protocol.is_type(model, GimbalModel):
-        return None
     return lambda model: STATE_SIZE

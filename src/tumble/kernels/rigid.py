@@ -15,7 +15,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
-from numba.extending import overload
 
 from tumble import _free_flow, _protocol, _quat, torques
 from tumble.dynamics import euler_coefficients, euler_principal
@@ -76,14 +75,9 @@ def from_principal(moments, axes, model) -> RigidModel:
                       codes=codes, moments=moments)
 
 
-def _is_rigid(model):
-    return _protocol.is_type(model, RigidModel)
 
-
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, RigidModel, inline=True)
 def _rigid_rhs(model, b0, t, Y, OUT):
-    if not _is_rigid(model):
-        return None
     if isinstance(model.types[2], types.NoneType):  # torque-free: no torque code at all
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
@@ -136,17 +130,13 @@ def _rigid_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.project, RigidModel, inline=True)
 def _rigid_project(model, b0, t, Y):
-    if not _is_rigid(model):
-        return None
     return _protocol.quaternion_projection(Y)
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, RigidModel)
 def _rigid_state_size(model):
-    if not _is_rigid(model):
-        return None
 
     def impl(model):
         return STATE_SIZE
@@ -154,16 +144,14 @@ def _rigid_state_size(model):
     return impl
 
 
-@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.body_rate, RigidModel, inline=True)
 def _rigid_body_rate(model, Y, j):
-    if not _is_rigid(model):
-        return None
     return _protocol.rate_at(4, Y)
 
 
-@overload(_protocol.inverse_moments, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.inverse_moments, RigidModel, inline=True)
 def _rigid_inverse_moments(model, b):
-    if not _is_rigid(model) or not isinstance(model.types[2], types.NoneType):
+    if not isinstance(model.types[2], types.NoneType):
         return None  # with a torque program, the body is not free: no splitting
 
     def impl(model, b):
@@ -174,10 +162,8 @@ def _rigid_inverse_moments(model, b):
     return impl
 
 
-@overload(_protocol.free_setup, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.free_setup, RigidModel, inline=True)
 def _rigid_free_setup(model, b, x):
-    if not _is_rigid(model):
-        return None
 
     def impl(model, b, x):
         r = b * (model.moments.shape[0] > 1)
@@ -187,10 +173,8 @@ def _rigid_free_setup(model, b, x):
     return impl
 
 
-@overload(_protocol.free_evaluate, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.free_evaluate, RigidModel, inline=True)
 def _rigid_free_evaluate(model, motion, tau):
-    if not _is_rigid(model):
-        return None
 
     def impl(model, motion, tau):
         w1, w2, w3, qw, qx, qy, qz = _free_flow._evaluate(motion, tau)
@@ -199,10 +183,8 @@ def _rigid_free_evaluate(model, motion, tau):
     return impl
 
 
-@overload(_protocol.torque_acceleration, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.torque_acceleration, RigidModel, inline=True)
 def _rigid_torque_acceleration(model, b, t, x, w1, w2, w3):
-    if not _is_rigid(model):
-        return None
     if isinstance(model.types[2], types.NoneType):
         return lambda model, b, t, x, w1, w2, w3: (0.0, 0.0, 0.0)
 
@@ -216,9 +198,7 @@ def _rigid_torque_acceleration(model, b, t, x, w1, w2, w3):
     return impl
 
 
-@overload(_protocol.torque_free, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.torque_free, RigidModel, inline=True)
 def _rigid_torque_free(model):
-    if not _is_rigid(model):
-        return None
     free = isinstance(model.types[2], types.NoneType)
     return lambda model: free

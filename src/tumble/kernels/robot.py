@@ -28,7 +28,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, objmode
-from numba.extending import overload
 
 from tumble import _callback, _protocol
 from tumble.kernels import featherstone as _featherstone
@@ -117,26 +116,17 @@ def _derivative(model, t, y, ydot):
     ydot[2 * n] = power
 
 
-def _is_robot(model):
-    return _protocol.is_type(model, RobotModel)
 
-
-@overload(_protocol.rhs, jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, RobotModel)
 def _robot_rhs(model, b0, t, Y, OUT):
-    if not _is_robot(model):
-        return None
     return _protocol.lanewise_rhs(_derivative, Y)
 
 
-@overload(_protocol.project, jit_options={"cache": True})
+@_protocol.implements(_protocol.project, RobotModel)
 def _robot_project(model, b0, t, Y):
-    if not _is_robot(model):
-        return None
     return lambda model, b0, t, Y: None  # joint coordinates and work live in a vector space
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, RobotModel)
 def _robot_state_size(model):
-    if not _is_robot(model):
-        return None
     return lambda model: 2 * model.params.shape[0] + 1

@@ -25,7 +25,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
-from numba.extending import overload
 
 from tumble import _protocol, _quat, torques
 from tumble._vec import cross, matvec
@@ -50,15 +49,10 @@ class SloshModel(NamedTuple):
     params: np.ndarray
     codes: np.ndarray
 
-    @property
-    def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
-
-    @property
-    def calls_python(self) -> bool:
-        """True when the torque program calls a Python function (the batch then runs on one core)."""
-        return torques.calls_python(self.codes)
+    #: Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate.
+    provides = frozenset({"rhs", "body_rate"})
+    #: True when the torque program calls a Python function (the batch then runs on one core).
+    calls_python = property(torques.program_calls_python)
 
 
 @njit(cache=True)
@@ -113,21 +107,14 @@ def project_state(y):
     y[10], y[11], y[12] = y[10] - along * y[7], y[11] - along * y[8], y[12] - along * y[9]
 
 
-def _is_slosh(model):
-    return _protocol.is_type(model, SloshModel)
 
-
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, SloshModel, inline=True)
 def _slosh_rhs(model, b0, t, Y, OUT):
-    if not _is_slosh(model):
-        return None
     return _protocol.lanewise_rhs(derivative, Y)
 
 
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.project, SloshModel, inline=True)
 def _slosh_project(model, b0, t, Y):
-    if not _is_slosh(model):
-        return None
     if Y.ndim == 1:
         return lambda model, b0, t, Y: project_state(Y)
 
@@ -138,15 +125,11 @@ def _slosh_project(model, b0, t, Y):
     return impl
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, SloshModel)
 def _slosh_state_size(model):
-    if not _is_slosh(model):
-        return None
     return lambda model: STATE_SIZE
 
 
-@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.body_rate, SloshModel, inline=True)
 def _slosh_body_rate(model, Y, j):
-    if not _is_slosh(model):
-        return None
     return _protocol.rate_at(4, Y)

@@ -26,7 +26,6 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
-from numba.extending import overload
 
 from tumble import _protocol, _quat, torques
 
@@ -47,15 +46,10 @@ class VariableModel(NamedTuple):
     params: np.ndarray
     codes: np.ndarray | None
 
-    @property
-    def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
-
-    @property
-    def calls_python(self) -> bool:
-        """True when the torque program calls a Python function (the batch then runs on one core)."""
-        return torques.calls_python(self.codes)
+    #: Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate.
+    provides = frozenset({"rhs", "body_rate"})
+    #: True when the torque program calls a Python function (the batch then runs on one core).
+    calls_python = property(torques.program_calls_python)
 
 
 def build(body, torque) -> VariableModel:
@@ -108,14 +102,9 @@ def angular_rate(breaks, c, s, qw, qx, qy, qz, lx, ly, lz):
             (c02 * bx + c12 * by + c22 * bz) * inv_det)
 
 
-def _is_variable(model):
-    return _protocol.is_type(model, VariableModel)
 
-
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, VariableModel, inline=True)
 def _variable_rhs(model, b0, t, Y, OUT):
-    if not _is_variable(model):
-        return None
     if isinstance(model.types[3], types.NoneType):
 
         def torque_rate(model, t, qw, qx, qy, qz, w1, w2, w3):
@@ -152,10 +141,8 @@ def _variable_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.project, VariableModel, inline=True)
 def _variable_project(model, b0, t, Y):
-    if not _is_variable(model):
-        return None
 
     if Y.ndim == 1:
 
@@ -173,17 +160,13 @@ def _variable_project(model, b0, t, Y):
     return impl
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, VariableModel)
 def _variable_state_size(model):
-    if not _is_variable(model):
-        return None
     return lambda model: STATE_SIZE
 
 
-@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.body_rate, VariableModel, inline=True)
 def _variable_body_rate(model, Y, j):
-    if not _is_variable(model):
-        return None
     if Y.ndim == 1:
         return lambda model, Y, j: angular_rate(model.breaks, model.coefficients, Y[7],
                                                 Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6])
