@@ -219,7 +219,7 @@ def simulate(
         raise ValidationError(f"torque: a {type(model).__name__} takes no torque argument")
     values, n = _initial_values(model, initial_state)
     model.check_run(m, times, options.get("dt"))
-    with _callback.keep_alive():  # Python functions wrapped while compiling live through the run
+    with _callback.keep_alive():  # Python functions wrapped while compiling live through the run and its outputs
         kernel = model.compile(torque, float(times[0]))
         who = f"a {type(model).__name__}" + (f" under torque={torque!r}" if torque is not None else "")
         integrate.check_method(m.name, kernel.provides, who)
@@ -229,7 +229,7 @@ def simulate(
                                   + (" and a progress callback" if progress is not None else ""))
         y0 = model.initial_states(kernel, values, float(times[0]))
         solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device, **options)
-    out = model.outputs(kernel, times, solution.states)
+        out = model.outputs(kernel, times, solution.states)  # may evaluate the kernel (diagnostics) too
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
     return _trajectory(model, m.name, times, out, info, single=n is None)
