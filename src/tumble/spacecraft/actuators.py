@@ -17,6 +17,9 @@ import numpy as np
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import Part
+from tumble.kernels.spacecraft import cmgs as _cmgs
+from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
+from tumble.kernels.spacecraft._base import Program
 
 __all__ = ["ReactionWheel", "CMGCluster", "Thruster", "PWPF", "Magnetorquers", "pyramid_wheels"]
 
@@ -217,6 +220,11 @@ class CMGCluster:
         """``g_i × s0_i`` (n, 3): the direction of the gyro torque ``ḣ_i`` at δ = 0."""
         return np.cross(self.gimbal_axes, self.spin_axes)
 
+    def _program(self) -> Program:
+        return _cmgs.program(self.gimbal_axes, self.spin_axes, self.momentum, max_gimbal_rate=self.max_gimbal_rate,
+                             robust_gain=self.robust_gain, robust_decay=self.robust_decay, dither=self.dither,
+                             dither_frequency=self.dither_frequency, dither_phases=self.dither_phases)
+
 
 @dataclass(frozen=True)
 class Thruster:
@@ -291,6 +299,9 @@ class Magnetorquers:
         if (m <= 0).any():
             raise ValidationError(f"max_dipole: each entry must be > 0 (A·m²), got {m.tolist()}")
         object.__setattr__(self, "max_dipole", m)
+
+    def _program(self) -> Program:
+        return _magnetorquers.program(self.max_dipole)
 
 
 def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options):

@@ -39,9 +39,9 @@ The laws (body axes, SI units):
 * :class:`WheelTorques`: motor torques commanded to the wheels directly, one
   per wheel (N·m): a constant, samples in time, or a Python function.
 
-``H`` is the spacecraft's angular momentum in body axes (hub and wheels and
-gyros). ``J`` is the inertia the body rate answers to: the total inertia less
-the wheels' spin inertias (see ``docs/spacecraft.md``).
+``H`` is the spacecraft's angular momentum in body axes (hub, wheels, gyros,
+damper). ``J`` is the inertia the body rate answers to: the total inertia less
+the wheels' spin inertias and the damper sphere (see ``docs/spacecraft.md``).
 """
 
 from __future__ import annotations
@@ -55,6 +55,7 @@ from tumble import _callback, attitude
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.kernels.spacecraft import laws as _laws
 from tumble.kernels.spacecraft._base import Program
+from tumble.spacecraft.actuators import _limit
 
 __all__ = ["QuaternionPD", "MRPFeedback", "RateDamping", "ConstantTorque", "BDot", "MomentumDumping", "PythonLaw",
            "WheelTorques", "TORQUE_LAWS", "DIPOLE_LAWS"]
@@ -65,13 +66,6 @@ def _quaternion(value, name: str) -> np.ndarray:
     if q.shape != (4,) or np.linalg.norm(q) == 0.0:
         raise ValidationError(f"{name}: must be a non-zero quaternion [w, x, y, z], got {q.tolist()}")
     return attitude.normalize(q)
-
-
-def _limit(value, name: str) -> float:
-    x = float(value)
-    if math.isnan(x) or x <= 0.0:
-        raise ValidationError(f"{name}: must be > 0 (math.inf for no limit), got {x}")
-    return x
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ from tumble.kernels import spacecraft as _kernel
 from tumble.kernels.spacecraft import cmgs as _cmgs
 from tumble.kernels.spacecraft import damper as _damper_kernel
 from tumble.kernels.spacecraft import environment as _environment
-from tumble.kernels.spacecraft import laws as _laws
+from tumble.kernels.spacecraft import laws as _law_kernels
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
 from tumble.kernels.spacecraft import thrusters as _thrusters
 from tumble.kernels.spacecraft import wheels as _wheels
@@ -45,8 +45,7 @@ from tumble.kernels.spacecraft._base import Program
 from tumble.simulate import Model, Outputs, StateField
 from tumble.simulate import simulate as _simulate
 from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, ReactionWheel, Thruster
-from tumble.spacecraft.control import (DIPOLE_LAWS, TORQUE_LAWS, BDot, MomentumDumping, MRPFeedback, PythonLaw,
-                                       WheelTorques)
+from tumble.spacecraft.control import DIPOLE_LAWS, TORQUE_LAWS, MomentumDumping, MRPFeedback, PythonLaw, WheelTorques
 from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField
 from tumble.spacecraft.orbit import Orbit
@@ -249,17 +248,9 @@ class Spacecraft(Model):
                 axes, *(np.array([getattr(w, name) for w in self.wheels]) for name in
                         ("inertia", "max_torque", "max_speed", "viscous", "coulomb", "coulomb_speed")),
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
-        if self.cmgs is not None:
-            c = self.cmgs
-            programs.append(_cmgs.program(c.gimbal_axes, c.spin_axes, c.momentum, max_gimbal_rate=c.max_gimbal_rate,
-                                          robust_gain=c.robust_gain, robust_decay=c.robust_decay, dither=c.dither,
-                                          dither_frequency=c.dither_frequency, dither_phases=c.dither_phases))
+        programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper) if part is not None]
         if self.thrusters:
             programs.append(self._thruster_program())
-        if self.magnetorquers is not None:
-            programs.append(_magnetorquers.program(self.magnetorquers.max_dipole))
-        if self.damper is not None:
-            programs.append(self.damper._program())
         for law in self.controller:
             programs += law._programs(self.rate_inertia)
         if isinstance(self.magnetic_field, DipoleField):
@@ -362,7 +353,7 @@ class Spacecraft(Model):
             s = where("damper").s + _damper_kernel.RATE
             y0[:, s:s + 3] = values["damper_omega0"]
         if "attitude_error_integral0" in values:
-            s = where("mrp_integral").s + _laws.INTEGRAL
+            s = where("mrp_integral").s + _law_kernels.INTEGRAL
             y0[:, s:s + 3] = values["attitude_error_integral0"]
         for y in y0:
             _kernel.initialise(kernel, float(t0), y)
@@ -421,8 +412,8 @@ class Spacecraft(Model):
         if self.thrusters:
             th = where("thrusters")
             state = _thrusters.state_slices(th.n, th.s)
-            program = self._thruster_program()
-            table = program.params[_thrusters.HEAD:].reshape(th.n, _thrusters.STRIDE)
+            table = kernel.data[th.p + _thrusters.HEAD:th.p + _thrusters.HEAD + th.n * _thrusters.STRIDE].reshape(
+                th.n, _thrusters.STRIDE)
             out = states[..., state["pwpf_output"]]
             firing = out[..., table[:, _thrusters.AXIS].astype(int)] == table[:, _thrusters.SIGN]
             add("thruster_firing", firing.astype(float), ("thruster",), "1", "1 while the thruster fires")
@@ -451,7 +442,7 @@ class Spacecraft(Model):
         integral = where("mrp_integral")
         if integral is not None:
             add("attitude_error_integral",
-                states[..., _laws.integral_slices(integral.n, integral.s)["attitude_error_integral"]], ("xyz",),
+                states[..., _law_kernels.integral_slices(integral.n, integral.s)["attitude_error_integral"]], ("xyz",),
                 "s", "integral of the MRP attitude error of the MRP feedback's integral term")
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
             "torque of all actuators on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper)")
