@@ -279,6 +279,22 @@ def test_tabulated_and_python_wheel_torques_agree_and_add_to_the_torque_law():
     np.testing.assert_allclose(a.wheel_torque, allocated + direct, rtol=0, atol=1e-16)
 
 
+@SLOW
+def test_sampled_wheel_torques_are_held_between_samples():
+    """With a control period the motor commands of a ramp are sampled at t = 0, 0.5, 1, ... s and held: each
+    wheel's torque is the ramp's value at the last sample, and h grows piecewise linearly by it."""
+    ramp = WheelTorques(np.outer([0.0, 2.0], MOTOR), t=[0.0, 2.0])            # 0 → 2 u over 2 s, linear
+    craft = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), controller=ramp, control_period=0.5)
+    t = np.linspace(0.0, 2.0, 41)
+    traj = tumble.simulate(craft, [0.01, 0.02, -0.01], t=t, method="rk4", dt=0.05)
+    held = np.floor(t / 0.5 + 1e-9) * 0.5                                      # the last sample time
+    np.testing.assert_allclose(traj.wheel_torque, held[:, None] * MOTOR, rtol=0, atol=1e-17)
+    # ∫ of the held staircase: exact for RK4 (constant within each step)
+    impulse = np.concatenate([[0.0], np.cumsum(held[:-1] * np.diff(t))])
+    np.testing.assert_allclose(traj.wheel_momentum - traj.wheel_momentum[0], impulse[:, None] * MOTOR, rtol=0,
+                               atol=1e-16)
+
+
 def test_wheel_torques_are_checked():
     with pytest.raises(tumble.ValidationError, match="controller: WheelTorques gives 3 motor torques for 4 wheels"):
         Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), controller=WheelTorques([0.0, 0.0, 0.0]))

@@ -28,7 +28,7 @@ diagnostics (see :data:`tumble.kernels.spacecraft.PARTS`)::
         ``routed``: the controller's torque command is this part's to deliver;
         ``cmd = (u₁, u₂, u₃, m₁, m₂, m₃, b₁, b₂, b₃, source)``: torque command
         (N·m), dipole command (A·m²) and magnetic field (T), body axes, and
-        what the wheel-torque law left for :func:`direct` wheel commands
+        what the wheel-torque law left for the wheels' direct commands
     sample(model, p, n, s, t, y, j)
         its discrete updates at the end of a step that ends at ``t`` (in place)
 """

@@ -22,7 +22,7 @@ from tumble import _quat
 from tumble._gravity import gravity_gradient_torque, kepler_state
 from tumble.kernels.spacecraft._base import Program, inline
 
-ORBIT = 0    # Kepler elements [a, e, i, Ω, ω, M₀, μ] (7): the dipole field and the gravity gradient
+ORBIT = 0    # Kepler elements [a, e, i, Ω, ω, M₀, μ] (7; μ at ORBIT + 6): dipole field, gravity gradient
 DIPOLE = 7   # dipole-field parameters (6) of DipoleField.params(), after the orbit
 UNIFORM = 0  # a uniform field (3), T, inertial axes
 
@@ -89,6 +89,6 @@ def gravity_gradient(model, p, j_offset, t, qw, qx, qy, qz):
     d = model.data
     r1, r2, r3 = position(d, p + ORBIT, t)
     r1, r2, r3 = _quat.qrotate_inv(qw, qx, qy, qz, r1, r2, r3)
-    o = j_offset
+    o = j_offset  # row-major: J₁₁ at o, J₂₂ at o + 4, J₃₃ at o + 8, J₁₂ at o + 1, J₁₃ at o + 2, J₂₃ at o + 5
     return gravity_gradient_torque(d[p + ORBIT + 6], r1, r2, r3, d[o], d[o + 4], d[o + 8], d[o + 1], d[o + 2],
                                    d[o + 5])
