@@ -2,8 +2,9 @@
 
 One spacecraft (total inertia with a product of inertia, four pyramid reaction wheels with
 torque limits and viscous friction) under the quaternion PD law (continuous), slewing 90°
-about a skewed axis: RK4 at 0.1 s steps, one core, end to end (``simulate``) and the
-integration alone (``tumble.integrate.solve`` on the compiled model). scipy's ``solve_ivp(method="RK45")`` runs
+about a skewed axis: RK4 at 0.1 s steps, one core, end to end (``tumble.simulate``) and the
+integration alone (``tumble.integrate.solve`` on the compiled model of ``Spacecraft.compile``).
+scipy's ``solve_ivp(method="RK45")`` runs
 the same equations, written below in NumPy, with its default tolerances (rtol 1e-3), and a
 fixed-step RK4 loop in plain Python over the same right-hand side shows the cost of the
 equations without a compiled loop. A second solve_ivp line (DOP853, rtol 1e-10, atol 1e-12)
@@ -26,10 +27,10 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 from scipy.integrate import solve_ivp  # noqa: E402
 
+import tumble  # noqa: E402
 from _timing import best_of  # noqa: E402
 from tumble import attitude, integrate  # noqa: E402
-from tumble.spacecraft import QuaternionPD, Spacecraft, pyramid_wheels, simulate  # noqa: E402
-from tumble.spacecraft.model import _initial_state  # noqa: E402
+from tumble.spacecraft import QuaternionPD, Spacecraft, pyramid_wheels  # noqa: E402
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
 WN, ZETA = 0.2, 0.8
@@ -42,7 +43,7 @@ CRAFT = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02, max_torque=0.2, 
 
 
 def numpy_rhs(craft):
-    """The spacecraft equations (see tumble.spacecraft._kernel) in NumPy: state [q, ω, h]."""
+    """The spacecraft equations (see tumble.kernels.spacecraft) in NumPy: state [q, ω, h]."""
     jw = craft.rate_inertia
     jinv = np.linalg.inv(jw)
     axes = np.array([w.axis for w in craft.wheels])
@@ -71,13 +72,15 @@ def numpy_rhs(craft):
 
 def main():
     t = np.linspace(0.0, SPAN, 31)
-    simulate(CRAFT, [0.0, 0.0, 0.0], t=t[:2], dt=DT)  # compile (cached on disk)
-    wall, traj = best_of(REPEATS, lambda: simulate(CRAFT, [0.0, 0.0, 0.0], t=t, dt=DT))
+    tumble.simulate(CRAFT, [0.0, 0.0, 0.0], t=t[:2], method="rk4", dt=DT)  # compile (cached on disk)
+    wall, traj = best_of(REPEATS, lambda: tumble.simulate(CRAFT, [0.0, 0.0, 0.0], t=t, method="rk4", dt=DT))
     angle = np.degrees(attitude.relative_angle(traj.q[-1], TARGET))
     print(f"tumble simulate, rk4, dt = {DT} s: {SPAN / wall:10.4g} simulated s per wall s  "
           f"({wall * 1e6 / (SPAN / DT):.2f} µs per step, set-up and outputs included; "
           f"error after {SPAN:g} s: {angle:.2e} deg)")
-    model, y0 = CRAFT.model(), _initial_state(CRAFT, [0.0, 0.0, 0.0], None, None, None)
+    model = CRAFT.compile(None, 0.0)
+    y0 = CRAFT.initial_states(model, {"omega0": np.zeros((1, 3)), "q0": attitude.identity()[None],
+                                      "wheel_speeds0": np.zeros((1, 4))}, 0.0)
     wall_solve, _ = best_of(REPEATS, lambda: integrate.solve(model, y0, t, method="rk4", dt=DT))
     print(f"  of which the integration:    {SPAN / wall_solve:10.4g} simulated s per wall s  "
           f"({wall_solve * 1e6 / (SPAN / DT):.2f} µs per step; set-up and outputs: "

@@ -7,10 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import tumble
 from tumble import attitude
 from tumble._validate import ValidationError
-from tumble.spacecraft import (PWPF, BDot, CMGCluster, ConstantTorque, Magnetorquers, QuaternionPD, Spacecraft,
-                               Thruster, simulate)
+from tumble.spacecraft import (PWPF, BDot, CMGCluster, ConstantTorque, Magnetorquers, QuaternionPD,
+                               SingularityWarning, Spacecraft, Thruster)
 from tumble.scenario import load
 
 # Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
@@ -32,7 +33,7 @@ def test_bdot_decays_the_rate_normal_to_the_field_by_the_predicted_factor():
                        controller=BDot(k))
     t = np.linspace(0.0, 100.0, 11)
     w0 = np.array([0.02, -0.03, 0.05])
-    traj = simulate(craft, w0, t=t, dt=0.05)
+    traj = tumble.simulate(craft, w0, t=t, method="rk4", dt=0.05)
     w_i = attitude.rotate(traj.q, traj.omega)
     bh = b / np.linalg.norm(b)
     along, normal = w0 @ bh * bh, w0 - w0 @ bh * bh
@@ -109,7 +110,7 @@ def test_pyramid_geometry():
 def cmg_slew():
     craft = _cmg_craft()
     t = np.linspace(0.0, 20.0, 41)
-    return craft, simulate(craft, [0.01, 0.0, -0.01], t=t, dt=0.02)
+    return craft, tumble.simulate(craft, [0.01, 0.0, -0.01], t=t, method="rk4", dt=0.02)
 
 
 def test_cmg_cluster_conserves_total_momentum(cmg_slew):
@@ -146,11 +147,77 @@ def test_singular_configuration_is_reported_not_crashed_through():
     delta0 = np.radians([90.0, 0.0, -90.0, 0.0])
     a = _columns(delta0).T
     assert abs(np.linalg.det(a @ a.T)) < 1e-12
-    traj = simulate(_cmg_craft(), [0.0, 0.0, 0.0], t=np.linspace(0.0, 10.0, 11), gimbal_angles0=delta0, dt=0.02)
+    with pytest.warns(SingularityWarning, match="first at t = 0 s"):
+        traj = tumble.simulate(_cmg_craft(), [0.0, 0.0, 0.0], t=np.linspace(0.0, 10.0, 11), gimbal_angles0=delta0,
+                               method="rk4", dt=0.02)
     measure = traj.extras["singularity"].data
     assert measure[0] < 1e-6
     assert np.all(np.isfinite(traj.q)) and np.all(np.isfinite(traj.extras["gimbal_rate"].data))
     assert np.abs(traj.extras["gimbal_rate"].data).max() <= 2.0   # the rate limit
+
+
+# The elliptic singularity of the pyramid (Wie, Bailey & Heiberg, J. Guidance 24(5), 2001; Wie 2008, §7.3): at
+# δ = (−90°, 0, 90°, 0) every torque column is normal to x and the cluster holds H = 2 cos β h x̂ = 1.155 h x̂, a
+# local maximum of H_x over the configurations with H_y = H_z = 0: no null motion leaves it, and a torque command
+# along −x (ḣ = −u along +x) is along the singular direction. h = 1 N·m·s, gimbal rates up to 2 rad/s.
+ESCAPE_DELTA0 = np.radians([-90.0, 0.0, 90.0, 0.0])
+ESCAPE_CLUSTER = CMGCluster.pyramid(H_CMG, max_gimbal_rate=2.0)
+
+
+def _escape(cluster, torque, t):
+    craft = Spacecraft(inertia=CMG_INERTIA, cmgs=cluster, controller=ConstantTorque(torque))
+    with pytest.warns(SingularityWarning):
+        traj = tumble.simulate(craft, [0.0, 0.0, 0.0], t=t, gimbal_angles0=ESCAPE_DELTA0, method="rk4", dt=0.01)
+    error = np.linalg.norm(traj.actuator_torque - torque, axis=-1) / np.linalg.norm(torque)
+    return craft, traj, error
+
+
+def test_sr_inverse_is_stuck_at_the_elliptic_singularity():
+    # 0.5 N·m along −x: A Aᵀ u = 0 up to the rounding of cos(±π/2), which (A Aᵀ + λE)⁻¹ amplifies by 1/λ = 100:
+    # the gimbals move by 5.7e-12 rad and the torque delivered is 2.9e-12 N·m in 5 s (measured): none
+    t = np.linspace(0.0, 5.0, 101)
+    _, traj, error = _escape(ESCAPE_CLUSTER, [-0.5, 0.0, 0.0], t)
+    assert np.abs(traj.gimbal_angle - ESCAPE_DELTA0).max() < 1e-10
+    assert np.abs(traj.actuator_torque).max() < 1e-10
+    # 5 % off the singular direction and 0.05 N·m: the error is still 99.86 % after 5 s (measured)
+    _, traj, error = _escape(ESCAPE_CLUSTER, 0.05 * np.array([-1.0, 0.05, 0.0]) / math.hypot(1.0, 0.05), t)
+    assert error[-1] > 0.99
+
+
+def test_generalised_sr_inverse_escapes_and_delivers_the_command():
+    """Wie's dither (ε₀ = 0.01, ω_ε = π/2 rad/s, φ = 0, π/2, π; λ₀ = 0.01, μ = 10) on the same command: the gimbals
+    leave the singularity and the cluster delivers 0.5 N·m along −x from t = 2.7 s on. The bound 1e-4 after 3 s is
+    that of the SR inverse once away from singular (λ/σ_min(A Aᵀ) ≈ 0.01 e^(−10·0.68)/0.6 = 2e-5; measured
+    3.8e-5 at the start of the window, where the measure is 0.82); the run stops at 5 s because the cluster
+    reaches its momentum envelope (H_x = (2 + 2 cos β) h = 3.15 h) at 6.4 s."""
+    t = np.linspace(0.0, 5.0, 101)
+    craft, traj, error = _escape(ESCAPE_CLUSTER.generalised(), np.array([-0.5, 0.0, 0.0]), t)
+    assert error[:40].min() > 0.9          # stuck for the first 2 s ...
+    assert error[t >= 2.75].max() < 0.01   # ... delivered to 1 % from 2.75 s (measured 2.4e-3 there)
+    assert error[t >= 3.0].max() < 1e-4
+    assert traj.singularity[t >= 3.0].min() > 0.5
+    # the price of the escape: a transient torque error across the command, left as 0.111 h of momentum in the
+    # cluster normal to x (measured); the x momentum grew by 0.5 N·m × (5 s − 2.39 s) = 1.30 N·m·s
+    cluster = traj.momentum_body - traj.omega @ craft.rate_inertia.T
+    assert np.linalg.norm(cluster[-1, 1:]) < 0.15 * H_CMG
+    np.testing.assert_allclose(cluster[-1, 0] - cluster[0, 0], 1.304, atol=0.01)
+    # the dither is deterministic: the steering is that of A# = Aᵀ(A Aᵀ + λE)⁻¹ with E's off-diagonal ε_i(t)
+    k = 60                                                    # t = 3 s
+    a = _columns(traj.gimbal_angle[k]).T
+    m = a @ a.T
+    lam = 0.01 * math.exp(-10.0 * np.linalg.det(m)) * H_CMG**2
+    e1, e2, e3 = 0.01 * np.sin(0.5 * math.pi * t[k] + np.array([0.0, 0.5 * math.pi, math.pi]))
+    big_e = np.array([[1.0, e3, e2], [e3, 1.0, e1], [e2, e1, 1.0]])
+    rate = a.T @ np.linalg.solve(m + lam * big_e, -traj.torque_command[k])
+    np.testing.assert_allclose(traj.gimbal_rate[k], rate, rtol=1e-10, atol=1e-15)
+
+
+def test_generalised_inverse_is_validated():
+    with pytest.raises(ValidationError, match="dither: must be < 0.5"):
+        ESCAPE_CLUSTER.generalised(0.6)
+    with pytest.raises(ValidationError, match="dither_phases: must be 3 finite angles"):
+        ESCAPE_CLUSTER.generalised(0.01, dither_phases=(0.0, 1.0))
+    assert ESCAPE_CLUSTER.dither == 0.0 and ESCAPE_CLUSTER.generalised().dither == 0.01
 
 
 # ----------------------------------------------------------------------------------------------
@@ -180,7 +247,7 @@ def pulses():
     command = np.array([0.4, -0.6, 0.0])   # N·m: r = 0.4, −0.6, 0 of the 1 N·m axes
     craft = _thruster_craft(command)
     t = np.linspace(0.0, 60.0, 6001)
-    return command, simulate(craft, [0.0, 0.0, 0.0], t=t, dt=0.01)
+    return command, tumble.simulate(craft, [0.0, 0.0, 0.0], t=t, method="rk4", dt=0.01)
 
 
 def test_thruster_torques_are_r_cross_f():
@@ -208,7 +275,7 @@ def test_minimum_on_time_is_respected():
     # r = 0.15: the modulator's own pulses last T_on = τ ln((u_on + K(1−r))/(u_off + K(1−r))) = 0.062 s;
     # a minimum on-time of 0.3 s stretches every pulse to 0.3 s (to the 0.01 s step)
     craft = _thruster_craft([0.15, 0.0, 0.0], min_on_time=0.3)
-    traj = simulate(craft, [0.0, 0.0, 0.0], t=np.linspace(0.0, 30.0, 3001), dt=0.01)
+    traj = tumble.simulate(craft, [0.0, 0.0, 0.0], t=np.linspace(0.0, 30.0, 3001), method="rk4", dt=0.01)
     firing = traj.extras["thruster_firing"].data[:, 0]
     edges = np.diff(firing)
     starts, stops = np.flatnonzero(edges > 0), np.flatnonzero(edges < 0)

@@ -23,7 +23,7 @@ from tumble.scenario._values import _Positive, _Table, _Vector
 from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import Torque, build_torque
 from tumble.simulate import simulate
-from tumble.spacecraft.damper import SphericalDamper, simulate_damped
+from tumble.spacecraft import Spacecraft, SphericalDamper
 from tumble.trajectory import Trajectory
 
 __all__ = ["DamperTable", "Problem", "RigidScenario"]
@@ -73,31 +73,18 @@ class Problem:
     damper_omega0: np.ndarray | None = None
 
     @property
-    def model(self) -> RigidBody:
-        """The tumble model: the body (with a damper, the hub; the damper is :attr:`damper`)."""
-        return self.body
+    def model(self):
+        """The tumble model: the body, or with a damper the spacecraft of hub and damper."""
+        if self.damper is None:
+            return self.body
+        return Spacecraft(hub=self.body, damper=self.damper)
 
     def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-        """Run :func:`tumble.simulate` (with a damper, :func:`_simulate_damped`); an argument it refuses is
-        reported against its scenario key."""
+        """Run :func:`tumble.simulate`; an argument it refuses is reported against its scenario key."""
+        damper = {} if self.damper_omega0 is None else {"damper_omega0": self.damper_omega0}
         with in_file(self.source), keyed(_RUN_KEYS, ""):
-            if self.damper is not None:
-                return _simulate_damped(self, progress)
-            return simulate(self.body, t=self.t, method=self.method, torque=self.torque, progress=progress,
-                            omega0=self.omega0, q0=self.q0, **self.options)
-
-
-def _simulate_damped(problem: Problem, progress) -> Trajectory:
-    """A hub with a spherical damper, integrated by today's entry point.
-
-    SWITCH TO tumble.simulate HERE: once the damped body is a tumble.simulate
-    model, this call becomes ``simulate(<that model>(problem.body,
-    problem.damper), ...)`` with the same keywords (``damper_omega0`` is then
-    an initial-state field) — a one-line change.
-    """
-    return simulate_damped(problem.body, problem.damper, t=problem.t, method=problem.method, torque=problem.torque,
-                           progress=progress, omega0=problem.omega0, q0=problem.q0,
-                           damper_omega0=problem.damper_omega0, **problem.options)
+            return simulate(self.model, t=self.t, method=self.method, torque=self.torque, progress=progress,
+                            omega0=self.omega0, q0=self.q0, **damper, **self.options)
 
 
 class RigidScenario(Scenario):

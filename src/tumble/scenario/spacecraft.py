@@ -52,10 +52,10 @@ from tumble.scenario._errors import ScenarioError, in_file, keyed
 from tumble.scenario._values import _Bool, _Limit, _Matrix, _Number, _Positive, _Quaternion, _Table, _Vector
 from tumble.scenario.orbit import OrbitTable
 from tumble.scenario.tables import EulerAngles, Initial, Solver, Time
+from tumble.simulate import simulate
 from tumble.spacecraft import actuators, control
 from tumble.spacecraft.environment import DipoleField
 from tumble.spacecraft.model import METHODS, Spacecraft
-from tumble.spacecraft.model import simulate as spacecraft_simulate
 from tumble.trajectory import Trajectory
 
 __all__ = ["SpacecraftProblem", "SpacecraftScenario"]
@@ -351,20 +351,11 @@ class SpacecraftProblem:
         return self.spacecraft
 
     def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-        """Simulate; an argument the library refuses is reported against its scenario key."""
+        """Simulate with :func:`tumble.simulate`; an argument the library refuses is reported against its
+        scenario key."""
         with in_file(self.source), keyed(self.keys, ""):
-            return _simulate_spacecraft(self, progress)
-
-
-def _simulate_spacecraft(problem: SpacecraftProblem, progress) -> Trajectory:
-    """A spacecraft, integrated by today's entry point :func:`tumble.spacecraft.model.simulate`.
-
-    SWITCH TO tumble.simulate HERE: once :class:`~tumble.spacecraft.Spacecraft`
-    is a tumble.simulate model, ``spacecraft_simulate`` becomes
-    ``tumble.simulate`` with the same arguments — a one-line change.
-    """
-    return spacecraft_simulate(problem.spacecraft, t=problem.t, method=problem.method, progress=progress,
-                               **problem.initial, **problem.options)
+            return simulate(self.spacecraft, t=self.t, method=self.method, progress=progress, **self.initial,
+                            **self.options)
 
 
 class SpacecraftScenario(Scenario):

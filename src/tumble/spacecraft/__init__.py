@@ -1,14 +1,15 @@
 """Spacecraft attitude dynamics and control: a rigid hub with reaction wheels, control moment gyros,
-thrusters and magnetorquers, in a Keplerian orbit with gravity gradient and a dipole magnetic field,
-under a feedback controller (continuous or sampled with a zero-order hold).
+thrusters, magnetorquers and a nutation damper, in a Keplerian orbit with gravity gradient and a dipole
+magnetic field, under feedback control laws (compiled or Python; continuous or sampled with a zero-order
+hold). A :class:`Spacecraft` is a model of :func:`tumble.simulate`.
 
-    >>> import numpy as np
+    >>> import numpy as np, tumble
     >>> from tumble import spacecraft as sc
     >>> craft = sc.Spacecraft(inertia=np.diag([10.0, 12.0, 8.0]),
     ...                       wheels=sc.pyramid_wheels(inertia=0.01, max_torque=0.1),
     ...                       controller=sc.QuaternionPD(natural_frequency=0.2, target=[0.0, 0.0, 0.0, 1.0]))
-    >>> traj = sc.simulate(craft, [0.0, 0.0, 0.0], t=np.linspace(0.0, 60.0, 61), dt=0.1)
-    >>> traj.extras["wheel_speed"].data.shape
+    >>> traj = tumble.simulate(craft, [0.0, 0.0, 0.0], t=np.linspace(0.0, 60.0, 61), method="rk4", dt=0.1)
+    >>> traj.wheel_speed.shape
     (61, 4)
 
 Conventions and equations: ``docs/spacecraft.md``; the orbit, LVLH, gravity gradient and the
@@ -17,18 +18,19 @@ gravity-gradient regions, nutation damper): ``docs/passive_stability.md``.
 """
 
 from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, ReactionWheel, Thruster, pyramid_wheels
-from tumble.spacecraft.control import BDot, ConstantTorque, MomentumDumping, QuaternionPD, RateDamping
+from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MRPFeedback, PythonLaw, QuaternionPD,
+                                       RateDamping, WheelTorques)
+from tumble.spacecraft.damper import SphericalDamper, simulate_damped
 from tumble.spacecraft.environment import DipoleField
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
-from tumble.spacecraft.model import METHODS, SaturationWarning, Spacecraft, simulate
-from tumble.spacecraft.damper import SphericalDamper, simulate_damped
+from tumble.spacecraft.model import METHODS, SaturationWarning, SingularityWarning, Spacecraft, simulate
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.spacecraft.passive import gravity_gradient_stability, gravity_gradient_stability_figure, spin_stability
 
 __all__ = [
-    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "METHODS", "Magnetorquers", "MomentumDumping", "Orbit",
-    "PWPF", "QuaternionPD", "RateDamping", "ReactionWheel", "SaturationWarning", "Spacecraft", "SphericalDamper",
-    "Thruster", "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure",
-    "lvlh_quaternion", "pyramid_wheels", "save_spacecraft_figure", "simulate", "simulate_damped",
-    "spacecraft_figure", "spin_stability",
+    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "METHODS", "MRPFeedback", "Magnetorquers",
+    "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel",
+    "SaturationWarning", "SingularityWarning", "Spacecraft", "SphericalDamper", "Thruster", "WheelTorques",
+    "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",
+    "pyramid_wheels", "save_spacecraft_figure", "simulate", "simulate_damped", "spacecraft_figure", "spin_stability",
 ]

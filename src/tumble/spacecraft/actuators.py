@@ -2,12 +2,14 @@
 
 Each class is an immutable, validated description in SI units and body axes
 (the spacecraft's reference axes B). :class:`tumble.spacecraft.Spacecraft`
-packs them into the arrays of its compiled model; the equations they enter
-are in :mod:`tumble.spacecraft._kernel` and ``docs/spacecraft.md``.
+compiles them into the programs of its compiled model; the equations they
+enter are in :mod:`tumble.kernels.spacecraft` (one file per actuator) and
+``docs/spacecraft.md``.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -15,6 +17,9 @@ import numpy as np
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import Part
+from tumble.kernels.spacecraft import cmgs as _cmgs
+from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
+from tumble.kernels.spacecraft._base import Program
 
 __all__ = ["ReactionWheel", "CMGCluster", "Thruster", "PWPF", "Magnetorquers", "pyramid_wheels"]
 
@@ -131,8 +136,16 @@ class CMGCluster:
     momentum : (n,) rotor angular momentum, N·m·s
     max_gimbal_rate : rad/s
     robust_gain, robust_decay : λ₀ and μ of the singularity-robust inverse
-        ``A# = Aᵀ (A Aᵀ + λ E)⁻¹``, ``λ = λ₀ exp(−μ det(Ā Āᵀ))`` with ``Ā = A / h`` (Bedrossian,
-        Paradiso & Bergmann, J. Guidance 13(6), 1990; Nakazawa 1988)
+        ``A# = Aᵀ (A Aᵀ + λ E)⁻¹``, ``λ = λ₀ exp(−μ det(Ā Āᵀ)) h̄²`` with ``Ā = A / h̄`` (Bedrossian,
+        Paradiso & Bergmann, J. Guidance 13(6), 1990; Nakazawa 1988), h̄ the largest rotor momentum
+    dither, dither_frequency, dither_phases : ε₀, ω_ε (rad/s) and φ₁, φ₂, φ₃ (rad) of the
+        generalised SR inverse (Wie, Bailey & Heiberg, J. Guidance 24(5), 2001): ``E`` has the
+        off-diagonal terms ``ε_i = ε₀ sin(ω_ε t + φ_i)`` (``E₁₂ = ε₃``, ``E₁₃ = ε₂``, ``E₂₃ = ε₁``),
+        which steer the gimbals out of a singular configuration where the SR inverse (``ε₀ = 0``,
+        the default) leaves them stuck. Wie's values: ε₀ = 0.01, ω_ε = π/2 rad/s, φ = (0, π/2, π)
+        (:meth:`generalised`). ``|ε₀| < 0.5`` keeps ``E`` positive definite.
+
+    The equations are in :mod:`tumble.kernels.spacecraft.cmgs`.
     """
 
     gimbal_axes: np.ndarray
@@ -141,6 +154,9 @@ class CMGCluster:
     max_gimbal_rate: float = 1.0
     robust_gain: float = 0.01
     robust_decay: float = 10.0
+    dither: float = 0.0
+    dither_frequency: float = 0.5 * math.pi
+    dither_phases: tuple = (0.0, 0.5 * math.pi, math.pi)
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -164,6 +180,15 @@ class CMGCluster:
         set_(self, "max_gimbal_rate", require_positive(self.max_gimbal_rate, "max_gimbal_rate"))
         set_(self, "robust_gain", _non_negative(self.robust_gain, "robust_gain"))
         set_(self, "robust_decay", _non_negative(self.robust_decay, "robust_decay"))
+        dither = _non_negative(self.dither, "dither")
+        if dither >= 0.5:
+            raise ValidationError(f"dither: must be < 0.5 (E stays positive definite), got {dither}")
+        set_(self, "dither", dither)
+        set_(self, "dither_frequency", _non_negative(self.dither_frequency, "dither_frequency"))
+        phases = as_array(self.dither_phases, "dither_phases")
+        if phases.shape != (3,) or not np.all(np.isfinite(phases)):
+            raise ValidationError(f"dither_phases: must be 3 finite angles (rad), got {phases.tolist()}")
+        set_(self, "dither_phases", tuple(float(x) for x in phases))
 
     @classmethod
     def pyramid(cls, momentum: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options):
@@ -184,10 +209,21 @@ class CMGCluster:
             s.append([-sn, c, 0.0])
         return cls(np.array(g), np.array(s), np.full(4, require_positive(momentum, "momentum")), **options)
 
+    def generalised(self, dither: float = 0.01, dither_frequency: float = 0.5 * math.pi,
+                    dither_phases=(0.0, 0.5 * math.pi, math.pi)) -> CMGCluster:
+        """The same cluster steered by the generalised singularity-robust inverse, with Wie's dither by default
+        (ε₀ = 0.01, ω_ε = π/2 rad/s, φ = (0, π/2, π); Wie 2008, §7.3)."""
+        return dataclasses.replace(self, dither=dither, dither_frequency=dither_frequency, dither_phases=dither_phases)
+
     @property
     def transverse_axes(self) -> np.ndarray:
         """``g_i × s0_i`` (n, 3): the direction of the gyro torque ``ḣ_i`` at δ = 0."""
         return np.cross(self.gimbal_axes, self.spin_axes)
+
+    def _program(self) -> Program:
+        return _cmgs.program(self.gimbal_axes, self.spin_axes, self.momentum, max_gimbal_rate=self.max_gimbal_rate,
+                             robust_gain=self.robust_gain, robust_decay=self.robust_decay, dither=self.dither,
+                             dither_frequency=self.dither_frequency, dither_phases=self.dither_phases)
 
 
 @dataclass(frozen=True)
@@ -263,6 +299,9 @@ class Magnetorquers:
         if (m <= 0).any():
             raise ValidationError(f"max_dipole: each entry must be > 0 (A·m²), got {m.tolist()}")
         object.__setattr__(self, "max_dipole", m)
+
+    def _program(self) -> Program:
+        return _magnetorquers.program(self.max_dipole)
 
 
 def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options):

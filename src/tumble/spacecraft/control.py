@@ -1,7 +1,9 @@
-"""Attitude control laws: quaternion-feedback PD, rate damping, B-dot, momentum dumping.
+"""Attitude control laws: quaternion-feedback PD, MRP feedback, rate damping, B-dot, momentum dumping,
+wheel motor torques, and any Python function.
 
 A controller is an immutable description; :class:`tumble.spacecraft.Spacecraft`
-turns it into gains for its compiled model. The laws (body axes, SI units):
+compiles it into a program of its compiled model (:mod:`tumble.kernels.spacecraft.laws`).
+The laws (body axes, SI units):
 
 * :class:`QuaternionPD` (Wie, Weiss & Arapostathis, J. Guidance 12(3), 1989;
   rate limit after Wie & Lu, J. Guidance 18(6), 1995)::
@@ -11,6 +13,16 @@ turns it into gains for its compiled model. The laws (body axes, SI units):
 
   with ``K = 2ω_n² J`` and ``C = 2ζω_n J``: linearised about the target, each
   axis obeys ``θ̈ + 2ζω_n θ̇ + ω_n² θ = 0`` (``q_e,v ≈ θ/2``).
+* :class:`MRPFeedback` (Schaub & Junkins, *Analytical Mechanics of Space Systems*,
+  4th ed., 2018, §8; Basilisk's ``mrpFeedback``), regulation to an inertial target::
+
+      σ = MRP of q_e = q_c* ⊗ q (w ≥ 0: the shortest rotation, |σ| ≤ 1)
+      u = −K σ − P ω + ω × H                       (without the integral term)
+      u = −K σ − P (ω + K_I z) + ω × H,  z = K ∫σ dt + J ω   (with it)
+
+  Both are globally stabilising: ``V = ½ ωᵀJω + 2K ln(1 + σᵀσ) (+ ½ K_I zᵀz)``
+  has ``V̇ = −(ω + K_I z)ᵀ P (ω + K_I z)``; the integral term removes the
+  steady error under a constant disturbance torque.
 * :class:`RateDamping`: ``u = −J ω / τ + ω × H``, so ``ω(t) = ω₀ e^{−t/τ}``.
 * :class:`ConstantTorque`: ``u = u₀`` (open loop).
 * :class:`BDot`: magnetic dipole ``m = −k Ḃ`` with ``Ḃ = −ω × B`` (the rate of
@@ -20,23 +32,40 @@ turns it into gains for its compiled model. The laws (body axes, SI units):
 * :class:`MomentumDumping`: ``m = k (h × B)/|B|²`` with ``h`` the wheels'
   momentum in body axes, giving ``τ = −k h_⊥`` (the part of ``h`` normal to
   ``B``) while the attitude law holds the body (Sidi 1997, §7.5).
+* :class:`PythonLaw` (or a plain callable): ``u = law(t, q, omega, wheel_speeds)``,
+  any torque command written in Python; it runs at Python speed (a few
+  microseconds per call, four calls per RK4 step unless the controller is
+  sampled) and a batch with one runs on one core.
+* :class:`WheelTorques`: motor torques commanded to the wheels directly, one
+  per wheel (N·m): a constant, samples in time, or a Python function.
 
-``H`` is the spacecraft's angular momentum in body axes (hub and wheels and
-gyros). ``J`` is the inertia the body rate answers to: the total inertia less
-the wheels' spin inertias (see ``docs/spacecraft.md``).
+``H`` is the spacecraft's angular momentum in body axes (hub, wheels, gyros,
+damper). ``J`` is the inertia the body rate answers to: the total inertia less
+the wheels' spin inertias and the damper sphere (see ``docs/spacecraft.md``).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from tumble import attitude
+from tumble import _callback, attitude
 from tumble._validate import ValidationError, as_array, require_positive
+from tumble.kernels.spacecraft import laws as _laws
+from tumble.kernels.spacecraft._base import Program
+from tumble.spacecraft.actuators import _limit
 
-__all__ = ["QuaternionPD", "RateDamping", "ConstantTorque", "BDot", "MomentumDumping"]
+__all__ = ["QuaternionPD", "MRPFeedback", "RateDamping", "ConstantTorque", "BDot", "MomentumDumping", "PythonLaw",
+           "WheelTorques", "TORQUE_LAWS", "DIPOLE_LAWS"]
+
+
+def _quaternion(value, name: str) -> np.ndarray:
+    q = as_array(value, name, tail=(4,))
+    if q.shape != (4,) or np.linalg.norm(q) == 0.0:
+        raise ValidationError(f"{name}: must be a non-zero quaternion [w, x, y, z], got {q.tolist()}")
+    return attitude.normalize(q)
 
 
 @dataclass(frozen=True)
@@ -58,20 +87,61 @@ class QuaternionPD:
         set_ = object.__setattr__
         set_(self, "natural_frequency", require_positive(self.natural_frequency, "natural_frequency"))
         set_(self, "damping_ratio", require_positive(self.damping_ratio, "damping_ratio"))
-        q = as_array(self.target, "target", tail=(4,))
-        if q.shape != (4,) or np.linalg.norm(q) == 0.0:
-            raise ValidationError(f"target: must be a non-zero quaternion [w, x, y, z], got {q.tolist()}")
-        set_(self, "target", attitude.normalize(q))
+        set_(self, "target", _quaternion(self.target, "target"))
         for name in ("max_rate", "max_torque"):
-            value = float(getattr(self, name))
-            if math.isnan(value) or value <= 0.0:
-                raise ValidationError(f"{name}: must be > 0 (math.inf for no limit), got {value}")
-            set_(self, name, value)
+            set_(self, name, _limit(getattr(self, name), name))
 
     def gains(self, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(K, C)`` = ``(2ω_n² J, 2ζω_n J)`` for the inertia ``J`` (kg·m²)."""
         wn, zeta = self.natural_frequency, self.damping_ratio
         return 2.0 * wn * wn * inertia, 2.0 * zeta * wn * inertia
+
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        k, c = self.gains(rate_inertia)
+        return (_laws.pd_program(c, np.linalg.solve(c, k), self.target, self.max_rate, self.max_torque, 1.0,
+                                 np.zeros(3)),)
+
+
+@dataclass(frozen=True)
+class MRPFeedback:
+    """MRP feedback regulator to the inertial attitude ``target`` (Schaub & Junkins, §8; Basilisk's
+    ``mrpFeedback``): ``u = −K σ − P (ω + K_I z) + ω × H`` (module docstring).
+
+    K : attitude gain, N·m (> 0)
+    P : rate gain, N·m·s: a number (> 0) or a symmetric positive-definite (3, 3) matrix, body axes
+    Ki : integral gain ``K_I``, 1/(N·m·s) (> 0), or None for no integral term; the integral
+        ``∫σ dt`` is a state (``attitude_error_integral``, initial value ``attitude_error_integral0``,
+        default 0), integrated continuously also when the controller is sampled
+    target : commanded attitude, unit quaternion ``[w, x, y, z]``, body → inertial
+
+    ``J`` (in ``z``) and ``H`` are the spacecraft's: the inertia its rate answers to and its
+    angular momentum (hub, wheels, gyros), body axes.
+    """
+
+    K: float
+    P: object
+    Ki: float | None = None
+    target: np.ndarray = (1.0, 0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "K", require_positive(self.K, "K"))
+        p = as_array(self.P, "P")
+        if p.shape == ():
+            p = require_positive(float(p), "P") * np.eye(3)
+        elif p.shape != (3, 3) or not np.allclose(p, p.T, rtol=1e-12, atol=0.0) \
+                or not np.all(np.linalg.eigvalsh(0.5 * (p + p.T)) > 0.0):
+            raise ValidationError(f"P: must be a number > 0 or a symmetric positive-definite (3, 3) matrix "
+                                  f"(N·m·s), got {p.tolist()}")
+        p.setflags(write=False)
+        set_(self, "P", p)
+        if self.Ki is not None:
+            set_(self, "Ki", require_positive(self.Ki, "Ki"))
+        set_(self, "target", _quaternion(self.target, "target"))
+
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        mrp = _laws.mrp_program(self.K, self.P, self.target)
+        return (mrp,) if self.Ki is None else (mrp, _laws.mrp_integral_program(self.Ki))
 
 
 @dataclass(frozen=True)
@@ -83,10 +153,12 @@ class RateDamping:
 
     def __post_init__(self):
         object.__setattr__(self, "time_constant", require_positive(self.time_constant, "time_constant"))
-        value = float(self.max_torque)
-        if math.isnan(value) or value <= 0.0:
-            raise ValidationError(f"max_torque: must be > 0 (math.inf for no limit), got {value}")
-        object.__setattr__(self, "max_torque", value)
+        object.__setattr__(self, "max_torque", _limit(self.max_torque, "max_torque"))
+
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        zero = np.zeros((3, 3))
+        return (_laws.pd_program(rate_inertia / self.time_constant, zero, attitude.identity(), math.inf,
+                                 self.max_torque, 1.0, np.zeros(3)),)
 
 
 @dataclass(frozen=True)
@@ -102,6 +174,10 @@ class ConstantTorque:
             raise ValidationError(f"torque: must have shape (3,), got {u.shape}")
         object.__setattr__(self, "torque", u)
 
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        zero = np.zeros((3, 3))
+        return (_laws.pd_program(zero, zero, attitude.identity(), math.inf, math.inf, 0.0, self.torque),)
+
 
 @dataclass(frozen=True)
 class BDot:
@@ -112,6 +188,9 @@ class BDot:
     def __post_init__(self):
         object.__setattr__(self, "gain", require_positive(self.gain, "gain"))
 
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        return (_laws.gain_program("bdot", self.gain),)
+
 
 @dataclass(frozen=True)
 class MomentumDumping:
@@ -121,3 +200,91 @@ class MomentumDumping:
 
     def __post_init__(self):
         object.__setattr__(self, "gain", require_positive(self.gain, "gain"))
+
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        return (_laws.gain_program("dumping", self.gain),)
+
+
+@dataclass(frozen=True, eq=False)
+class PythonLaw:
+    """A torque command written in Python: ``u = function(t, q, omega, wheel_speeds)``.
+
+    ``t`` (s), ``q`` (unit quaternion, body → inertial), ``omega`` (rad/s, body
+    axes) and ``wheel_speeds`` (rad/s relative to the hub, one per wheel; empty
+    without wheels) are fresh NumPy arrays; it returns the torque command on
+    the hub, 3 numbers (N·m, body axes), delivered by the spacecraft's
+    actuators as a compiled law's is. It is called back from the compiled
+    integrator through :mod:`tumble._callback`: a few microseconds per call,
+    four calls per RK4 step (once per sample with a ``control_period``), and a
+    batch runs on one core. A plain callable given as a controller is wrapped
+    in this class.
+    """
+
+    function: object
+    slot: int = field(init=False, repr=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "slot", _callback.register(
+            self, self.function, field="controller", signature="(t, q, omega, wheel_speeds)",
+            returns="3 finite numbers (torque command, body axes, N·m)"))
+
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        return (_laws.python_program("python_law", self.slot),)
+
+
+@dataclass(frozen=True, eq=False)
+class WheelTorques:
+    """Motor torques commanded to the reaction wheels directly, N·m, one per wheel (in the order of
+    ``Spacecraft.wheels``), added to what a torque law allocates to them, then limited as any motor command.
+
+    torques : (n_w,) a constant; (n_t, n_w) samples at the times ``t`` (s, strictly increasing),
+        interpolated ``"linear"`` or ``"previous"`` (zero-order hold), the end values held outside; or a
+        Python function ``torques(t, q, omega, wheel_speeds) -> (n_w,)`` (Python speed, one core; see
+        :class:`PythonLaw`)
+    """
+
+    torques: object
+    t: object = None
+    interpolation: str = "linear"
+    slot: int | None = field(init=False, repr=False, default=None)
+
+    def __post_init__(self):
+        if self.interpolation not in ("linear", "previous"):
+            raise ValidationError(f"interpolation: must be 'linear' or 'previous', got {self.interpolation!r}")
+        if callable(self.torques):
+            if self.t is not None:
+                raise ValidationError("t: a function of time needs no sample times")
+            object.__setattr__(self, "slot", _callback.register(
+                self, self.torques, field="controller", signature="(t, q, omega, wheel_speeds)",
+                returns="one finite number per wheel (motor torque, N·m)"))
+            return
+        values = as_array(self.torques, "torques")
+        if self.t is None:
+            if values.ndim != 1 or values.size < 1:
+                raise ValidationError(f"torques: a constant is one motor torque per wheel, shape (n_w,), "
+                                      f"got {values.shape}")
+            times, values = np.zeros(1), values[None, :]
+        else:
+            times = as_array(self.t, "t")
+            if times.ndim != 1 or times.size < 1 or np.any(np.diff(times) <= 0.0):
+                raise ValidationError("t: must be a 1-D array of strictly increasing sample times (s)")
+            if values.ndim != 2 or values.shape[0] != times.size:
+                raise ValidationError(f"torques: must have shape (len(t), n_w) = ({times.size}, n_w), "
+                                      f"got {values.shape}")
+        object.__setattr__(self, "t", times)
+        object.__setattr__(self, "torques", values)
+
+    @property
+    def wheels(self) -> int | None:
+        """The number of wheels the samples are for (None for a Python function)."""
+        return None if self.slot is not None else self.torques.shape[1]
+
+    def _programs(self, rate_inertia) -> tuple[Program, ...]:
+        if self.slot is not None:
+            return (_laws.python_program("wheel_python", self.slot),)
+        return (_laws.wheel_table_program(self.t, self.torques, self.interpolation == "previous"),)
+
+
+#: The laws that command a torque on the hub (at most one per spacecraft), and those that command a dipole.
+TORQUE_LAWS = (QuaternionPD, MRPFeedback, RateDamping, ConstantTorque, PythonLaw)
+DIPOLE_LAWS = (BDot, MomentumDumping)

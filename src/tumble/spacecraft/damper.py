@@ -21,10 +21,14 @@ sphere. Without external torque the total angular momentum
 the body ends in the state of least energy for its ``|L|``, a spin about the
 axis of largest moment (the major-axis rule; :mod:`tumble.spacecraft.passive`).
 
-State of the model (:mod:`tumble._protocol` protocol), ``y = [q_w, q_x, q_y,
-q_z, ω₁, ω₂, ω₃, ω_d1, ω_d2, ω_d3]``; results come back as a
-:class:`tumble.Trajectory` with the sphere's rate in
-``extras["damper_omega"]``.
+The damper is a part of :class:`tumble.spacecraft.Spacecraft`
+(``Spacecraft(hub=body, damper=SphericalDamper(J, c))``, or the total inertia
+with the sphere counted as locked to the hub, ``inertia = I + J E``), integrated
+by :func:`tumble.simulate` with the initial sphere rate ``damper_omega0``
+(default: ``omega0``, the sphere turning with the hub); the compiled part is
+:mod:`tumble.kernels.spacecraft.damper`. The trajectory carries the sphere's
+rate in ``extras["damper_omega"]`` and the totals of hub and sphere (plus any
+wheels) in ``traj.energy``, ``traj.momentum_body`` and ``traj.momentum_inertial``.
 
 The nutation time constant of a nearly axisymmetric spinner (spin ``Ω``
 about the symmetry axis, moments ``I_s`` axial and ``I_t`` transverse) by
@@ -39,34 +43,26 @@ axis, ``I_s < I_t``, the Explorer 1 case); ``τ < 0``: it decays (major axis).
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
 
-from tumble import _protocol, _quat, attitude, integrate, torques
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
-from tumble.trajectory import Extra, Trajectory
+from tumble.kernels.spacecraft import damper as _kernel
+from tumble.kernels.spacecraft._base import Program
+from tumble.simulate import simulate
+from tumble.trajectory import Trajectory
 
 __all__ = [
-    "DamperModel",
     "SphericalDamper",
     "energy_sink_time_constant",
     "measured_time_constant",
     "nutation_angle",
     "simulate_damped",
-    "total_energy",
-    "total_momentum_body",
-    "total_momentum_inertial",
 ]
-
-STATE_SIZE = 10
-#: The integration methods that take this model (the splitting and exact methods need a rigid body).
-METHODS = ("dop853", "rk4", "cf4")
 
 
 @dataclass(frozen=True)
@@ -94,215 +90,37 @@ class SphericalDamper:
         return cls(inertia, inertia * abs(float(spin)) * require_positive(axial, "axial")
                    / require_positive(transverse, "transverse"))
 
-
-class DamperModel(NamedTuple):
-    """Compiled parameters of a hub with a spherical damper (one body shared by the batch).
-
-    inertia : (9,) hub inertia, body axes, row-major (kg·m²)
-    inverse : (9,) its inverse
-    damper  : (2,) ``[J, c]``
-    params  : (1, n_p) external torque program in body axes
-    codes   : int64 torque-program codes, or None without external torque
-    """
-
-    inertia: np.ndarray
-    inverse: np.ndarray
-    damper: np.ndarray
-    params: np.ndarray
-    codes: np.ndarray | None
-
-    @property
-    def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
-
-    @property
-    def calls_python(self) -> bool:
-        """True when the torque program calls a Python function (the batch then runs on one core)."""
-        return torques.calls_python(self.codes)
-
-
-def build(body: RigidBody, damper: SphericalDamper, torque=None) -> DamperModel:
-    """The :class:`DamperModel` of ``body`` (the hub, without the sphere) with ``damper`` and an external torque."""
-    model = torques.as_torque_model(torque)
-    if model is not None and model.needs_python:
-        raise ValidationError("torque: a hub with a damper takes compiled torque models only, not a Python function")
-    codes, params = torques.compile_program(model, np.eye(3), offset=0)
-    inertia = np.array(body.inertia, dtype=np.float64)
-    return DamperModel(inertia=inertia.ravel().copy(), inverse=np.linalg.inv(inertia).ravel(),
-                       damper=np.array([damper.inertia, damper.damping]),
-                       params=params[None, :], codes=None if model is None else codes)
-
-
-def _is_damper(model):
-    return _protocol.is_type(model, DamperModel)
-
-
-@overload(_protocol.rhs, inline="always", jit_options={"cache": True})
-def _damper_rhs(model, b0, t, Y, OUT):
-    if not _is_damper(model):
-        return None
-    if isinstance(model.types[4], types.NoneType):
-
-        def torque(model, t, qw, qx, qy, qz, w1, w2, w3):
-            return 0.0, 0.0, 0.0
-
-    else:
-
-        def torque(model, t, qw, qx, qy, qz, w1, w2, w3):
-            return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, model.params, 0, model.codes)
-
-    torque = njit(inline="always")(torque)
-
-    @njit(inline="always")
-    def derivative(model, t, qw, qx, qy, qz, w1, w2, w3, d1, d2, d3):
-        I, K = model.inertia, model.inverse
-        J, c = model.damper[0], model.damper[1]
-        e1, e2, e3 = torque(model, t, qw, qx, qy, qz, w1, w2, w3)
-        s1, s2, s3 = d1 - w1, d2 - w2, d3 - w3  # sphere rate relative to the hub
-        h1 = I[0] * w1 + I[1] * w2 + I[2] * w3
-        h2 = I[3] * w1 + I[4] * w2 + I[5] * w3
-        h3 = I[6] * w1 + I[7] * w2 + I[8] * w3
-        # I ω̇ = τ + c σ − ω × (I ω)
-        r1 = e1 + c * s1 - (w2 * h3 - w3 * h2)
-        r2 = e2 + c * s2 - (w3 * h1 - w1 * h3)
-        r3 = e3 + c * s3 - (w1 * h2 - w2 * h1)
-        a1 = K[0] * r1 + K[1] * r2 + K[2] * r3
-        a2 = K[3] * r1 + K[4] * r2 + K[5] * r3
-        a3 = K[6] * r1 + K[7] * r2 + K[8] * r3
-        # ω̇_d = −(c/J) σ − ω × ω_d
-        k = c / J
-        b1 = -k * s1 - (w2 * d3 - w3 * d2)
-        b2 = -k * s2 - (w3 * d1 - w1 * d3)
-        b3 = -k * s3 - (w1 * d2 - w2 * d1)
-        q = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-        return 0.5 * q[0], 0.5 * q[1], 0.5 * q[2], 0.5 * q[3], a1, a2, a3, b1, b2, b3
-
-    if Y.ndim == 1:
-
-        def impl(model, b0, t, Y, OUT):
-            (OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6], OUT[7], OUT[8], OUT[9]) = derivative(
-                model, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6], Y[7], Y[8], Y[9])
-
-    else:
-
-        def impl(model, b0, t, Y, OUT):
-            for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j], OUT[7, j],
-                 OUT[8, j], OUT[9, j]) = derivative(
-                    model, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j], Y[7, j], Y[8, j],
-                    Y[9, j])
-
-    return impl
-
-
-@overload(_protocol.project, inline="always", jit_options={"cache": True})
-def _damper_project(model, b0, t, Y):
-    if not _is_damper(model):
-        return None
-    return _protocol.quaternion_projection(Y)
-
-
-@overload(_protocol.state_size, jit_options={"cache": True})
-def _damper_state_size(model):
-    if not _is_damper(model):
-        return None
-    return lambda model: STATE_SIZE
-
-
-@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
-def _damper_body_rate(model, Y, j):
-    if not _is_damper(model):
-        return None
-    return _protocol.rate_at(4, Y)
+    def _program(self) -> Program:
+        return _kernel.program(self.inertia, self.damping)
 
 
 def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0, *, t, q0=None, damper_omega0=None,
-                    method: str = "dop853", rtol: float = 1e-10, atol: float = 1e-12, dt: float | None = None,
-                    torque=None, max_steps: int = 10**9,
+                    method: str = "dop853", rtol: float | None = None, atol: float | None = None,
+                    dt: float | None = None, torque=None, max_steps: int | None = None,
                     progress: Callable[[int, int], None] | None = None) -> Trajectory:
-    """Integrate a hub ``body`` with a spherical damper through the output times ``t`` (s).
+    """Deprecated: ``tumble.simulate(Spacecraft(hub=body, damper=damper), omega0, ...)`` (the same run).
 
-    ``omega0`` (3,) or (N, 3): hub rate, rad/s, body axes; ``damper_omega0``:
-    the sphere's rate relative to inertial, body axes (default: ``omega0``,
-    the sphere turning with the hub); ``q0``: body → inertial, scalar first
-    (default identity); ``torque``: an external compiled torque model (body
-    axes). Methods and options as in :func:`tumble.simulate` (``dop853``,
-    ``rk4``, ``cf4``; ``progress(done, total)`` as there). Returns a
-    :class:`tumble.Trajectory` of the hub with ``extras["damper_omega"]``
-    (n, [N,] 3); use :func:`total_momentum_inertial` and
-    :func:`total_energy` for the invariants of hub and sphere together.
+    ``body`` is the hub without the sphere; the result is the trajectory of
+    the spacecraft (hub and sphere: ``traj.energy``, ``traj.momentum_inertial``).
     """
+    warnings.warn("tumble.spacecraft.simulate_damped is deprecated: use tumble.simulate(Spacecraft(hub=body, "
+                  "damper=damper), omega0, damper_omega0=..., ...)", DeprecationWarning, stacklevel=2)
+    from tumble.spacecraft.model import Spacecraft  # the spacecraft builds on this module
+
     if not isinstance(body, RigidBody):
         raise ValidationError(f"body: must be a RigidBody (the hub, without the damper), got {type(body).__name__}")
-    if not isinstance(damper, SphericalDamper):
-        raise ValidationError(f"damper: must be a SphericalDamper, got {type(damper).__name__}")
-    if method not in METHODS:
-        raise ValidationError(f"method: a hub with a damper integrates with one of {', '.join(map(repr, METHODS))} "
-                              f"(the others need a rigid body), got {method!r}")
-    integrate.check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
-    times = as_array(t, "t")
-    if times.ndim != 1 or times.size < 1 or np.any(np.diff(times) <= 0.0):
-        raise ValidationError("t: must be a 1-D array of strictly increasing output times")
-    omega0 = as_array(omega0, "omega0", tail=(3,))
-    if omega0.ndim > 2:
-        raise ValidationError(f"omega0: must have shape (3,) or (N, 3), got {omega0.shape}")
-    batch = omega0.shape[:-1]
-    damper_omega0 = omega0 if damper_omega0 is None else as_array(damper_omega0, "damper_omega0", tail=(3,))
-    q0 = attitude.identity() if q0 is None else as_array(q0, "q0", tail=(4,))
-    if np.any(np.linalg.norm(q0, axis=-1) == 0.0):
-        raise ValidationError("q0: must be a non-zero quaternion [w, x, y, z]")
-    n = omega0.shape[0] if batch else 1
-    y0 = np.empty((n, STATE_SIZE))
-    try:
-        y0[:, :4] = attitude.normalize(np.broadcast_to(q0, (n, 4)))
-        y0[:, 4:7] = omega0
-        y0[:, 7:] = damper_omega0
-    except ValueError:
-        raise ValidationError(f"q0, damper_omega0: must broadcast to the batch of omega0 {omega0.shape}") from None
-    model = build(body, damper, torque)
-    solution = integrate.solve(model, y0, times, method=method, dt=dt, rtol=rtol, atol=atol,
-                                    max_steps=max_steps, progress=progress)
-    states, stats = solution.states, solution.statistics()
-    if not batch:
-        states = states[:, 0]
-    info = {"torque": repr(torques.as_torque_model(torque)) if torque is not None else "none",
-            "damper_inertia": damper.inertia, "damper_damping": damper.damping, **stats}
-    info.update({"rtol": float(rtol), "atol": float(atol)} if method == "dop853" else {"dt": float(dt)})
-    extras = {"damper_omega": Extra(states[..., 7:], ("body_axis",), "rad/s",
-                                    "angular velocity of the damper sphere relative to inertial, body axes")}
-    return Trajectory(t=times, q=states[..., :4], omega=states[..., 4:7], inertia=body.inertia, method=method,
-                      info=info, extras=extras)
+    initial = {name: value for name, value in (("q0", q0), ("damper_omega0", damper_omega0)) if value is not None}
+    return simulate(Spacecraft(hub=body, damper=damper), omega0, t=t, method=method, rtol=rtol, atol=atol, dt=dt,
+                    max_steps=max_steps, torque=torque, progress=progress, **initial)
 
 
-def _damper_rate(traj: Trajectory) -> np.ndarray:
-    if "damper_omega" not in traj.extras:
-        raise ValidationError("traj: has no extras['damper_omega'] (not a simulate_damped result)")
-    return traj.extras["damper_omega"].data
-
-
-def total_momentum_body(traj: Trajectory, damper: SphericalDamper) -> np.ndarray:
-    """``L = I ω + J ω_d`` (N·m·s) in body axes, (n, [N,] 3)."""
-    return traj.momentum_body + damper.inertia * _damper_rate(traj)
-
-
-def total_momentum_inertial(traj: Trajectory, damper: SphericalDamper) -> np.ndarray:
-    """``L_N = R(q) (I ω + J ω_d)`` (N·m·s), inertial axes, (n, [N,] 3): constant without external torque."""
-    return attitude.rotate(traj.q, total_momentum_body(traj, damper))
-
-
-def total_energy(traj: Trajectory, damper: SphericalDamper) -> np.ndarray:
-    """``T = ½ ω·Iω + ½ J |ω_d|²`` (J), (n, [N]): non-increasing without external torque."""
-    w_d = _damper_rate(traj)
-    return traj.energy + 0.5 * damper.inertia * np.sum(w_d * w_d, axis=-1)
-
-
-def nutation_angle(traj: Trajectory, damper: SphericalDamper, axis) -> np.ndarray:
-    """Angle (rad) between the body axis ``axis`` (body axes) and the total angular momentum, (n, [N])."""
+def nutation_angle(traj: Trajectory, axis) -> np.ndarray:
+    """Angle (rad) between the body axis ``axis`` (body axes) and the total angular momentum of the
+    trajectory's system (``traj.momentum_body``: hub, sphere, wheels), (n, [N])."""
     a = as_array(axis, "axis", tail=(3,))
     if a.shape != (3,) or not np.linalg.norm(a) > 0.0:
         raise ValidationError(f"axis: must be a non-zero vector of shape (3,), got {a.tolist()}")
-    L = total_momentum_body(traj, damper)
+    L = traj.momentum_body
     cos = (L @ a) / (np.linalg.norm(L, axis=-1) * np.linalg.norm(a))
     sin = np.linalg.norm(np.cross(L, a), axis=-1) / (np.linalg.norm(L, axis=-1) * np.linalg.norm(a))
     return np.arctan2(sin, cos)

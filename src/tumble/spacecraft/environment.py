@@ -5,7 +5,8 @@ Gravity gradient (:func:`gravity_gradient_torque`, compiled; as a torque model
 
     τ_B = (3 μ / |r|⁵) r_B × (I r_B)      r_B: position in body axes, m
 
-Tilted-dipole geomagnetic field (:func:`dipole_field`, :class:`DipoleField`),
+Tilted-dipole geomagnetic field (:func:`dipole_field`, compiled, in
+:mod:`tumble.kernels.spacecraft.environment`; :class:`DipoleField`),
 in inertial axes, tesla::
 
     B(r) = B₀ (a/|r|)³ [3 (m̂·r̂) r̂ − m̂]
@@ -39,6 +40,7 @@ from numba import njit
 
 from tumble._gravity import gravity_gradient_torque
 from tumble._validate import ValidationError, as_array, require_finite, require_positive
+from tumble.kernels.spacecraft.environment import dipole_field
 
 __all__ = ["DipoleField", "IGRF2020_DIPOLE", "dipole_field", "gravity_gradient_torque"]
 
@@ -111,28 +113,6 @@ class DipoleField:
         out = np.empty((t.size, 3))
         _fields(t.ravel(), np.ascontiguousarray(r.reshape(-1, 3)), self.params(), out)
         return out.reshape((*t.shape, 3))
-
-
-@njit(cache=True)
-def dipole_field(t, rx, ry, rz, params):
-    """Tilted-dipole geomagnetic field ``(Bx, By, Bz)`` (T, inertial axes) at time ``t`` (s) and inertial
-    position ``r`` (m).
-
-    ``B = (B₀a³/|r|³) [3 (m̂·r̂) r̂ − m̂]`` with ``m̂`` turned from Earth-fixed
-    to inertial axes by ``R₃(greenwich_angle + earth_rate·t)``; ``params`` from
-    :meth:`DipoleField.params`.
-    """
-    k = params[0]
-    angle = params[5] + params[4] * t
-    c, s = math.cos(angle), math.sin(angle)
-    mx = c * params[1] - s * params[2]
-    my = s * params[1] + c * params[2]
-    mz = params[3]
-    r_sq = rx * rx + ry * ry + rz * rz
-    r = math.sqrt(r_sq)
-    f = k / (r_sq * r)
-    proj = 3.0 * (mx * rx + my * ry + mz * rz) / r_sq
-    return f * (proj * rx - mx), f * (proj * ry - my), f * (proj * rz - mz)
 
 
 @njit(cache=True)

@@ -50,6 +50,7 @@ from tumble.analytic import classify_axes
 from tumble.body import RigidBody
 from tumble.simulate import simulate
 from tumble.spacecraft import damper as _damper
+from tumble.spacecraft.model import Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.torques import GravityGradient
 from tumble.trajectory import Trajectory, write_atomic
@@ -378,6 +379,10 @@ class Explorer1(NamedTuple):
         """The damper tuned for the initial spin (:meth:`SphericalDamper.tuned`)."""
         return _damper.SphericalDamper.tuned(self.damper_inertia, *self.locked_moments(), self.spin)
 
+    def spacecraft(self) -> Spacecraft:
+        """The hub with its damper, a model of :func:`tumble.simulate`."""
+        return Spacecraft(hub=self.hub(), damper=self.damper())
+
     def omega0(self) -> np.ndarray:
         """Body rate (rad/s) with spin ``spin`` and nutation angle ``nutation0`` between L and the z axis."""
         i_s, i_t = self.locked_moments()
@@ -396,9 +401,9 @@ def explorer1_figure(traj: Trajectory, spacecraft: Explorer1 = EXPLORER1) -> Fig
     dm = spacecraft.damper()
     i_s, i_t = spacecraft.locked_moments()
     tau = _damper.energy_sink_time_constant(i_s, i_t, dm, spacecraft.spin)
-    theta = _damper.nutation_angle(traj, dm, [0.0, 0.0, 1.0])
-    energy = _damper.total_energy(traj, dm)
-    momentum = np.linalg.norm(_damper.total_momentum_body(traj, dm)[0])
+    theta = _damper.nutation_angle(traj, [0.0, 0.0, 1.0])
+    energy = traj.energy
+    momentum = np.linalg.norm(traj.momentum_body[0])
     minutes = traj.t / 60.0
 
     fig = Figure(figsize=(7.5, 8.0), layout="constrained")
@@ -432,7 +437,7 @@ def explorer1_figure(traj: Trajectory, spacecraft: Explorer1 = EXPLORER1) -> Fig
 def demo_explorer1(out_dir, spacecraft: Explorer1 = EXPLORER1) -> dict:
     """Simulate the Explorer 1 flat spin and compare its nutation time constant with the energy-sink estimate.
 
-    Integrates hub + damper (:func:`tumble.spacecraft.damper.simulate_damped`,
+    Integrates hub + damper (:meth:`Explorer1.spacecraft` through :func:`tumble.simulate`,
     dop853, rtol 1e-12) for ``spacecraft.duration`` s, writes
     ``explorer1.nc`` and ``explorer1.png`` in ``out_dir`` atomically, and
     returns: the time constant measured (fit of ln θ for θ between 2θ₀ and
@@ -444,13 +449,13 @@ def demo_explorer1(out_dir, spacecraft: Explorer1 = EXPLORER1) -> dict:
     _check_dir(out_dir)
     dm = spacecraft.damper()
     t = np.linspace(0.0, spacecraft.duration, int(round(spacecraft.duration * 2)) + 1)
-    traj = _damper.simulate_damped(spacecraft.hub(), dm, spacecraft.omega0(), t=t, rtol=1e-12, atol=1e-12)
-    theta = _damper.nutation_angle(traj, dm, [0.0, 0.0, 1.0])
+    traj = simulate(spacecraft.spacecraft(), spacecraft.omega0(), t=t, rtol=1e-12, atol=1e-12)
+    theta = _damper.nutation_angle(traj, [0.0, 0.0, 1.0])
     i_s, i_t = spacecraft.locked_moments()
-    momentum = _damper.total_momentum_inertial(traj, dm)
+    momentum = traj.momentum_inertial
     size = np.linalg.norm(momentum, axis=-1)
-    energy = _damper.total_energy(traj, dm)
-    final_axis = _damper.total_momentum_body(traj, dm)[-1] / size[-1]
+    energy = traj.energy
+    final_axis = traj.momentum_body[-1] / size[-1]
     paths = {"nc": os.path.join(out_dir, "explorer1.nc"), "png": os.path.join(out_dir, "explorer1.png")}
     traj.save(paths["nc"])
     _save_png(explorer1_figure(traj, spacecraft), paths["png"])

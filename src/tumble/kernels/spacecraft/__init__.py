@@ -1,0 +1,235 @@
+"""The spacecraft as a compiled model (see :mod:`tumble._protocol`): a rigid hub and the parts it carries.
+
+A spacecraft is assembled from *parts*, each a program of one kind of
+:data:`PARTS` — an actuator (one file each: :mod:`.wheels`, :mod:`.cmgs`,
+:mod:`.thrusters`, :mod:`.magnetorquers`, :mod:`.damper`), a control law
+(:mod:`.laws`), a piece of the environment (:mod:`.environment`) or the
+zero-order hold of a sampled controller — made of a parameter block in the one
+flat array ``data``, a slice of the state vector and a slice of the
+diagnostics, all at named offsets. :class:`SpacecraftModel` records which
+kinds are present in its *type* (a field per kind, None when absent), so that
+Numba compiles each combination on its own and a part the spacecraft lacks
+costs nothing.
+
+State vector::
+
+    [q (4), ω (3), then each present part's state slice, in the order of PARTS]
+
+``q`` body → inertial; ``ω`` the hub's rate relative to inertial, rad/s, body
+axes. Equations (body axes; Hughes, *Spacecraft Attitude Dynamics*, §7.2;
+Markley & Crassidis 2014, §3.3.5)::
+
+    J_ω ω̇ = τ_ext + Σ τ_k − ω × H,      H = J_ω ω + Σ h_k,      q̇ = ½ q ⊗ [0, ω]
+
+where ``J_ω`` is the inertia the hub's rate answers to (the total ``J``, every
+rotor counted as a rigid part, less the inertias the parts carry in their own
+states: the wheels' spin inertias, the damper sphere), ``h_k`` the angular
+momentum part ``k`` carries and ``τ_k`` the torque it exerts on the hub
+(``−dh_k/dt`` seen from the hub for internal parts; thrusters and
+magnetorquers exert external torques), and ``τ_ext`` the environment's
+gravity gradient plus the external torque program of ``torque=``
+(:mod:`tumble.torques`). The controller's commands — torque ``u_c`` (N·m),
+dipole ``m_c`` (A·m²), motor torques of the wheels — are evaluated in the
+right-hand side (continuous control) or, with a ``"hold"`` part, at the
+sample times ``t₀ + k·period`` in :func:`tumble._protocol.project` and held
+in the state (zero-order hold). The torque command goes to the actuator
+``route`` (a kind index of :data:`PARTS`; −1: none).
+
+The diagnostics of one sample (:func:`evaluate`) start with the core block
+(``AUX_*``), then each part's.
+
+Inside: :mod:`._layout` says where things are (the kinds, the hub block, the
+core diagnostics, each part's packed place), :mod:`._base` what every part
+shares (state access, the :class:`~._base.Actuator` interface),
+:mod:`._commands` assembles the controller and :mod:`._assembly` the
+right-hand side, when Numba compiles a model type.
+"""
+
+from __future__ import annotations
+
+import collections
+
+import numpy as np
+from numba import njit
+from numba.extending import overload
+
+from tumble import _protocol, torques
+from tumble.kernels.spacecraft._assembly import assemble as _assemble
+from tumble.kernels.spacecraft._base import SAMPLE_TOLERANCE, Program, inline
+from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_CORE, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL,
+                                               AUX_FIELD, AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND,
+                                               HELD_WHEELS, HUB_SIZE, PARTS, PERIOD, START, Slices, pack, unpack)
+
+__all__ = ["AUX_ACTUATOR", "AUX_DIPOLE_COMMAND", "AUX_ENERGY", "AUX_EXTERNAL", "AUX_FIELD", "AUX_GRAVITY",
+           "AUX_MOMENTUM", "AUX_TORQUE_COMMAND", "HELD_WHEELS", "PARTS", "Program", "Slices", "SpacecraftModel",
+           "assemble", "evaluate", "initialise", "slices"]
+
+#: Kinds that call Python functions (the batch then runs on one core).
+_PYTHON = ("python_law", "wheel_python")
+
+
+class SpacecraftModel(collections.namedtuple(
+        "SpacecraftModel", ("data", "route", "size", "aux_size", "torque_params", "torque_codes") + PARTS)):
+    """Compiled parameters of a spacecraft (shared by every member of a batch).
+
+    data        : float64 parameters: the hub block (``J``, ``J_RATE``, ``J_RATE_INV``,
+                  ``PERIOD``, ``START``), then each present part's block
+    route       : the kind index of the actuator that delivers the torque command, or −1
+    size        : length of the state vector
+    aux_size    : length of the diagnostics of one sample
+    torque_params, torque_codes : the program of ``torque=`` (:func:`tumble.torques.compile_program`
+                  in body axes, params (1, n)), or None
+
+    then one field per kind of :data:`PARTS`: None when the spacecraft has no such part, else where the part
+    is, ``(p, n, s, a)`` (:class:`Slices`) packed into one int64 (:func:`pack`). So the set of parts is in the
+    Numba type, and the layout travels as scalars (the parallel drivers take no tuples; an array of offsets
+    would be read from memory at every evaluation, 8 % of the RK4 step of four wheels and a PD law).
+    """
+
+    __slots__ = ()
+
+    @property
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when a control law or the torque program calls a Python function (the batch then runs on one core)."""
+        return any(getattr(self, kind) is not None for kind in _PYTHON) or torques.calls_python(self.torque_codes)
+
+
+def assemble(inertia, rate_inertia, period: float, t0: float, programs, route: str | None,
+             torque=None) -> SpacecraftModel:
+    """The :class:`SpacecraftModel` of a hub (total inertia ``J`` and ``J_ω``, kg·m², body axes) with the parts
+    ``programs`` (:class:`~tumble.kernels.spacecraft._base.Program`, at most one of each kind), a control
+    ``period`` (s; 0: continuous) whose clock starts at ``t0`` (s), the actuator ``route`` that delivers the
+    torque command (a kind, or None) and an external torque model (:mod:`tumble.torques`, or None)."""
+    by_kind = {p.kind: p for p in programs}
+    if len(by_kind) != len(programs) or not set(by_kind) <= set(PARTS):
+        raise ValueError(f"programs: one of each kind of {PARTS}, got {[p.kind for p in programs]}")
+    blocks = [np.ravel(inertia), np.ravel(rate_inertia), np.ravel(np.linalg.inv(rate_inertia)), [period, t0]]
+    p, s, a = HUB_SIZE, 7, AUX_CORE
+    layout = {}
+    for kind in PARTS:
+        if kind in by_kind:
+            part = by_kind[kind]
+            layout[kind] = pack(Slices(p, part.count, s, a))
+            blocks.append(np.ravel(part.params))
+            p, s, a = p + part.params.size, s + part.state, a + part.aux
+    codes, params = None, None
+    if torque is not None:
+        codes, block = torques.compile_program(torque, np.eye(3), offset=0)
+        params = np.ascontiguousarray(block[None, :])
+    return SpacecraftModel(
+        data=np.ascontiguousarray(np.concatenate([np.asarray(b, dtype=np.float64) for b in blocks])),
+        route=-1 if route is None else PARTS.index(route), size=s, aux_size=a, torque_params=params,
+        torque_codes=codes, **{kind: layout.get(kind) for kind in PARTS})
+
+
+def slices(model: SpacecraftModel, kind: str) -> Slices | None:
+    """Where the part of ``kind`` is in ``model`` (:class:`Slices`), or None when it has none."""
+    value = getattr(model, kind)
+    return None if value is None else unpack(value)
+
+
+def _is_spacecraft(model):
+    return _protocol.is_type(model, SpacecraftModel)
+
+
+# Not inline="always": Numba's overload inliner (0.68) loses the loop accumulators of the parts
+# (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
+@overload(_protocol.rhs, jit_options={"cache": True})
+def _spacecraft_rhs(model, b0, t, Y, OUT):
+    if not _is_spacecraft(model):
+        return None
+    derivative, _, _ = _assemble(model, Y.ndim)
+    if Y.ndim == 1:
+        def impl(model, b0, t, Y, OUT):
+            derivative(model, t, Y, 0, OUT, Y, False)
+    else:
+        def impl(model, b0, t, Y, OUT):
+            for j in range(Y.shape[1]):
+                derivative(model, t, Y, j, OUT, Y, False)
+    return impl
+
+
+@overload(_protocol.project, jit_options={"cache": True})
+def _spacecraft_project(model, b0, t, Y):
+    if not _is_spacecraft(model):
+        return None
+    _, sample, discrete = _assemble(model, Y.ndim)
+    if Y.ndim == 1:
+        normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
+    else:
+        normalize, lanes = _protocol.normalize_quaternions, inline(lambda Y: Y.shape[1])
+    if discrete == "hold":
+        def impl(model, b0, t, Y):
+            normalize(Y)
+            period, start = model.data[PERIOD], model.data[START]
+            k = round((t - start) / period)
+            if abs(t - start - k * period) <= SAMPLE_TOLERANCE * period:
+                for j in range(lanes(Y)):
+                    sample(model, t, Y, j)
+    elif discrete == "step":
+        def impl(model, b0, t, Y):
+            normalize(Y)
+            for j in range(lanes(Y)):
+                sample(model, t, Y, j)
+    else:
+        def impl(model, b0, t, Y):
+            normalize(Y)
+    return impl
+
+
+@overload(_protocol.state_size, jit_options={"cache": True})
+def _spacecraft_state_size(model):
+    if not _is_spacecraft(model):
+        return None
+    return lambda model: model.size
+
+
+@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
+def _spacecraft_body_rate(model, Y, j):
+    if not _is_spacecraft(model):
+        return None
+    return _protocol.rate_at(4, Y)
+
+
+def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload in compiled code
+    raise NotImplementedError
+
+
+@overload(_evaluate, jit_options={"cache": True})
+def _evaluate_overload(model, t, y, aux):
+    derivative, _, _ = _assemble(model, 1)
+
+    def impl(model, t, y, aux):
+        out = np.empty(y.shape[1])
+        for k in range(y.shape[0]):
+            derivative(model, t[k], y[k], 0, out, aux[k], True)
+
+    return impl
+
+
+def _sample(model, t, y):  # pragma: no cover - replaced by the overload in compiled code
+    raise NotImplementedError
+
+
+@overload(_sample, jit_options={"cache": True})
+def _sample_overload(model, t, y):
+    _, sample, _ = _assemble(model, 1)
+    return lambda model, t, y: sample(model, t, y, 0)
+
+
+@njit(cache=True)
+def evaluate(model, t, y, aux):
+    """Diagnostics of the samples ``y`` (n, state) at the times ``t`` (n,) into ``aux`` (n, ``model.aux_size``)."""
+    _evaluate(model, t, y, aux)
+
+
+@njit(cache=True)
+def initialise(model, t, y):
+    """Apply the discrete updates of the start time ``t`` (s) to the state vector ``y``: the commands held
+    from the first sample, the PWPF triggers."""
+    _sample(model, t, y)

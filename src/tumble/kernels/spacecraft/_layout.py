@@ -1,0 +1,105 @@
+"""Where things are in the compiled spacecraft: the kinds of part, the hub block, the core diagnostics, and
+each part's place ``(p, n, s, a)`` packed into one field of the model (see :mod:`tumble.kernels.spacecraft`)."""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+from numba import types
+
+from tumble._validate import ValidationError
+from tumble.kernels.spacecraft._base import inline
+
+#: The kinds of part, in the order of their state slices.
+PARTS = ("hold", "wheels", "cmgs", "thrusters", "magnetorquers", "damper", "pd", "mrp", "mrp_integral",
+         "python_law", "bdot", "dumping", "wheel_table", "wheel_python", "dipole_field", "uniform_field",
+         "gravity_gradient")
+
+# The hub's block at the start of data:
+J = 0              # J (9), total inertia about the centre of mass, kg·m², row-major
+J_RATE = 9         # J_ω (9)
+J_RATE_INV = 18    # J_ω⁻¹ (9)
+PERIOD = 27        # control period, s (0: continuous)
+START = 28         # the control clock's start t₀, s
+HUB_SIZE = 29
+
+# The "hold" part's state: u_c (3), m_c (3), then one motor torque per wheel when a wheel-torque law is present.
+HELD_TORQUE, HELD_DIPOLE, HELD_WHEELS = 0, 3, 6
+
+# The core block of the diagnostics:
+AUX_ENERGY = 0            # kinetic energy of hub and parts, J (1)
+AUX_MOMENTUM = 1          # H, N·m·s, body axes (3)
+AUX_TORQUE_COMMAND = 4    # u_c, N·m (3)
+AUX_DIPOLE_COMMAND = 7    # m_c before the limits, A·m² (3)
+AUX_FIELD = 10            # B, T, body axes (3)
+AUX_GRAVITY = 13          # gravity-gradient torque, N·m (3)
+AUX_ACTUATOR = 16         # Σ τ_k, N·m (3)
+AUX_EXTERNAL = 19         # the torque program of torque=, N·m (3)
+AUX_CORE = 22
+
+
+class Slices(NamedTuple):
+    """Where one part is in a compiled model: parameter offset, count, state offset, diagnostics offset."""
+
+    p: int
+    n: int
+    s: int
+    a: int
+
+
+# The bits of a packed Slices: p in bits 0–30, n in 31–40, s in 41–51, a in 52–62 (the sign bit stays clear).
+_BITS = ((0, 31), (31, 10), (41, 11), (52, 11))
+
+
+def pack(where: Slices) -> int:
+    """``(p, n, s, a)`` as one int64 (the field of a part in ``SpacecraftModel``); each must fit its bits."""
+    value = 0
+    for (shift, bits), x, name in zip(_BITS, where, Slices._fields):
+        if not 0 <= x < 1 << bits:
+            raise ValidationError(f"{name}: a part of a spacecraft needs 0 <= {name} < 2**{bits} (its offsets and "
+                                  f"count), got {x}")
+        value |= x << shift
+    return value
+
+
+def unpack(value: int) -> Slices:
+    """The :class:`Slices` of a packed int64."""
+    return Slices(*((value >> shift) & ((1 << bits) - 1) for shift, bits in _BITS))
+
+
+def present(model) -> dict[str, bool]:
+    """The kinds present in the Numba type ``model`` of a SpacecraftModel (their fields not None)."""
+    return {kind: not isinstance(model.types[model.fields.index(kind)], types.NoneType) for kind in PARTS}
+
+
+def locator(has: dict, kind: str):
+    """A compiled ``where(L) -> (p, n, s, a)`` of the part ``kind`` in the layout ``L`` of :func:`loader`."""
+    k = 4 * sum(has[other] for other in PARTS[:PARTS.index(kind)])
+
+    @inline
+    def where(L):
+        return L[k], L[k + 1], L[k + 2], L[k + 3]
+
+    return where
+
+
+def loader(model):
+    """A compiled ``load(model) -> L``: ``(p, n, s, a)`` of every part present in the Numba type ``model``,
+    unpacked into one flat tuple (once per evaluation; :func:`locator` then indexes it with constants)."""
+    load = inline(lambda model: ())
+    for kind, here in present(model).items():
+        if here:
+            load = _load_part(load, model.fields.index(kind))
+    return load
+
+
+def _load_part(previous, field):
+    (_, b0), (s1, b1), (s2, b2), (s3, b3) = _BITS
+    m0, m1, m2, m3 = (1 << b0) - 1, (1 << b1) - 1, (1 << b2) - 1, (1 << b3) - 1
+
+    @inline
+    def load(model):
+        v = model[field]
+        return previous(model) + (v & m0, (v >> s1) & m1, (v >> s2) & m2, (v >> s3) & m3)
+
+    return load
