@@ -256,6 +256,23 @@ def test_run_dispatches_a_spacecraft_scenario(tmp_path):
     assert f"peak speed {peak:.4g} rad/s" in result.stdout
 
 
+def test_run_writes_the_mrp_disturbance_example_and_its_figure(tmp_path):
+    # The command line of the example's header: exit 0, the trajectory (with the MRP integral term and the
+    # disturbance torque of its [[torque]] table) and the spacecraft figure written, nothing else left.
+    scenario = EXAMPLES / "spacecraft" / "mrp_disturbance.toml"
+    out, png = tmp_path / "out.nc", tmp_path / "out.png"
+    result = invoke("run", scenario, "-o", out, "--plot", png)
+    assert result.exit_code == 0, result.output
+    assert png.read_bytes()[:8] == PNG_MAGIC
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.nc", "out.png"]
+    saved, traj = tumble.load(out), run_scenario(scenario)
+    np.testing.assert_array_equal(saved.q, traj.q)
+    np.testing.assert_array_equal(saved.extras["attitude_error_integral"].data, traj.attitude_error_integral)
+    np.testing.assert_array_equal(saved.extras["external_torque"].data[-1], [0.005, -0.003, 0.002])
+    for label, value in load_scenario(scenario).rows(traj):
+        assert f"{label} {value}" in " ".join(result.stdout.split())
+
+
 @pytest.mark.parametrize("scenario", [EXAMPLES / "symmetric_top.toml", EXAMPLES / "spacecraft" / "slew_wheels.toml"],
                          ids=lambda p: p.stem)
 def test_run_parses_the_file_once(tmp_path, monkeypatch, scenario):

@@ -20,6 +20,8 @@ from tumble.ins.demo import DEMO_GYRO
 from tumble.scenario import ScenarioError, load, parse
 from tumble.variable import Human, Motion, VariableBody, diver
 
+from helpers import assert_same_run
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -84,22 +86,6 @@ def same_model_in_python(name: str):
         return robot.load(EXAMPLES / "robots" / "panda.urdf"), dict(t=np.linspace(0.0, 2.0, 401), q0=PANDA_Q0,
                                                                      method="dop853", rtol=1e-12, atol=1e-12)
     raise AssertionError(name)
-
-
-def assert_same_run(traj, reference):
-    """Every sampled array of the two trajectories is the same, bit for bit."""
-    np.testing.assert_array_equal(traj.t, reference.t)
-    for name in ("q", "omega", "inertia"):
-        a, b = getattr(traj, name), getattr(reference, name)
-        assert (a is None) == (b is None), name
-        if a is not None:
-            np.testing.assert_array_equal(a, b, err_msg=name)
-    assert traj.extras.keys() == reference.extras.keys() and traj.totals.keys() == reference.totals.keys()
-    for name in traj.extras:
-        np.testing.assert_array_equal(traj.extras[name].data, reference.extras[name].data, err_msg=name)
-    for name in traj.totals:
-        np.testing.assert_array_equal(traj.totals[name], reference.totals[name], err_msg=name)
-    assert traj.method == reference.method and traj.model == reference.model
 
 
 @pytest.fixture(scope="module")

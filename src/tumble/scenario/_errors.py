@@ -20,7 +20,7 @@ from contextlib import contextmanager
 from typing import get_args
 
 from tumble._validate import ValidationError
-from tumble.scenario._values import _Table
+from tumble.scenario._values import SHAPE_TAGS, _Table
 
 __all__ = ["ScenarioError"]
 
@@ -147,12 +147,15 @@ def _locate(loc: tuple, root: type[_Table]) -> tuple[list, type[_Table] | None]:
     """Split a pydantic error location into the file's key path and the table holding its last key.
 
     Locations include the tags of union members (``"_Shape"``, ``"box"``,
-    ``"tabulated"``, ``"quaternion_pd"``, ``"gimbal"``: see :func:`_tags`), which are not keys of the file.
+    ``"tabulated"``, ``"quaternion_pd"``, ``"gimbal"``: see :func:`_tags`; the form of a value,
+    :data:`~tumble.scenario._values.SHAPE_TAGS`), which are not keys of the file.
     """
     path, candidates, table = [], [root], None
     for part in loc:
         if isinstance(part, int):  # an index into an array
             path.append(part)
+            continue
+        if part in SHAPE_TAGS:  # the form of a value: a number or an array, an array or rows
             continue
         tagged = [cls for cls in candidates if part in _tags(cls)]
         if tagged:  # a union tag narrows down the table

@@ -6,9 +6,9 @@ and finite (``nan`` and ``inf`` are refused) unless a type says otherwise.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, ClassVar, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag
 
 _Number = Annotated[float, Field(strict=True, allow_inf_nan=False)]  # a TOML integer is accepted too
 _Positive = Annotated[_Number, Field(gt=0.0)]
@@ -19,6 +19,22 @@ _Quaternion = Annotated[list[_Number], Field(min_length=4, max_length=4)]
 _Bool = Annotated[bool, Field(strict=True)]
 _Text = Annotated[str, Field(strict=True)]
 _Axis = Literal["x", "y", "z"]
+
+#: The tags of :func:`_flat_or_rows`: not keys of a file (an error's key path leaves them out).
+SHAPE_TAGS = ("<flat>", "<rows>")
+
+
+def _shape_of(value) -> str:
+    """``"<rows>"`` for an array whose first entry is an array, else ``"<flat>"``."""
+    return SHAPE_TAGS[isinstance(value, list) and bool(value) and isinstance(value[0], list)]
+
+
+def _flat_or_rows(flat, rows):
+    """A value written either as ``flat`` (a number, or an array of numbers) or as ``rows`` (an array of
+    arrays), chosen by what the file wrote, so that a bad value gets the one rule of the form it meant
+    (a gain that is a number or a matrix; one torque per wheel, or a row of them per time)."""
+    return Annotated[Union[Annotated[flat, Tag(SHAPE_TAGS[0])], Annotated[rows, Tag(SHAPE_TAGS[1])]],
+                     Discriminator(_shape_of)]
 
 
 class _Table(BaseModel):

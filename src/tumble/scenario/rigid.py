@@ -19,7 +19,8 @@ from tumble import torques
 from tumble.body import RigidBody
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import in_file, keyed
-from tumble.scenario._values import _Positive, _Table, _Vector
+from tumble.scenario._values import _Vector
+from tumble.scenario.damper import SphericalDamperTable
 from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import Torque, build_torque
 from tumble.simulate import simulate
@@ -29,16 +30,12 @@ from tumble.trajectory import Trajectory
 __all__ = ["DamperTable", "Problem", "RigidScenario"]
 
 
-class DamperTable(_Table):
-    """A spherical viscous nutation damper in the body (:mod:`tumble.spacecraft.damper`): sphere ``inertia``
-    J (kg m²), ``damping`` c (N m s), initial sphere rate ``omega`` (rad/s, body axes; default: the body's)."""
+class DamperTable(SphericalDamperTable):
+    """``[damper]``: a spherical viscous nutation damper in the body (:mod:`tumble.scenario.damper`): sphere
+    ``inertia`` J (kg m²), ``damping`` c (N m s), initial sphere rate ``omega`` (rad/s, body axes; default:
+    the body's)."""
 
-    inertia: _Positive
-    damping: _Positive
     omega: _Vector | None = None
-
-    def build(self) -> SphericalDamper:
-        return SphericalDamper(self.inertia, self.damping)
 
 
 # Where the arguments of a run come from in the file (those of the tables' own builds aside).

@@ -31,34 +31,41 @@ orbit in degrees)::
     dt = 0.1
 
 The tables and keys are the arguments of :class:`tumble.spacecraft.Spacecraft`
-and of its parts (``docs/spacecraft.md`` lists them); ``[initial]``,
-``[time]``, ``[solver]`` and ``[spacecraft.orbit]`` are the shared tables
-(:mod:`tumble.scenario.tables`, :mod:`tumble.scenario.orbit`).
+and of its parts (``docs/spacecraft.md`` lists them): actuators, a nutation
+damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment,
+and the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`).
+``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
+external torques ``[[torque]]`` (``torque=`` of :func:`tumble.simulate`, on
+top of the spacecraft's own environment) are the shared tables
+(:mod:`tumble.scenario.tables`, :mod:`tumble.scenario.orbit`,
+:mod:`tumble.scenario.torques`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from dataclasses import dataclass
-from typing import Annotated, ClassVar, Literal, Union
+from typing import Annotated, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
 
+from tumble import attitude
 from tumble.body import RigidBody
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError, in_file, keyed
-from tumble.scenario._values import _Bool, _Limit, _Matrix, _Number, _Positive, _Quaternion, _Table, _Vector
+from tumble.scenario._run import RUN_KEYS, Run
+from tumble.scenario._values import _Bool, _Limit, _Matrix, _Number, _Positive, _Table, _Vector
+from tumble.scenario.control import Controller, Regulator
+from tumble.scenario.damper import SphericalDamperTable
 from tumble.scenario.orbit import OrbitTable
-from tumble.scenario.tables import EulerAngles, Initial, Solver, Time
-from tumble.simulate import simulate
-from tumble.spacecraft import actuators, control
+from tumble.scenario.tables import Initial, Solver, Time
+from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
+from tumble.spacecraft import actuators
 from tumble.spacecraft.environment import DipoleField
 from tumble.spacecraft.model import METHODS, Spacecraft
 from tumble.trajectory import Trajectory
 
-__all__ = ["SpacecraftProblem", "SpacecraftScenario"]
+__all__ = ["SpacecraftScenario"]
 
 _MAGIC_SKEW = math.degrees(math.atan(math.sqrt(2.0)))  # deg: the pyramid whose four axes are equally spaced
 
@@ -126,14 +133,34 @@ class HubTable(_Table):
 
 
 class CMGPyramid(_Table):
+    """Four CMGs in a pyramid (:meth:`tumble.spacecraft.CMGCluster.pyramid`), steered by the
+    singularity-robust inverse (``steering = "singularity_robust"``, the default) or by the generalised one
+    (``steering = "generalised"``: :meth:`~tumble.spacecraft.CMGCluster.generalised`, whose dither ``dither``
+    ε₀, ``dither_frequency`` ω_ε (rad/s) and ``dither_phases`` φ (rad) default to Wie's 0.01, π/2, (0, π/2, π))."""
+
     momentum: _Positive
     skew: _Positive = _MAGIC_SKEW
     max_gimbal_rate: _Positive = 1.0
     robust_gain: _Number = 0.01
     robust_decay: _Number = 10.0
+    steering: Literal["singularity_robust", "generalised"] = "singularity_robust"
+    dither: _Number | None = None
+    dither_frequency: _Number | None = None
+    dither_phases: _Vector | None = None
+
+    @field_validator("dither", "dither_frequency", "dither_phases")
+    @classmethod
+    def _generalised_only(cls, value, info):
+        if value is not None and info.data.get("steering") == "singularity_robust":
+            raise ValueError('only with steering = "generalised" (the dither of the generalised SR inverse)')
+        return value
 
     def build(self):
-        return actuators.CMGCluster.pyramid(**self.model_dump())
+        dither = {"dither", "dither_frequency", "dither_phases"}
+        cluster = actuators.CMGCluster.pyramid(**self.model_dump(exclude={"steering", *dither}))
+        if self.steering == "singularity_robust":
+            return cluster
+        return cluster.generalised(**self.model_dump(include=dither, exclude_none=True))
 
 
 class ThrusterTable(_Table):
@@ -179,65 +206,6 @@ class FieldTable(_Table):
         return DipoleField() if self.model == "dipole" else np.array(self.uniform)
 
 
-class PDTable(_Table):
-    kind: Literal["quaternion_pd"]
-    natural_frequency: _Positive
-    damping_ratio: _Positive = 1.0 / math.sqrt(2.0)
-    target: _Quaternion | None = None
-    target_euler: EulerAngles | None = None
-    max_rate: _Limit = math.inf
-    max_torque: _Limit = math.inf
-
-    def argument_keys(self, prefix: str) -> dict[str, str]:
-        keys = super().argument_keys(prefix)
-        if self.target_euler is not None:
-            keys.update(self.target_euler.argument_keys(f"{prefix}.target_euler"))
-        return keys
-
-    def build(self):
-        target = (self.target_euler.quaternion() if self.target_euler is not None
-                  else (1.0, 0.0, 0.0, 0.0) if self.target is None else self.target)
-        return control.QuaternionPD(self.natural_frequency, self.damping_ratio, target=target,
-                                    max_rate=self.max_rate, max_torque=self.max_torque)
-
-
-class RateDampingTable(_Table):
-    kind: Literal["rate_damping"]
-    time_constant: _Positive
-    max_torque: _Limit = math.inf
-
-    def build(self):
-        return control.RateDamping(self.time_constant, self.max_torque)
-
-
-class ConstantTorqueTable(_Table):
-    kind: Literal["constant_torque"]
-    torque: _Vector
-
-    def build(self):
-        return control.ConstantTorque(self.torque)
-
-
-class BDotTable(_Table):
-    kind: Literal["bdot"]
-    gain: _Positive
-
-    def build(self):
-        return control.BDot(self.gain)
-
-
-class DumpingTable(_Table):
-    kind: Literal["momentum_dumping"]
-    gain: _Positive
-
-    def build(self):
-        return control.MomentumDumping(self.gain)
-
-
-_Controller = Annotated[Union[PDTable, RateDampingTable, ConstantTorqueTable, BDotTable, DumpingTable],
-                        Field(discriminator="kind")]
-
-
 def _built(table: _Table, key: str):
     """``table.build()``, a refusal by the library reported against the key behind the argument."""
     with keyed(table.argument_keys(key), key):
@@ -246,8 +214,8 @@ def _built(table: _Table, key: str):
 
 class SpacecraftTable(_Table):
     """``[spacecraft]``: mass properties (``inertia`` or ``moments``: the total, wheels included; or a
-    ``hub`` table: the hub without the wheels, which then need mass properties), actuators, environment
-    and controllers."""
+    ``hub`` table: the hub without the wheels and the damper sphere, the wheels then needing mass properties),
+    actuators, a nutation ``damper``, environment and controllers."""
 
     inertia: _Matrix | None = None
     moments: _Vector | None = None
@@ -258,10 +226,11 @@ class SpacecraftTable(_Table):
     thrusters: list[ThrusterTable] = []
     pwpf: PWPFTable = PWPFTable()
     magnetorquers: MagnetorquerTable | None = None
+    damper: SphericalDamperTable | None = None
     orbit: OrbitTable | None = None
     magnetic_field: FieldTable | None = None
     gravity_gradient: _Bool = False
-    controller: list[_Controller] = []
+    controller: list[Controller] = []
     control_period: _Positive | None = None
 
     @model_validator(mode="after")
@@ -285,7 +254,7 @@ class SpacecraftTable(_Table):
         """The :class:`~tumble.spacecraft.Spacecraft`; a refusal is reported against its key."""
         parts = {key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
                  for key in ("wheels", "thrusters", "controller")}
-        for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "orbit", "magnetic_field"):
+        for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
         pyramid = parts.pop("wheel_pyramid")
@@ -312,10 +281,14 @@ class SpacecraftTable(_Table):
 
 class SpacecraftInitial(Initial):
     """``[initial]``: ``omega``, ``q`` or ``euler`` as in every kind, plus ``wheel_speeds`` (rad/s, relative
-    to the hub) and ``gimbal_angles`` (rad)."""
+    to the hub), ``gimbal_angles`` (rad), ``damper_omega`` (the damper sphere's rate relative to inertial,
+    rad/s, body axes; default ``omega``) and ``attitude_error_integral`` (∫σ dt of the MRP feedback's
+    integral term, s; default 0). A key the spacecraft has no state for is refused by :func:`tumble.simulate`."""
 
     wheel_speeds: list[_Number] | None = None
     gimbal_angles: list[_Number] | None = None
+    damper_omega: _Vector | None = None
+    attitude_error_integral: _Vector | None = None
 
 
 class SpacecraftSolver(Solver):
@@ -327,60 +300,44 @@ class SpacecraftSolver(Solver):
     method: Annotated[str, Field(strict=True)] = "rk4"
 
 
-# Where the run's arguments come from in the file, besides [initial]'s (key x → initial value x0).
-_RUN_KEYS = {"t": "time", "method": "solver.method", "rtol": "solver.rtol", "atol": "solver.atol",
-             "dt": "solver.dt"}
-
-
-@dataclass(frozen=True)
-class SpacecraftProblem:
-    """A spacecraft scenario turned into a run: the ``spacecraft``, its ``initial`` state by name
-    (``omega0``, ``q0``, ``wheel_speeds0``, ``gimbal_angles0``: the keywords of the simulation), output
-    times ``t`` (s), ``method`` and ``options``, ``keys`` (argument → scenario key) and ``source``."""
-
-    spacecraft: Spacecraft
-    initial: dict[str, np.ndarray]
-    t: np.ndarray
-    method: str
-    options: dict[str, float]
-    keys: dict[str, str]
-    source: str = "<scenario>"
-
-    @property
-    def model(self) -> Spacecraft:
-        return self.spacecraft
-
-    def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-        """Simulate with :func:`tumble.simulate`; an argument the library refuses is reported against its
-        scenario key."""
-        with in_file(self.source), keyed(self.keys, ""):
-            return simulate(self.spacecraft, t=self.t, method=self.method, progress=progress, **self.initial,
-                            **self.options)
-
-
 class SpacecraftScenario(Scenario):
-    """A validated spacecraft scenario (``kind = "spacecraft"``, or any file with a ``[spacecraft]`` table)."""
+    """A validated spacecraft scenario (``kind = "spacecraft"``, or any file with a ``[spacecraft]`` table):
+    the spacecraft, its initial state, times, solver and the external torques ``[[torque]]`` on it
+    (:mod:`tumble.scenario.torques`: ``torque=`` of :func:`tumble.simulate`, on top of its own environment)."""
 
     spacecraft: SpacecraftTable
     initial: SpacecraftInitial
     time: Time
     solver: SpacecraftSolver = SpacecraftSolver(dt=0.1)
+    torque: list[Torque] = []
 
-    def build(self) -> SpacecraftProblem:
-        """Build the spacecraft and its initial state; a refusal by the library names the key."""
+    def build(self) -> Run:
+        """Build the spacecraft, its initial state and external torque; a refusal by the library names the key."""
         with in_file(self.source):
             craft = self.spacecraft.build()
-            keys = {**self.initial.argument_keys("initial"), **_RUN_KEYS}
+            self._check_gravity_gradient_once()
+            torque = build_torque(self.torque, craft.body)
+            keys = {**self.initial.argument_keys("initial"), **RUN_KEYS}
             with keyed(keys, "initial"):
                 initial = self.initial.state()
-            return SpacecraftProblem(spacecraft=craft, initial=initial, t=self.time.times(), method=self.solver.method,
-                                     options=self.solver.options(), keys=keys, source=self.source)
+            return Run(craft, initial, self.time.times(), self.solver.method, self.solver.options(), torque, keys,
+                       self.source)
+
+    def _check_gravity_gradient_once(self):
+        """``spacecraft.gravity_gradient = true`` and a ``gravity_gradient`` ``[[torque]]`` would count the
+        torque twice."""
+        if self.spacecraft.gravity_gradient:
+            twice = [(f"torque[{i}].kind", "the gravity gradient is already on: spacecraft.gravity_gradient = "
+                                           "true (give one of the two)")
+                     for i, entry in enumerate(self.torque) if isinstance(entry, GravityGradientTorque)]
+            if twice:
+                raise ScenarioError("", twice)
 
     def target(self) -> np.ndarray | None:
-        """The attitude commanded by the scenario's quaternion PD law, if it has one (for figures)."""
+        """The attitude commanded by the scenario's regulator (quaternion PD or MRP feedback), if it has one."""
         for law in self.spacecraft.controller:
-            if isinstance(law, PDTable):
-                return law.build().target
+            if isinstance(law, Regulator):
+                return law.target_quaternion()
         return None
 
     def figure(self, traj: Trajectory):
@@ -390,8 +347,13 @@ class SpacecraftScenario(Scenario):
         return spacecraft_figure(traj, target=self.target(), title=self.name)
 
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
-        """Final rate, wheels (peak speed, saturation), drift of the total momentum (hub + actuators)."""
+        """Final rate and angle to the target, wheels (peak speed, saturation), change of the total momentum
+        (hub + actuators)."""
         rows = [("rate", f"final |omega| {np.linalg.norm(traj.omega[-1]):.3g} rad/s")]
+        target = self.target()
+        if target is not None:
+            angle = np.degrees(attitude.relative_angle(traj.q[-1], attitude.normalize(target)))
+            rows.append(("target", f"final angle to the target {angle:.3g} deg"))
         if "wheel_speed" in traj.extras:
             speed = np.abs(traj.extras["wheel_speed"].data)
             saturated = "wheel_saturated" in traj.extras and bool(np.any(traj.extras["wheel_saturated"].data > 0))
