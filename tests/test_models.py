@@ -15,6 +15,7 @@ from tumble import integrate, robot
 from tumble.flexible import FlexibleBody, Mode
 from tumble.ins import GimbaledGyro, Gyroscope
 from tumble.slosh import Pendulum, SloshBody
+from tumble.spacecraft import MRPFeedback, ReactionWheel, Spacecraft
 from tumble.variable import Human, Motion, VariableBody
 
 from helpers import read_by
@@ -103,6 +104,19 @@ CASES["Gyroscope"][4].update(exact_split2=1e-9, exact_split4=1e-12)
 CASES["SerialChain"] = (lambda: robot.load(ROBOTS / "planar_2link.toml"), dict(q0=[0.3, -0.5], qd0=[0.1, 0.2]),
                         1.0, 1e-3, {"dop853": 1e-11, "rk4": 1e-9})
 KEPT["SerialChain"] = {"energy_minus_work"}
+# A spacecraft with three reaction wheels under Schaub's MRP feedback (the craft of tests/test_spacecraft_control.py,
+# so the compiled type is shared), started off target and with spinning wheels: the law's torque is internal, so
+# the spacecraft keeps its inertial momentum, and its energy changes by the work of the wheel motors only (the
+# wheels spin up: E grows from 26 J to 1.4 kJ, so E − W is measured against its 26 J start). Measured: dop853
+# 4.3e-12 (E − W), 3.2e-15 (momentum); rk4 at dt = 0.05 s 1.5e-8 (E − W, its O(dt⁴) truncation error: 2.4e-7,
+# 1.5e-8, 9.3e-10 at dt = 0.1, 0.05, 0.025 s), 8.8e-13 (momentum); cf4 the same to 2 digits.
+CASES["Spacecraft"] = (
+    lambda: Spacecraft(inertia=np.diag([900.0, 800.0, 600.0]),
+                       wheels=[ReactionWheel(axis=a, inertia=0.1) for a in np.eye(3)],
+                       controller=MRPFeedback(K=10.0, P=150.0)),
+    dict(omega0=[0.01, -0.01, 0.005], q0=[0.9, 0.1, -0.3, 0.2], wheel_speeds0=[20.0, -10.0, 5.0]), 60.0, 0.05,
+    {"dop853": 1e-10, "rk4": 2e-7})
+KEPT["Spacecraft"] = {"momentum_inertial", "energy_minus_wheel_work"}
 # cf4 (Lie group, order 4) on the models that give a body rate, at the rk4 steps: measured at or below
 # rk4's change on every model (3.5e-14 flexible, 2.1e-13 slosh, 6.9e-16 variable, 1.1e-15 human,
 # 3.5e-15 gyroscope); the tolerance of rk4 applies.

@@ -223,9 +223,10 @@ def test_bad_wheel_is_refused(kwargs, message):
         ReactionWheel(**kwargs)
 
 
-def test_simulate_refuses_unknown_method():
-    with pytest.raises(ValidationError, match="method: must be one of"):
-        tumble.simulate(_craft(), [0.0, 0.0, 0.0], t=[0.0, 1.0], method="cf4", dt=0.1)
+def test_simulate_refuses_a_method_the_spacecraft_does_not_provide_for():
+    with pytest.raises(ValidationError, match="method: 'splitting2' needs .*, which a Spacecraft is not; "
+                                              "methods for it: 'rk4', 'dop853', 'cf4'"):
+        tumble.simulate(_craft(), [0.0, 0.0, 0.0], t=[0.0, 1.0], method="splitting2", dt=0.1)
 
 
 @SLOW  # also compiles the parallel batch driver for the spacecraft model

@@ -224,7 +224,9 @@ def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, se
         _exact.run(model, y, t, out)
     elif method in _SCHEMES:
         scheme, evaluations = _SCHEMES[method]
-        if serial:
+        if y.shape[0] == 1:
+            _fixed.run_one(scheme, model, y, t, dt, out, stats)
+        elif serial:
             for k in range(-(-y.shape[0] // _fixed.LANES)):
                 _fixed.run_block(scheme, model, k, y, t, dt, out, stats)
         else:

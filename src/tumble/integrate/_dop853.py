@@ -22,6 +22,7 @@ import numpy as np
 from numba import njit, prange
 
 from tumble._protocol import project, rhs, state_size
+from tumble.integrate._fixed import store
 
 ORDER = 8
 _STAGES = 12
@@ -90,7 +91,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
     n = state_size(model)
     K = np.empty((_STAGES + 1, n))
     y_new, tmp = np.empty(n), np.empty(n)
-    out[0, :] = y
+    store(out[0], y)
     t = t_out[0]
     rhs(model, b, t, y, K[0])
     stats[2] += 1
@@ -106,13 +107,13 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
         landing = t + 1.01 * h >= target
         step = target - t if landing else h
         for s in range(1, _STAGES):
-            tmp[:] = y
+            store(tmp, y)
             for r in range(s):
                 a = step * A[s, r]
                 for i in range(n):
                     tmp[i] += a * K[r, i]
             rhs(model, b, t + C[s] * step, tmp, K[s])
-        y_new[:] = y
+        store(y_new, y)
         for r in range(_STAGES):
             a = step * B[r]
             for i in range(n):
@@ -140,12 +141,12 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
             h_next = step * factor
             h = max(h, h_next) if landing else h_next
             t = target if landing else t + step
-            y[:] = y_new
+            store(y, y_new)
             project(model, b, t, y)
             K[0] = K[_STAGES]
             rejected_last = False
             if landing:
-                out[k, :] = y
+                store(out[k], y)
                 k += 1
         else:
             stats[1] += 1

@@ -23,6 +23,7 @@ import math
 
 import numpy as np
 from numba import njit, prange
+from numba.extending import overload
 
 #: Bodies advanced together in one structure-of-arrays block (SIMD lanes × unrolling).
 LANES = 64
@@ -36,6 +37,31 @@ def workspace(scheme, model, Y):  # pragma: no cover - replaced by overloads in 
 def advance(scheme, model, b0, t0, h, m, Y, work):  # pragma: no cover - replaced by overloads in compiled code
     """Advance ``Y`` (in place) by ``m`` steps of ``h`` (s) from ``t0`` (s) with ``scheme``."""
     raise NotImplementedError(f"no compiled step for {type(scheme).__name__}")
+
+
+def store(dst, Y):  # pragma: no cover - replaced by the overload in compiled code
+    """``dst[...] = Y.T`` by explicit loops: ``Y`` a state vector (n,) into ``dst`` (n,), or a block
+    (state × lanes) into ``dst`` (lanes × state).
+
+    Loops rather than an array assignment, whose shape check compiles an
+    error-message formatter into every integrator (about 7 s of compile per
+    model and method, measured with Numba 0.68).
+    """
+    raise NotImplementedError
+
+
+@overload(store, inline="always", jit_options={"cache": True})
+def _store(dst, Y):
+    if Y.ndim == 1:
+        def impl(dst, Y):
+            for i in range(Y.shape[0]):
+                dst[i] = Y[i]
+    else:
+        def impl(dst, Y):
+            for i in range(Y.shape[0]):
+                for j in range(Y.shape[1]):
+                    dst[j, i] = Y[i, j]
+    return impl
 
 
 @njit(cache=True)
@@ -57,27 +83,37 @@ def fixed_path(scheme, model, b0, Y, t_out, dt, out):
     ``out[k]`` receives ``Y.T`` at ``t_out[k]``. Returns the number of steps taken.
     """
     work = workspace(scheme, model, Y)
-    out[0] = Y.T
+    store(out[0], Y)
     steps = 0
     for k in range(1, t_out.shape[0]):
         m, h = landing_steps(t_out[k] - t_out[k - 1], dt)
         advance(scheme, model, b0, t_out[k - 1], h, m, Y, work)
         steps += m
-        out[k] = Y.T
+        store(out[k], Y)
     return steps
 
 
 @njit(cache=True)
+def run_one(scheme, model, y, t_out, dt, out, stats):
+    """Integrate the lone body ``y[0]`` (a batch of one, updated in place) on its state vector.
+
+    Its own entry point, so that a single run compiles the state-vector path
+    only, not the lane loops of a block as well (half the compile time).
+    """
+    stats[0, 0] += fixed_path(scheme, model, 0, y[0], t_out, dt, out[:, 0])
+
+
+@njit(cache=True)
 def run_block(scheme, model, k, y, t_out, dt, out, stats):
-    """Integrate block ``k`` (bodies ``k·LANES …``) of the batch ``y`` (bodies × state, updated in place)."""
+    """Integrate block ``k`` (bodies ``k·LANES …``) of the batch ``y`` (bodies × state, updated in place).
+
+    Every block runs its lanes as a structure of arrays, a last block of one lane included.
+    """
     b0 = k * LANES
     b1 = min(y.shape[0], b0 + LANES)
-    if b1 - b0 == 1:  # a lone body runs on its state vector (no lane loops)
-        steps = fixed_path(scheme, model, b0, y[b0], t_out, dt, out[:, b0])
-    else:
-        Y = np.ascontiguousarray(y[b0:b1].T)
-        steps = fixed_path(scheme, model, b0, Y, t_out, dt, out[:, b0:b1])
-        y[b0:b1] = Y.T
+    Y = np.ascontiguousarray(y[b0:b1].T)
+    steps = fixed_path(scheme, model, b0, Y, t_out, dt, out[:, b0:b1])
+    store(y[b0:b1], Y)
     for b in range(b0, b1):
         stats[b, 0] += steps
 

@@ -22,6 +22,11 @@ The rest of the state ``x`` (the body rate, and whatever a model adds) takes
 the stages and weights of classical RK4 (``x₂ = x + h k₁/2``, …,
 ``x ← x + h (k₁ + 2k₂ + 2k₃ + k₄)/6``), which is what CF4 reduces to on a
 vector space; the method is of order 4 for any torque model.
+
+Every step ends, as with every stepper, with the model's
+:func:`~tumble._protocol.project`: it renormalises a quaternion that the
+exact rotations kept unit to rounding, and it is where a model updates what it
+samples at step ends (a spacecraft's zero-order hold, its PWPF triggers).
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from tumble import _protocol, _quat
-from tumble._protocol import body_rate, rhs
+from tumble._protocol import body_rate, project, rhs
 from tumble.integrate import _fixed
 
 ORDER = 4
@@ -95,7 +100,9 @@ def _cf4_advance(scheme, model, b0, t0, h, m, Y, work):
         # one body's state vector runs as a block of one lane
         y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))
         for s in range(m):
-            _cf4_step(model, b0, t0 + s * h, h, y, K, S, W, Q2)
+            t = t0 + s * h
+            _cf4_step(model, b0, t, h, y, K, S, W, Q2)
+            project(model, b0, t + h, y)
 
     return impl
 

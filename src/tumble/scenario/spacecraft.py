@@ -44,7 +44,7 @@ top of the spacecraft's own environment) are the shared tables
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar, Literal
+from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -62,7 +62,7 @@ from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
 from tumble.spacecraft import actuators
 from tumble.spacecraft.environment import DipoleField
-from tumble.spacecraft.model import METHODS, Spacecraft
+from tumble.spacecraft.model import Spacecraft
 from tumble.trajectory import Trajectory
 
 __all__ = ["SpacecraftScenario"]
@@ -292,10 +292,8 @@ class SpacecraftInitial(Initial):
 
 
 class SpacecraftSolver(Solver):
-    """``[solver]``: ``rk4`` (``dt``; the default) or ``dop853`` (``rtol``, ``atol``; continuous control only)."""
-
-    methods: ClassVar[tuple[str, ...]] = METHODS
-    model_name: ClassVar[str] = "spacecraft"
+    """``[solver]``: ``rk4`` (``dt``; the default), ``cf4`` (``dt``) or ``dop853`` (``rtol``, ``atol``;
+    continuous control only)."""
 
     method: Annotated[str, Field(strict=True)] = "rk4"
 

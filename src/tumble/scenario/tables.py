@@ -300,14 +300,10 @@ class Solver(_Table):
 
     Adaptive methods take ``rtol``/``atol`` (defaults: those of
     :func:`tumble.simulate`); fixed-step methods need ``dt`` (s). An option the
-    method does not use is refused rather than ignored. A kind whose model
-    integrates with fewer methods narrows ``methods`` (and ``model_name``, for
-    the message) in a subclass.
+    method does not use is refused rather than ignored. Whether the kind's model
+    provides what the method needs is :func:`tumble.simulate`'s one check,
+    reported at ``solver.method``.
     """
-
-    #: The methods this kind's model integrates with (None: every one of tumble.integrate.METHODS).
-    methods: ClassVar[tuple[str, ...] | None] = None
-    model_name: ClassVar[str] = ""
 
     method: _Text = "dop853"
     rtol: _Positive | None = None
@@ -317,10 +313,8 @@ class Solver(_Table):
     @field_validator("method")
     @classmethod
     def _known_method(cls, method):
-        allowed = cls.methods or tuple(integrate.METHODS)
-        if method not in allowed:
-            model = f" for a {cls.model_name}" if cls.methods else ""
-            raise ValueError(f"must be one of {', '.join(map(repr, allowed))}{model}, got {method!r}")
+        if method not in integrate.METHODS:
+            raise ValueError(f"must be one of {', '.join(map(repr, integrate.METHODS))}, got {method!r}")
         return method
 
     @field_validator("rtol", "atol", "dt")

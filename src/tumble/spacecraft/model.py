@@ -51,11 +51,8 @@ from tumble.spacecraft.environment import DipoleField
 from tumble.spacecraft.orbit import Orbit
 from tumble.trajectory import Extra, Trajectory
 
-__all__ = ["Spacecraft", "SaturationWarning", "SingularityWarning", "simulate", "METHODS"]
+__all__ = ["Spacecraft", "SaturationWarning", "SingularityWarning", "simulate"]
 
-#: Methods that call the model's projection after every step, where the sampled controller and the PWPF
-#: triggers update (cf4 does not).
-METHODS = ("rk4", "dop853")
 # A whole number of steps per control period or output interval to this relative tolerance.
 _WHOLE = 1e-9
 # The stack depth from a warning in outputs() to the caller of tumble.simulate.
@@ -311,17 +308,15 @@ class Spacecraft(Model):
         return tuple(fields)
 
     def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:
-        """Only rk4 and dop853 (their steps end with the projection, where the discrete parts update); a
-        sampled controller needs rk4 with a step that divides the control period and every output interval."""
-        if method.name not in METHODS:
-            raise ValidationError(f"method: must be one of {', '.join(map(repr, METHODS))} for a spacecraft "
-                                  f"(their steps end with the update of the controller), got {method.name!r}")
+        """A sampled controller needs a fixed-step method (rk4, cf4) whose step divides the control period and
+        every output interval, so that steps end on the sample times (where the projection updates the held
+        commands). Which methods apply at all is the kernel's to declare (``provides``)."""
         period = self.control_period
         if period is None:
             return
-        if method.name != "rk4":
-            raise ValidationError(f"method: a sampled controller (control_period = {period} s) needs the "
-                                  f"fixed-step 'rk4', whose steps land on the sample times; got {method.name!r}")
+        if method.adaptive:
+            raise ValidationError(f"method: a sampled controller (control_period = {period} s) needs a fixed-step "
+                                  f"method ('rk4', 'cf4'), whose steps land on the sample times; got {method.name!r}")
         ratio = period / dt
         if abs(ratio - round(ratio)) > _WHOLE * ratio:
             raise ValidationError(f"dt: must divide control_period = {period} s into whole steps, got dt = {dt} "

@@ -64,6 +64,10 @@ __all__ = ["AUX_ACTUATOR", "AUX_DIPOLE_COMMAND", "AUX_ENERGY", "AUX_EXTERNAL", "
            "AUX_MOMENTUM", "AUX_TORQUE_COMMAND", "HELD_WHEELS", "PARTS", "Program", "Slices", "SpacecraftModel",
            "assemble", "evaluate", "initialise", "slices"]
 
+#: The ``store`` flags of the right-hand side (False) and of the diagnostics (True), read from an array so that
+#: Numba types both as one runtime boolean and compiles the spacecraft's derivative once for both.
+_STORE = np.array([False, True])
+
 #: Kinds that call Python functions (the batch then runs on one core).
 _PYTHON = ("python_law", "wheel_python")
 
@@ -133,31 +137,24 @@ def slices(model: SpacecraftModel, kind: str) -> Slices | None:
     return None if value is None else unpack(value)
 
 
-def _is_spacecraft(model):
-    return _protocol.is_type(model, SpacecraftModel)
-
 
 # Not inline="always": Numba's overload inliner (0.68) loses the loop accumulators of the parts
 # (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
-@overload(_protocol.rhs, jit_options={"cache": True})
+@_protocol.implements(_protocol.rhs, SpacecraftModel)
 def _spacecraft_rhs(model, b0, t, Y, OUT):
-    if not _is_spacecraft(model):
-        return None
     derivative, _, _ = _assemble(model, Y.ndim)
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
-            derivative(model, t, Y, 0, OUT, Y, False)
+            derivative(model, t, Y, 0, OUT, Y, _STORE[0])
     else:
         def impl(model, b0, t, Y, OUT):
             for j in range(Y.shape[1]):
-                derivative(model, t, Y, j, OUT, Y, False)
+                derivative(model, t, Y, j, OUT, Y, _STORE[0])
     return impl
 
 
-@overload(_protocol.project, jit_options={"cache": True})
+@_protocol.implements(_protocol.project, SpacecraftModel)
 def _spacecraft_project(model, b0, t, Y):
-    if not _is_spacecraft(model):
-        return None
     _, sample, discrete = _assemble(model, Y.ndim)
     if Y.ndim == 1:
         normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
@@ -182,17 +179,13 @@ def _spacecraft_project(model, b0, t, Y):
     return impl
 
 
-@overload(_protocol.state_size, jit_options={"cache": True})
+@_protocol.implements(_protocol.state_size, SpacecraftModel)
 def _spacecraft_state_size(model):
-    if not _is_spacecraft(model):
-        return None
     return lambda model: model.size
 
 
-@overload(_protocol.body_rate, inline="always", jit_options={"cache": True})
+@_protocol.implements(_protocol.body_rate, SpacecraftModel, inline=True)
 def _spacecraft_body_rate(model, Y, j):
-    if not _is_spacecraft(model):
-        return None
     return _protocol.rate_at(4, Y)
 
 
@@ -207,7 +200,7 @@ def _evaluate_overload(model, t, y, aux):
     def impl(model, t, y, aux):
         out = np.empty(y.shape[1])
         for k in range(y.shape[0]):
-            derivative(model, t[k], y[k], 0, out, aux[k], True)
+            derivative(model, t[k], y[k], 0, out, aux[k], _STORE[1])
 
     return impl
 

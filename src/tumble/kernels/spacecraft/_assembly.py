@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 
-from numba import types
+from numba import njit, types
 
 from tumble import _quat, torques
 from tumble._vec import cross, matvec_flat
@@ -199,7 +199,9 @@ def assemble(model, ndim):
     else:
         hold_rates = _no_hold_rates
 
-    @inline
+    # Not inlined: one compiled function that the right-hand side and the diagnostics
+    # (:func:`tumble.kernels.spacecraft.evaluate`) share, so that a model type compiles it once.
+    @njit
     def derivative(model, t, y, j, out, aux, store):
         d = model.data
         L = load(model)
