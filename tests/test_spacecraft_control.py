@@ -301,7 +301,8 @@ def test_wheel_torques_are_checked():
         Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), controller=WheelTorques([0.0, 0.0, 0.0]))
     with pytest.raises(tumble.ValidationError, match="controller: WheelTorques needs reaction wheels"):
         Spacecraft(inertia=INERTIA, controller=WheelTorques([0.0]))
-    with pytest.raises(tumble.ValidationError, match="t: must be a 1-D array of strictly increasing"):
+    with pytest.raises(tumble.ValidationError,
+                       match=r"t: sample times must be strictly increasing \(t\[1\] = 0.0 <= t\[0\] = 1.0\)"):
         WheelTorques([[0.0], [1.0]], t=[1.0, 0.0])
     with pytest.raises(tumble.ValidationError, match="interpolation"):
         WheelTorques([0.0], interpolation="cubic")

@@ -74,19 +74,28 @@ def require_non_negative(x: float, name: str) -> float:
     return x
 
 
+def increasing_times(t, name: str = "t", *, what: str = "output times", at_least: int = 1) -> np.ndarray:
+    """``t`` (s) as a 1-D float64 array of at least ``at_least`` strictly increasing times, else a
+    :class:`ValidationError` naming ``name``, ``what`` the times are and the first step that does not increase.
+
+    The one check of times, used for the output times of every model (:func:`output_times`) and the sample
+    times of tabulated inputs (torques, motor torques, variable inertia)."""
+    times = as_array(t, name)
+    if times.ndim != 1 or times.size < at_least:
+        count = "one" if at_least == 1 else f"at least {at_least}"
+        raise ValidationError(f"{name}: must be a 1-D array of {count} {what}, got shape {times.shape}")
+    steps = np.diff(times)
+    if np.any(steps <= 0.0):
+        k = int(np.flatnonzero(steps <= 0.0)[0])
+        raise ValidationError(f"{name}: {what} must be strictly increasing ({name}[{k + 1}] = {times[k + 1]} "
+                              f"<= {name}[{k}] = {times[k]})")
+    return times
+
+
 def output_times(t) -> np.ndarray:
     """The output times ``t`` (s) as a 1-D float64 array of at least one strictly increasing time.
 
     The one check of output times, used by every model through :func:`tumble.simulate`.
     """
-    times = as_array(t, "t")
-    if times.ndim != 1 or times.size < 1:
-        raise ValidationError(f"t: must be a 1-D array of output times, got shape {times.shape}")
-    steps = np.diff(times)
-    if np.any(steps <= 0.0):
-        k = int(np.flatnonzero(steps <= 0.0)[0])
-        raise ValidationError(
-            f"t: output times must be strictly increasing (t[{k + 1}] = {times[k + 1]} <= t[{k}] = {times[k]})"
-        )
-    return times
+    return increasing_times(t)
 

@@ -40,7 +40,7 @@ from numba import njit, objmode
 from numba.extending import register_jitable
 
 from tumble import _callback, _gravity, _quat
-from tumble._validate import ValidationError, as_array, require_positive
+from tumble._validate import ValidationError, as_array, increasing_times, require_positive
 from tumble.attitude import rotate_inverse
 from tumble._inertia import principal_axes
 
@@ -160,14 +160,10 @@ class Tabulated(TorqueModel):
     """
 
     def __init__(self, t, torque, *, frame: str = "body", interpolation: str = "linear"):
-        t = as_array(t, "t")
+        t = increasing_times(t, what="sample times")
         torque = as_array(torque, "torque", tail=(3,))
-        if t.ndim != 1 or t.size < 1:
-            raise ValidationError(f"t: must be a 1-D array of at least one time, got shape {t.shape}")
         if torque.shape != (t.size, 3):
             raise ValidationError(f"torque: must have shape (len(t), 3) = ({t.size}, 3), got {torque.shape}")
-        if np.any(np.diff(t) <= 0.0):
-            raise ValidationError("t: sample times must be strictly increasing")
         if frame not in ("body", "inertial"):
             raise ValidationError(f"frame: must be 'body' or 'inertial', got {frame!r}")
         if interpolation not in ("linear", "previous"):

@@ -52,7 +52,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tumble import _callback, attitude
-from tumble._validate import ValidationError, as_array, require_positive
+from tumble._validate import ValidationError, as_array, increasing_times, require_positive
 from tumble.kernels.spacecraft import laws as _laws
 from tumble.kernels.spacecraft._base import Program
 from tumble.spacecraft.actuators import _limit
@@ -265,9 +265,7 @@ class WheelTorques:
                                       f"got {values.shape}")
             times, values = np.zeros(1), values[None, :]
         else:
-            times = as_array(self.t, "t")
-            if times.ndim != 1 or times.size < 1 or np.any(np.diff(times) <= 0.0):
-                raise ValidationError("t: must be a 1-D array of strictly increasing sample times (s)")
+            times = increasing_times(self.t, what="sample times")
             if values.ndim != 2 or values.shape[0] != times.size:
                 raise ValidationError(f"torques: must have shape (len(t), n_w) = ({times.size}, n_w), "
                                       f"got {values.shape}")

@@ -45,7 +45,7 @@ from scipy.interpolate import CubicSpline
 
 from tumble import attitude, dynamics, torques
 from tumble._inertia import frozen, principal_axes
-from tumble._validate import ValidationError, as_array, require_positive
+from tumble._validate import ValidationError, as_array, increasing_times, require_positive
 from tumble.kernels import variable as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory
@@ -93,14 +93,7 @@ class VariableBody(Model):
     __slots__ = ("_t", "_inertia", "_shape_momentum", "_spline")
 
     def __init__(self, t, inertia, shape_momentum=None, *, check_triangle: bool = True):
-        t = as_array(t, "t")
-        if t.ndim != 1 or t.size < 4:
-            raise ValidationError(f"t: must be a 1-D array of at least 4 sample times, got shape {t.shape}")
-        steps = np.diff(t)
-        if np.any(steps <= 0.0):
-            k = int(np.flatnonzero(steps <= 0.0)[0])
-            raise ValidationError(f"t: sample times must be strictly increasing (t[{k + 1}] = {t[k + 1]} "
-                                  f"<= t[{k}] = {t[k]})")
+        t = increasing_times(t, what="sample times", at_least=4)
         inertia = as_array(inertia, "inertia", tail=(3, 3))
         if inertia.shape != (t.size, 3, 3):
             raise ValidationError(f"inertia: must have shape ({t.size}, 3, 3) (one tensor per sample time), "
