@@ -86,11 +86,14 @@ def scene(traj, *, model=None, frames: int = DEFAULT_FRAMES, axis: str | None = 
     traj = _trajectory(traj)
     if traj.batch_size is not None:
         raise ValidationError(f"traj: a batch of {traj.batch_size} runs; view one run with traj.body(i)")
-    if model is not None and traj.model and type(model).__name__ != traj.model:
-        raise ValidationError(f"model: the trajectory was made by a {traj.model}, got a {type(model).__name__}")
-    builder = BUILDERS.get(traj.model, BUILDERS["RigidBody"])
-    if traj.q is None and builder is BUILDERS["RigidBody"]:
-        raise ValidationError(f"traj: a {traj.model or 'model'} trajectory without an attitude has no scene")
+    builder = BUILDERS.get(traj.model)
+    if builder is None:  # a model with no scene of its own: drawn from its attitude; its model adds nothing
+        if traj.q is None:
+            raise ValidationError(f"traj: a {traj.model or 'model'} trajectory without an attitude has no scene")
+        if model is not None and type(model).__name__ != traj.model:
+            raise ValidationError(f"model: the trajectory was made by a {traj.model or 'model'}, "
+                                  f"got a {type(model).__name__}")
+        builder, model = BUILDERS["RigidBody"], None
     idx = frame_indices(len(traj), budget)
     title = (f"{traj.model or 'trajectory'}: {traj.method or 'unknown method'}, t = {traj.t[0]:g} … {traj.t[-1]:g} s, "
              f"{len(traj)} samples")

@@ -22,9 +22,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tumble._validate import ValidationError
 from tumble.viewer._shapes import Mesh
 
-__all__ = ["Lines", "Panel", "Polhode", "Scene", "Solid", "as_json"]
+__all__ = ["Lines", "Panel", "Polhode", "Scene", "Solid", "as_json", "check_model"]
+
+
+def check_model(model, kinds: tuple, traj) -> None:
+    """Refuse a ``model`` that is neither None nor one of ``kinds`` (classes) for the trajectory ``traj``."""
+    if model is not None and not isinstance(model, kinds):
+        names = " or ".join(kind.__name__ for kind in kinds)
+        raise ValidationError(f"model: a {traj.model} trajectory is drawn with a {names} (or None), "
+                              f"got a {type(model).__name__}")
 
 
 @dataclass

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from tumble.flexible import FlexibleBody
-from tumble.viewer._scene import Lines
+from tumble.viewer._scene import Lines, check_model
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 from tumble.viewer.scenes.rigid import hub_mesh
 
@@ -36,6 +36,7 @@ def _panel_axes(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def scene(traj, idx, model, options):
+    check_model(model, (FlexibleBody,), traj)
     body = model.body if isinstance(model, FlexibleBody) else None
     mesh, note = hub_mesh(traj, body, options.shape)
     scene = attitude_scene(traj, idx, mesh=mesh, mesh_note=note, axis=options.axis, title=options.title, body="hub")

@@ -1,8 +1,9 @@
 """The scene of a human body in flight (a diver, a gymnast): its segments at their poses.
 
-For a :class:`tumble.variable.MovingHuman`, the segment poses relative to
-the trunk frame B come from :meth:`tumble.variable.Human.kinematics` at the
-frame times with the model's joint-angle schedule: segment ``i`` has axes
+For a :class:`tumble.variable.MovingHuman` (the model, or its
+:class:`~tumble.variable.Human`), the segment poses relative to the trunk
+frame B come from :meth:`tumble.variable.Human.kinematics` at the frame
+times with the joint angles the trajectory recorded (``joint_angles``): segment ``i`` has axes
 ``R_i`` and joint ``o_i`` (B axes, from the hip centre) and the whole-body
 centre of mass is ``C``; drawn about ``C``, a point ``v`` of the segment (own
 axes) is at ``R(q) (R_i v + o_i − C)``. Each segment is drawn as the uniform
@@ -16,8 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from tumble._inertia import principal_axes
-from tumble.variable.human import MovingHuman
-from tumble.viewer._scene import Solid
+from tumble._validate import ValidationError
+from tumble.variable.human import Human, MovingHuman
+from tumble.viewer._scene import Solid, check_model
 from tumble.viewer._shapes import Mesh, box_mesh, equivalent_box
 from tumble.viewer.scenes import rigid
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
@@ -36,11 +38,29 @@ def segment_mesh(part) -> Mesh:
     return box_mesh(equivalent_box(moments, part.mass)).moved(axes, part.com)
 
 
+class _AtFrames:
+    """Joint angles known at the frames only (the trajectory's ``joint_angles``): a pose needs no rates."""
+
+    def __init__(self, values):
+        self._values = values
+
+    def angle(self, t):
+        return self._values
+
+    def rate(self, t):
+        return np.zeros_like(self._values)
+
+
 def scene(traj, idx, model, options):
-    if not isinstance(model, MovingHuman):
+    check_model(model, (MovingHuman, Human), traj)
+    if model is None:
         return rigid.scene(traj, idx, None, options)
-    human = model.human
-    kin = human.kinematics(traj.t[idx], model.angles)
+    human = model.human if isinstance(model, MovingHuman) else model
+    if traj.joint_angles.shape[-1] != len(human.dofs):
+        raise ValidationError(f"model: has {len(human.dofs)} joint angles, the trajectory's joint_angles "
+                              f"{traj.joint_angles.shape[-1]}")
+    angles = traj.joint_angles[idx]
+    kin = human.kinematics(traj.t[idx], {name: _AtFrames(angles[:, k]) for k, name in enumerate(human.dofs)})
     R = rotations(traj.q[idx])
     meshes = [segment_mesh(s.part) for s in human.segments]
     points = [np.einsum("fij,vj->fvi", kin.rotation[:, i], m.vertices) + (kin.joint[:, i] - kin.com)[:, None]

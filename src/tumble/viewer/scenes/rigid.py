@@ -10,8 +10,9 @@ that has one), else the equivalent box of the trajectory's ``inertia``
 from __future__ import annotations
 
 from tumble.body import RigidBody
-from tumble.viewer.scenes._attitude import attitude_scene
+from tumble.viewer._scene import check_model
 from tumble.viewer._shapes import body_mesh
+from tumble.viewer.scenes._attitude import attitude_scene
 
 __all__ = ["hub_mesh", "scene"]
 
@@ -24,5 +25,6 @@ def hub_mesh(traj, body, shape):
 
 
 def scene(traj, idx, model, options):
+    check_model(model, (RigidBody,), traj)
     mesh, note = hub_mesh(traj, model, options.shape)
     return attitude_scene(traj, idx, mesh=mesh, mesh_note=note, axis=options.axis, title=options.title)

@@ -15,7 +15,7 @@ import numpy as np
 
 from tumble._validate import ValidationError
 from tumble.robot import SerialChain, link_poses
-from tumble.viewer._scene import Lines, Panel, Scene, Solid
+from tumble.viewer._scene import Lines, Panel, Scene, Solid, check_model
 from tumble.viewer._shapes import box_mesh
 
 __all__ = ["joint_points", "scene"]
@@ -30,7 +30,8 @@ def joint_points(chain: SerialChain, q: np.ndarray) -> np.ndarray:
 
 
 def scene(traj, idx, model, options):
-    if not isinstance(model, SerialChain):
+    check_model(model, (SerialChain,), traj)
+    if model is None:
         raise ValidationError("model: a SerialChain trajectory holds joint coordinates only; pass its chain "
                               "(model=chain) to draw the links by forward kinematics")
     q = traj.joint_position[idx]

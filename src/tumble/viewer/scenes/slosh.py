@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tumble.slosh import SloshBody
-from tumble.viewer._scene import Lines
+from tumble.viewer._scene import Lines, check_model
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 from tumble.viewer.scenes.rigid import hub_mesh
 
@@ -20,6 +20,7 @@ __all__ = ["scene"]
 
 
 def scene(traj, idx, model, options):
+    check_model(model, (SloshBody,), traj)
     body = model.body if isinstance(model, SloshBody) else None
     mesh, note = hub_mesh(traj, body, options.shape)
     scene = attitude_scene(traj, idx, mesh=mesh, mesh_note=note, axis=options.axis, title=options.title, body="hub")

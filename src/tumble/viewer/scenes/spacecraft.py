@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from tumble.spacecraft import Spacecraft
-from tumble.viewer._scene import Lines, Solid
+from tumble.viewer._scene import Lines, Solid, check_model
 from tumble.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 from tumble.viewer.scenes.rigid import hub_mesh
@@ -51,6 +51,7 @@ def _rotor(radius: float, thickness: float) -> tuple[Mesh, Mesh]:
 
 
 def scene(traj, idx, model, options):
+    check_model(model, (Spacecraft,), traj)
     craft = model if isinstance(model, Spacecraft) else None
     body = None if craft is None else (craft.hub if craft.hub is not None else craft.body)
     mesh, note = hub_mesh(traj, body, options.shape)
