@@ -60,9 +60,9 @@ def box_mesh(size) -> Mesh:
     """A box of sides ``size`` (3,), m, centred on the origin, edges along the axes: 8 vertices, 12 triangles."""
     half = 0.5 * np.asarray(size, dtype=np.float64)
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=np.float64) * half
-    faces = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6],      # x = -, +
-                      [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7],      # y = -, +
-                      [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])     # z = -, +
+    faces = np.array([[0, 1, 2], [1, 3, 2], [4, 6, 5], [5, 6, 7],      # x = -, +
+                      [0, 4, 1], [1, 4, 5], [2, 3, 6], [3, 7, 6],      # y = -, +
+                      [0, 2, 4], [2, 6, 4], [1, 5, 3], [3, 5, 7]])     # z = -, +
     return Mesh(corners, faces)
 
 
@@ -174,10 +174,10 @@ def ellipsoid_mesh(semi_axes, rings: int = 16, sections: int = SECTIONS) -> Mesh
     vertices = np.concatenate([[[0.0, 0.0, 1.0]], ring.reshape(-1, 3), [[0.0, 0.0, -1.0]]])
     k = np.arange(sections)
     nxt = (k + 1) % sections
-    faces = [np.stack([np.zeros(sections, int), 1 + nxt, 1 + k], 1)]
+    faces = [np.stack([np.zeros(sections, int), 1 + k, 1 + nxt], 1)]
     for r in range(rings - 2):
         a, b = 1 + r * sections, 1 + (r + 1) * sections
-        faces += [np.stack([a + k, a + nxt, b + k], 1), np.stack([a + nxt, b + nxt, b + k], 1)]
+        faces += [np.stack([a + k, b + k, a + nxt], 1), np.stack([a + nxt, b + k, b + nxt], 1)]
     last, bottom = 1 + (rings - 2) * sections, len(vertices) - 1
-    faces.append(np.stack([np.full(sections, bottom), last + k, last + nxt], 1))
+    faces.append(np.stack([np.full(sections, bottom), last + nxt, last + k], 1))
     return Mesh(vertices * np.asarray(semi_axes, dtype=np.float64), np.concatenate(faces))

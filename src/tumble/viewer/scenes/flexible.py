@@ -3,7 +3,7 @@
 The model's modes carry no mode shape, only the participation vector
 ``δₖ`` (the angular momentum per unit modal rate, body axes): a panel whose
 deflection turns it about ``δ̂ₖ``. Panel ``k`` is drawn as a line from the
-hub's surface along the body direction ``uₖ ⊥ δ̂ₖ`` closest to a body axis,
+hub's surface along the body direction ``±uₖ ⊥ δ̂ₖ`` closest to a body axis (the modes alternate sides),
 of length ``s`` (the hub's half-diagonal), bent along ``δ̂ₖ × uₖ`` by
 ``d(x) = g ηₖ (x/s)²`` — a picture of the deflection, not the mode shape —
 with one gain ``g`` (m per kg^½·m) for all modes, chosen so that the largest
@@ -51,6 +51,7 @@ def scene(traj, idx, model, options):
     R = rotations(traj.q[idx])
     for k, delta in enumerate(model.participation.T):
         u, bend = _panel_axes(delta)
+        u, bend = (-1) ** k * u, (-1) ** k * bend   # modes alternate sides of the hub
         root = u * np.abs(mesh.vertices @ u).max()
         shape = root + length * x[:, None] * u                                      # (P, 3) undeformed
         points = shape + gain * eta[:, k, None, None] * (x**2)[:, None] * bend       # (F, P, 3)
