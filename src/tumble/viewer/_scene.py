@@ -83,7 +83,8 @@ class Polhode:
 @dataclass
 class Scene:
     """Everything a page shows: frame times ``t`` (F,) s, their sample indices ``sample`` (F,) of ``samples``,
-    the 3-D parts, the half-width ``extent`` (m) of the cube they are drawn in, the panel, the polhode, and
+    the 3-D parts, the half-width ``extent`` (m) of the cube they are drawn in and the ``frame`` of its axes
+    ("inertial", or "base" for a robot arm), the panel, the polhode, and
     ``notes``: sentences the page prints under the scene (what is drawn, at which scale)."""
 
     title: str
@@ -91,6 +92,7 @@ class Scene:
     sample: np.ndarray
     samples: int
     extent: float
+    frame: str = "inertial"
     solids: list = field(default_factory=list)
     lines: list = field(default_factory=list)
     panel: Panel | None = None
@@ -126,6 +128,7 @@ def as_json(scene: Scene) -> dict:
         "sample": [int(k) for k in scene.sample],
         "samples": int(scene.samples),
         "range": 1.05 * float(scene.extent),
+        "frame": scene.frame,
         "speeds": list(SPEEDS),
         "speed": default_speed(duration),
         "solids": [{"name": s.name, "vertices": _plain(s.mesh.vertices), "faces": s.mesh.faces.tolist(),

@@ -54,7 +54,7 @@
       const xyz = linePoints(line, 0);
       traces.push({type: "scatter3d", mode: line.markers ? "lines+markers" : "lines", name: line.name,
                    x: xyz[0], y: xyz[1], z: xyz[2], line: {color: line.color, width: line.width},
-                   marker: {size: 3, color: line.color}, showlegend: line.legend, hoverinfo: "name",
+                   marker: {size: line.markers ? 5 : 3, color: line.color}, showlegend: line.legend, hoverinfo: "name",
                    connectgaps: false});
     });
     return traces;
@@ -120,10 +120,15 @@
     return Promise.all(work);
   }
 
-  function tick(now) {
+  // Simulated time advances with the wall clock times the speed; a pause of the page (a busy machine, a hidden
+  // tab) counts as at most MAX_STEP s, so playback never jumps ahead.
+  const MAX_STEP = 0.1;
+
+  function tick() {
     if (!state.playing) return;
+    const now = performance.now();
     if (state.last !== null) {
-      state.simTime += (now - state.last) / 1000 * Number(speedSelect.value);
+      state.simTime += Math.min(MAX_STEP, (now - state.last) / 1000) * Number(speedSelect.value);
     }
     state.last = now;
     let f = state.frame;
@@ -152,9 +157,9 @@
     const option = document.createElement("option");
     option.value = s;
     option.textContent = s + "×";
-    if (s === S.speed) option.selected = true;
     speedSelect.appendChild(option);
   });
+  speedSelect.value = String(S.speed);
   slider.max = F - 1;
   slider.addEventListener("input", function () { pause(); show(Number(slider.value)); });
   playButton.addEventListener("click", function () { if (state.playing) pause(); else play(); });
@@ -166,7 +171,7 @@
   document.getElementById("tumble-title").textContent = S.title;
 
   const plots = [Plotly.newPlot(main, mainTraces(), {
-    scene: sceneLayout(S.range, ["x inertial (m)", "y inertial (m)", "z inertial (m)"]),
+    scene: sceneLayout(S.range, ["x", "y", "z"].map(function (a) { return a + " " + S.frame + " (m)"; })),
     margin: {l: 0, r: 0, t: 0, b: 0}, legend: {x: 0, y: 1}, uirevision: "keep"}, config)];
   if (S.panel) {
     plots.push(Plotly.newPlot(panel, S.panel.series.map(function (s) {

@@ -38,12 +38,12 @@ def scene(traj, idx, model, options):
     points = joint_points(model, q)
     reach = float(np.linalg.norm(points, axis=-1).max())
     reach = reach if reach > 0.0 else 1.0
-    scene = Scene(title=options.title, t=traj.t[idx], sample=idx, samples=len(traj.t), extent=1.1 * reach,
+    scene = Scene(title=options.title, t=traj.t[idx], sample=idx, samples=len(traj.t), extent=1.1 * reach, frame="base",
                   notes=["links: straight segments between the link frames' origins (forward kinematics of the "
                          "chain, tumble.robot.link_poses), a marker on each; base axes, m"])
     scene.solids.append(Solid("base", box_mesh(np.full(3, 0.08 * reach)), np.eye(3)[None], np.zeros((1, 3)),
                               "#7f7f7f"))
-    scene.lines.append(Lines("links", points, "#333333", width=10.0, markers=True))
+    scene.lines.append(Lines("links", points, "#333333", width=12.0, markers=True))
     names = [f"q{k + 1}" for k in range(q.shape[1])]
     scene.panel = Panel("joint coordinates", "q (rad or m)",
                         [(name, q[:, k], _COLORS[k % len(_COLORS)]) for k, name in enumerate(names)])
