@@ -14,6 +14,7 @@
   const playButton = document.getElementById("tumble-play");
   const speedSelect = document.getElementById("tumble-speed");
   const config = {displaylogo: false, responsive: true};
+  const sideConfig = {displaylogo: false, responsive: true, displayModeBar: false};
   const state = {frame: 0, playing: false, applied: {}, ready: false, simTime: S.t[0], last: null};
 
   function at(array, f) { return array[Math.min(f, array.length - 1)]; }
@@ -176,7 +177,7 @@
   if (S.panel) {
     plots.push(Plotly.newPlot(panel, S.panel.series.map(function (s) {
       return {type: "scatter", mode: "lines", name: s.name, x: S.t, y: s.values, line: {color: s.color, width: 1.5}};
-    }), panelLayout(), config));
+    }), panelLayout(), sideConfig));
   } else {
     panel.style.display = "none";
   }
@@ -184,7 +185,7 @@
     plots.push(Plotly.newPlot(polhode, polhodeTraces(), {
       scene: sceneLayout(S.polhode.range, ["ω₁ (rad/s)", "ω₂ (rad/s)", "ω₃ (rad/s)"]),
       title: {text: "polhode on the energy ellipsoid (principal axes)", font: {size: 13}},
-      margin: {l: 0, r: 0, t: 30, b: 0}, showlegend: false, uirevision: "keep"}, config));
+      margin: {l: 0, r: 0, t: 30, b: 0}, showlegend: false, uirevision: "keep"}, sideConfig));
   } else {
     polhode.style.display = "none";
   }
