@@ -47,6 +47,7 @@ class Solid:
     position: np.ndarray
     color: str
     opacity: float = 1.0
+    legend: bool = True
 
 
 @dataclass
@@ -133,7 +134,7 @@ def as_json(scene: Scene) -> dict:
         "speed": default_speed(duration),
         "solids": [{"name": s.name, "vertices": _plain(s.mesh.vertices), "faces": s.mesh.faces.tolist(),
                     "rotation": _plain(s.rotation), "position": _plain(s.position), "color": s.color,
-                    "opacity": s.opacity} for s in scene.solids],
+                    "opacity": s.opacity, "legend": s.legend} for s in scene.solids],
         "lines": [{"name": line.name, "points": _plain(line.points), "color": line.color, "width": line.width,
                    "trail": line.trail, "markers": line.markers, "legend": line.legend} for line in scene.lines],
         "panel": None if scene.panel is None else {

@@ -48,7 +48,7 @@
       traces.push({type: "mesh3d", name: solid.name, x: xyz[0], y: xyz[1], z: xyz[2],
                    i: faces.map(function (t) { return t[0]; }), j: faces.map(function (t) { return t[1]; }),
                    k: faces.map(function (t) { return t[2]; }), color: solid.color, opacity: solid.opacity,
-                   flatshading: true, showlegend: true, hoverinfo: "name",
+                   flatshading: true, showlegend: solid.legend, hoverinfo: "name",
                    lighting: {ambient: 0.55, diffuse: 0.8, specular: 0.1}});
     });
     S.lines.forEach(function (line) {

@@ -87,6 +87,6 @@ def attitude_scene(traj, idx: np.ndarray, *, mesh: Mesh | None, mesh_note: str, 
     scene.notes.append(f"the trace of body axis {'xyz'[axis]} on the unit sphere, drawn at radius {a:.4g} m")
     scene.panel = Panel("body rates", "ω, body axes (rad/s)",
                         [(f"ω{name}", traj.omega[idx, k], AXIS_COLORS[k]) for k, name in enumerate("xyz")])
-    if traj.model == "RigidBody" and traj.info.get("torque") == "none":
+    if traj.model in ("RigidBody", "RigidBodies") and traj.info.get("torque") == "none":
         scene.polhode = _polhode(traj, idx)
     return scene

@@ -70,7 +70,7 @@ def scene(traj, idx, model, options):
             axes = R @ _about(wheel.axis, theta[:, i]) @ turn_z_to(wheel.axis)
             position = np.einsum("fij,j->fi", R, where)
             scene.solids.append(Solid(f"wheel {i + 1}", disk, axes, position, "#7f7f7f"))
-            scene.solids.append(Solid(f"wheel {i + 1} spoke", spoke, axes, position, "#ffffff"))
+            scene.solids.append(Solid(f"wheel {i + 1} spoke", spoke, axes, position, "#ffffff", legend=False))
         scene.notes.append("wheels: disks on their axes (at their positions, or just outside the hub); the spoke "
                            "turns by the spin angle relative to the hub, the integral of the sampled wheel speed "
                            "(at the frames: a fast wheel aliases)")
