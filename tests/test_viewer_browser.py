@@ -195,32 +195,41 @@ def _check_rotations(page: Page, traj, name: str) -> float:
     return worst
 
 
-@pytest.fixture(scope="module")
-def pages(tmp_path_factory):
-    """The three trajectories and their pages (short runs, the compiled kernels of the rest of the suite)."""
-    folder = tmp_path_factory.mktemp("pages")
+# The three trajectories and their pages, each built by the test that opens it (under pytest-xdist a worker
+# builds only those it runs): short runs on the compiled kernels of the rest of the suite (a RigidBody under rk4,
+# a Spacecraft with wheels under rk4, the planar two-link arm under dop853, none with a torque).
+
+
+def free_page(folder: Path):
     body = tumble.RigidBody.t_handle()
     free = tumble.simulate(body, body.axes @ [0.05, 6.0, 0.05], q0=[0.9, 0.1, -0.3, 0.2],
                            t=np.linspace(0.0, 3.0, 601), method="rk4", dt=1e-3)
     shape = [Cylinder(radius=0.004, length=0.08, axis="x", position=(0.04, 0.0, 0.0)),
              Cylinder(radius=0.004, length=0.08, axis="y", position=(0.08, 0.0, 0.0))]
     free.to_html(folder / "free.html", model=body, shape=shape, frames=FRAMES)
+    return free, folder / "free.html"
+
+
+def spacecraft_page(folder: Path):
     craft = Spacecraft(inertia=np.diag([900.0, 800.0, 600.0]),
                        wheels=[ReactionWheel(axis=a, inertia=0.1) for a in np.eye(3)],
                        controller=MRPFeedback(K=10.0, P=150.0))
     slew = tumble.simulate(craft, [0.01, -0.01, 0.005], q0=[0.9, 0.2, 0.3, -0.2], t=np.linspace(0.0, 60.0, 601),
                            method="rk4", dt=0.05)
     slew.to_html(folder / "spacecraft.html", model=craft, frames=FRAMES)
+    return slew, craft, folder / "spacecraft.html"
+
+
+def robot_page(folder: Path):
     arm = robot.load(ROBOTS / "planar_2link.toml")
     fall = tumble.simulate(arm, t=np.linspace(0.0, 2.0, 401), q0=[0.3, -0.5], qd0=[0.1, 0.2],
                            rtol=1e-12, atol=1e-12)
     fall.to_html(folder / "robot.html", model=arm, frames=FRAMES)
-    return {"free": (free, folder / "free.html"), "spacecraft": (slew, craft, folder / "spacecraft.html"),
-            "robot": (fall, arm, folder / "robot.html")}
+    return fall, arm, folder / "robot.html"
 
 
-def test_free_rigid_body_page(browser, pages):
-    traj, path = pages["free"]
+def test_free_rigid_body_page(browser, tmp_path):
+    traj, path = free_page(tmp_path)
     page = Page(browser, path)
     assert len(page.scene["t"]) == FRAMES and page.scene["polhode"] is not None
     _check_page(page, "viewer.png")
@@ -235,8 +244,8 @@ def test_free_rigid_body_page(browser, pages):
     np.testing.assert_allclose(tips, [tips[0]] * 3, atol=1e-9)
 
 
-def test_spacecraft_with_wheels_page(browser, pages):
-    traj, craft, path = pages["spacecraft"]
+def test_spacecraft_with_wheels_page(browser, tmp_path):
+    traj, craft, path = spacecraft_page(tmp_path)
     page = Page(browser, path)
     _check_page(page, "viewer_spacecraft.png")
     worst = _check_rotations(page, traj, "hub")
@@ -252,8 +261,8 @@ def test_spacecraft_with_wheels_page(browser, pages):
             np.testing.assert_allclose(applied[:, 2], R @ wheel.axis, atol=ROTATION_TOLERANCE)
 
 
-def test_robot_arm_page(browser, pages):
-    traj, arm, path = pages["robot"]
+def test_robot_arm_page(browser, tmp_path):
+    traj, arm, path = robot_page(tmp_path)
     page = Page(browser, path)
     _check_page(page, "viewer_robot.png")
     worst = 0.0
