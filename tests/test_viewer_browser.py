@@ -154,9 +154,10 @@ def _check_page(page: Page, screenshot: str) -> None:
     assert [url for url in resources if not url.startswith("data:")] == []
     page.show(FRAMES // 3)
     rgb, drawn = _scene_pixels(page, screenshot)
-    # not blank: the scene's traces cover part of the canvas (measured 1.5 % for the thin robot arm, 5-9 % for
-    # the bodies) in shades of their colours (lit faces, antialiased lines)
-    assert drawn.mean() > 0.005, f"only {drawn.mean():.2%} of the canvas shows the scene"
+    # not blank: the scene's traces cover part of the canvas (measured 0.90 % for the thin robot arm, 2.7 % for
+    # the T-handle, 6.4 % for the spacecraft) in shades of their colours (measured 136 to 596: lit faces,
+    # antialiased lines); a blank canvas changes nowhere
+    assert drawn.mean() > 0.004, f"only {drawn.mean():.2%} of the canvas shows the scene"
     assert len(np.unique((rgb[drawn] * 255).astype(np.uint8), axis=0)) > 20
     before = page.driver.execute_script("return window.tumbleViewer.state.frame")
     page.driver.find_element("id", "tumble-play").click()
