@@ -5,6 +5,8 @@ free motion: ``q(t) = [cos(Ωt/2), sin(Ωt/2) e]``), so the module compiles noth
 helpers. tests/test_viewer_browser.py opens the pages in Chromium.
 """
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import xarray as xr
@@ -18,6 +20,7 @@ from tumble.viewer._frames import frame_indices
 from tumble.viewer._shapes import body_mesh, box_mesh, cylinder_mesh, ellipsoid_mesh, equivalent_box
 from tumble.viewer.scenes.spacecraft import spin_angles
 
+ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
 INERTIA = np.diag([1.0, 2.0, 3.0])   # kg m²
 SPIN = 2.0                           # rad/s about body z, the major axis
 
@@ -156,7 +159,7 @@ def test_a_batch_a_wrong_model_and_a_robot_without_its_chain_are_refused():
     with pytest.raises(ValidationError, match=r"traj: a batch of 2 runs; view one run with traj.body\(i\)"):
         viewer.scene(batch)
     with pytest.raises(ValidationError, match="model: a RigidBody trajectory is drawn with a RigidBody"):
-        viewer.scene(one, model=tumble.robot.load("examples/robots/planar_2link.toml"))
+        viewer.scene(one, model=tumble.robot.load(ROBOTS / "planar_2link.toml"))
     with pytest.raises(ValidationError, match="model: a SerialChain trajectory holds joint coordinates only"):
         viewer.scene(arm_trajectory())
     with pytest.raises(ValidationError, match="axis: must be 'x', 'y', 'z' or None"):
