@@ -7,6 +7,7 @@
     tumble demo NAME [-o DIRECTORY]        (the demos of tumble._demos.DEMOS: diver, flexible, ...)
     tumble robot torques ROBOT_FILE --q ...
     tumble info out.nc
+    tumble view out.nc -o out.html [--scenario SCENARIO.toml] [--frames 600] [--axis x]
     tumble --version
 
 Exit codes: 0 success; 2 bad input (a one-line message per problem on
@@ -70,6 +71,10 @@ _RACKET_TOLERANCE = 1e-12
 # 1 rad/s about each of the others (principal axes): a motion just inside the
 # "major" regime, so that its polhode stands apart from the separatrix.
 _POLHODE_OMEGA = (1.0, 10.0, 1.0)
+# The T-handle as the viewer draws it: RigidBody.t_handle()'s handle (along x, from the origin) and cross bar
+# (along y, centred on the handle's end), solid cylinders of its default radius and lengths (m).
+_T_HANDLE_PIECES = [dict(radius=0.004, length=0.08, axis="x", position=(0.04, 0.0, 0.0)),
+                    dict(radius=0.004, length=0.08, axis="y", position=(0.08, 0.0, 0.0))]
 
 _stderr = Console(stderr=True)
 
@@ -132,8 +137,11 @@ def racket(
     with 1e-3 rad/s about the other two, integrated by dop853 at rtol = atol = 1e-12. A flip
     is a sign change of the intermediate-axis rate; the command prints their number, the
     mean time between them, and the time between flips predicted by the exact (elliptic)
-    solution, 2K(m)/lambda.
+    solution, 2K(m)/lambda. Beside the figure it writes the flips in the offline 3-D viewer
+    (the figure's name with .html).
     """
+    from tumble.viewer import Cylinder
+
     with _exit_codes():
         require_positive(duration, "--duration")
         _check_outputs(output, plot)
@@ -145,10 +153,12 @@ def racket(
                             method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE, progress=progress)
         flips = flip_times(traj, body)
         _save(traj, output, _racket_figure(traj, body, flips), plot)
+        page = plot.with_suffix(".html")
+        traj.to_html(page, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
     mean = f", mean time between flips {np.diff(flips).mean():.6g} s" if flips.size > 1 else ""
     _print_rows([*_summary(traj), ("flips", f"{flips.size} in {duration:g} s{mean}"),
                  ("predicted", f"time between flips 2K/lambda = {flip_interval(body, omega0):.6g} s (exact solution)"),
-                 ("wrote", _written(output, plot))])
+                 ("wrote", f"{_written(output, plot)}, {page}")])
 
 
 @demo_app.command("polhode")
@@ -228,7 +238,7 @@ def _demo_command(demo: Demo) -> Callable[..., None]:
     ) -> None:
         with _exit_codes():
             summary = getattr(importlib.import_module(module), function)(output)
-        written = [str(v) for v in summary.values() if isinstance(v, (str, Path)) and str(v).endswith((".png", ".nc"))]
+        written = [str(v) for v in summary.values() if isinstance(v, (str, Path)) and str(v).endswith((".png", ".nc", ".html"))]
         _print_rows([*demo.rows(summary), ("wrote", ", ".join(written))])
 
     command.__doc__ = demo.help
@@ -258,6 +268,33 @@ def info(path: Annotated[Path, typer.Argument(help="NetCDF file written by tumbl
     rows += _summary(traj)
     rows += [("solver" if i == 0 else "", f"{key} = {value}") for i, (key, value) in enumerate(traj.info.items())]
     _print_rows(rows)
+
+
+@app.command()
+def view(
+    path: Annotated[Path, typer.Argument(help="NetCDF trajectory written by tumble run / tumble demo / save().")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="HTML file to write (e.g. run.html).")],
+    scenario: Annotated[Path | None, typer.Option(
+        "--scenario", help="The scenario file of the run: its model draws what a trajectory alone cannot tell "
+                           "(a robot's links, a spacecraft's wheels and thrusters).")] = None,
+    frames: Annotated[int, typer.Option("--frames", help="Frame budget: at most this many samples are shown "
+                                                         "(>= 2).")] = 600,
+    axis: Annotated[str | None, typer.Option("--axis", help="Body axis whose trace on the unit sphere is drawn: "
+                                                            "x, y or z (default: the one along omega(0)).")] = None,
+) -> None:
+    """Write the offline 3-D viewer of a trajectory: one HTML file that opens by double-click, with no network.
+
+    The body (the uniform box of its principal moments), its axes, omega and L as arrows, the trace of a body
+    axis, the model's parts, the body rates beside it; play/pause, speed and a time slider (docs/viewer.md).
+    Bad input (not a tumble trajectory, an empty one, --frames < 2) exits with code 2 and writes nothing.
+    """
+    from tumble.viewer import write_html
+
+    with _exit_codes():
+        _check_outputs(output, None, inputs=(path,) + (() if scenario is None else (scenario,)))
+        model = None if scenario is None else scenarios.load(scenario).model
+        write_html(path, output, model=model, frames=frames, axis=axis)
+    _print_rows([("trajectory", str(path)), ("wrote", str(output))])
 
 
 # --------------------------------------------------------------------------

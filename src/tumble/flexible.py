@@ -316,7 +316,8 @@ def demo_flexible(out_dir) -> dict:
 
     Integrates with dop853 (rtol = atol = 1e-11) through the manoeuvre and 60 s after it,
     writes ``out_dir/flexible.nc`` (the flexible trajectory with its modal coordinates) and
-    ``out_dir/flexible.png`` (:func:`slew_figure`) atomically and returns a summary: the peak
+    ``out_dir/flexible.png`` (:func:`slew_figure`) and ``out_dir/flexible.html`` (the offline viewer,
+    :mod:`tumble.viewer`) atomically and returns a summary: the peak
     torque (N·m), the residual modal amplitudes after the manoeuvre (kg^½·m), the pointing
     jitter (peak and RMS, arcsec) and rate jitter (peak, arcsec/s) of the flexible hub after
     the manoeuvre, the final pointing error of the rigid body (arcsec), the largest total
@@ -346,9 +347,11 @@ def demo_flexible(out_dir) -> dict:
     }
     figure = slew_figure(flexible, rigid, T, _DEMO_SLEW["angle"])
     nc_path, png_path = os.path.join(out_dir, "flexible.nc"), os.path.join(out_dir, "flexible.png")
+    html_path = os.path.join(out_dir, "flexible.html")
     flexible.save(nc_path)
     write_atomic(png_path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
-    return {**summary, "nc": nc_path, "png": png_path}
+    flexible.to_html(html_path, model=fbody)
+    return {**summary, "nc": nc_path, "png": png_path, "html": html_path}
 
 
 def slew_figure(flexible: Trajectory, rigid: Trajectory, end: float, target: float):

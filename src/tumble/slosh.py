@@ -325,8 +325,8 @@ def demo_slosh(out_dir) -> dict:
     """Slosh-induced nutation growth of a minor-axis spinner (:data:`DEMO_BODY`).
 
     Spins the hub at 2 rad/s about its minor axis z with a small wobble, integrates 600 s
-    with dop853 (rtol = atol = 1e-11), writes ``out_dir/slosh.nc`` and ``out_dir/slosh.png``
-    (:func:`nutation_figure`) atomically and returns: the initial and final nutation angles
+    with dop853 (rtol = atol = 1e-11), writes ``out_dir/slosh.nc``, ``out_dir/slosh.png``
+    (:func:`nutation_figure`) and ``out_dir/slosh.html`` (the offline viewer, :mod:`tumble.viewer`) atomically and returns: the initial and final nutation angles
     (deg), the growth time constant (s), measured (:func:`growth_time_constant` over 2°–20°) and
     predicted by the linearisation about the steady spin (:func:`steady_spin_eigenvalues`), the largest
     relative change of ``|H|``, the relative energy change, whether the energy decreased at every
@@ -357,9 +357,11 @@ def demo_slosh(out_dir) -> dict:
     figure = nutation_figure(trajectory, angle, h, e, summary["growth_time_constant_linear_s"],
                              summary["energy_flat_spin"])
     nc_path, png_path = os.path.join(out_dir, "slosh.nc"), os.path.join(out_dir, "slosh.png")
+    html_path = os.path.join(out_dir, "slosh.html")
     trajectory.save(nc_path)
     write_atomic(png_path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
-    return {**summary, "nc": nc_path, "png": png_path}
+    trajectory.to_html(html_path, model=sbody)
+    return {**summary, "nc": nc_path, "png": png_path, "html": html_path}
 
 
 def nutation_figure(trajectory: Trajectory, angle: np.ndarray, momentum_norm: np.ndarray, total_energy: np.ndarray,

@@ -492,6 +492,24 @@ class Trajectory:
         ds = self.to_xarray()
         write_atomic(path, lambda tmp_path: ds.to_netcdf(tmp_path, engine=_ENGINE))
 
+    # -- viewer ------------------------------------------------------------------------
+
+    def to_html(self, path: str | os.PathLike, **options) -> None:
+        """Write the offline 3-D viewer of this trajectory to ``path``: one self-contained HTML file, atomically.
+
+        ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``) and what the page shows:
+        :func:`tumble.viewer.write_html` (``docs/viewer.md``).
+        """
+        from tumble.viewer import write_html
+
+        write_html(self, path, **options)
+
+    def _repr_html_(self) -> str | None:
+        """The viewer in a notebook cell (an ``<iframe>``; :func:`tumble.viewer.notebook_html`)."""
+        from tumble.viewer import notebook_html
+
+        return notebook_html(self)
+
     # -- figure ------------------------------------------------------------------------
 
     def plot(self, *, title: str | None = None) -> Figure:

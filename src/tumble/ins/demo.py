@@ -63,6 +63,8 @@ CONING_RANGES = {"none": (0.05, 1.0), "one-sample": (0.05, 0.5), "two-sample": (
 _GYRO_TOLERANCE = 1e-12            # rtol = atol of the gyroscope runs (dop853)
 _CONING_HALF_ANGLE = 0.01           # rad
 _CONING_FREQUENCY = 2.0 * math.pi   # rad/s
+_CONING_PERIODS_SHOWN = 2           # cone periods of the coning motion in ins_coning.html
+_CONING_FRAMES = 201                # its samples
 
 
 def _check_dir(out_dir) -> str:
@@ -86,7 +88,8 @@ def demo_gyroscope(out_dir) -> dict:
     """Simulate :data:`DEMO_GYRO` released with its axis horizontal, and its drift mechanisms.
 
     Writes ``ins_gyro_precession.png`` (azimuth and tilt of the axis over
-    0.4 s: cycloidal nutation about the mean precession) and
+    0.4 s: cycloidal nutation about the mean precession) with ``ins_gyro_precession.html`` (that
+    run in the offline viewer, :mod:`tumble.viewer`) and
     ``ins_gyro_drift.png`` (azimuth drift from imbalance with and without a
     spin-bearing drag of 2e-3 N·m, which slows the spin from 100 to 80 rad/s,
     and the tilt from a pivot friction of 1e-5 N·m, over 20 s, each against
@@ -121,6 +124,8 @@ def demo_gyroscope(out_dir) -> dict:
     top.set_title(f"gyro released at rest: I_s ω_s = {gyro.momentum:g} N·m·s, τ = {gyro.imbalance_torque:.3g} N·m, "
                   f"ω_n = {gyro.nutation_frequency:.4g} rad/s", fontsize=9)
     precession_png = _save(figure, os.path.join(out_dir, "ins_gyro_precession.png"))
+    precession_html = os.path.join(out_dir, "ins_gyro_precession.html")
+    released.to_html(precession_html, model=gyro)
 
     spin_drag, pivot_drag = 2e-3, 1e-5
     t = np.linspace(0.0, 20.0, 401)
@@ -157,6 +162,7 @@ def demo_gyroscope(out_dir) -> dict:
         "spin_drag_drift_error_rad": float(np.abs(dragged.phi - dragged_law).max()),
         "pivot_tilt_error_rad": float(np.abs(tilted.theta - math.pi / 2 - tilt_law).max()),
         "precession_png": precession_png,
+        "precession_html": precession_html,
         "drift_png": drift_png,
     }
 
@@ -166,6 +172,7 @@ def demo_coning(out_dir, *, points: int = 12) -> dict:
 
     Writes ``ins_coning.png`` (measured |drift| and the laws of
     :func:`~tumble.ins.coning.drift_law` against the update rate 1/T) and
+    ``ins_coning.html`` (two periods of the coning motion in the offline viewer), and
     returns, per algorithm, the update rates (Hz), measured and predicted
     drifts (rad/s, magnitudes) and the largest relative deviation from the
     law inside :data:`CONING_RANGES`.
@@ -198,6 +205,9 @@ def demo_coning(out_dir, *, points: int = 12) -> dict:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
     summary["png"] = _save(figure, os.path.join(out_dir, "ins_coning.png"))
+    summary["html"] = os.path.join(out_dir, "ins_coning.html")
+    coning.trajectory(np.linspace(0.0, _CONING_PERIODS_SHOWN * 2.0 * math.pi / coning.frequency,
+                                  _CONING_FRAMES)).to_html(summary["html"])
     return summary
 
 
@@ -211,7 +221,7 @@ def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
     rule). Three runs of the strapdown algorithm: error-free increments, angle
     random walk alone, and every error term. Writes ``ins_error.png`` (error
     angle against time, with ``N √(3t)``, the RMS angle random walk of three
-    axes) and ``ins_allan.png`` (Allan deviation of the same gyro at rest for
+    axes), ``ins_truth.html`` (the tumbling body in the offline viewer) and ``ins_allan.png`` (Allan deviation of the same gyro at rest for
     4 h at 10 Hz, with the N and B it recovers). Returns the final and
     largest errors (rad) of each run, the ARW prediction and the recovered N,
     B against the true ones.
@@ -248,6 +258,8 @@ def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
     ax.legend(fontsize=8)
     summary["arw_prediction_rad"] = float(errors.white_noise * math.sqrt(3 * t[-1]))
     summary["error_png"] = _save(figure, os.path.join(out_dir, "ins_error.png"))
+    summary["truth_html"] = os.path.join(out_dir, "ins_truth.html")
+    truth.to_html(summary["truth_html"])
 
     rest_dt = 0.1
     rest = errors.apply(np.zeros((round(4 * 3600.0 / rest_dt), 3)), rest_dt, np.random.default_rng(seed))

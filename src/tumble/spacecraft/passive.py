@@ -317,8 +317,9 @@ def demo_gravity_gradient(out_dir) -> dict:
     """A boom satellite (:data:`GG_SATELLITE`) released 5° pitch, 3° roll, 2° yaw off LVLH, 10 orbits.
 
     Writes ``gravity_gradient.nc`` (the trajectory), ``gravity_gradient.png``
-    (roll, pitch, yaw from LVLH against orbits) and
-    ``passive_gg_regions.png`` (the stability regions with the satellite) in
+    (roll, pitch, yaw from LVLH against orbits),
+    ``passive_gg_regions.png`` (the stability regions with the satellite) and
+    ``gravity_gradient.html`` (the offline viewer, :mod:`tumble.viewer`) in
     ``out_dir``, atomically. Returns the stability classification, the
     linear-theory frequencies (units of the orbit rate), the largest angle
     from LVLH (deg) and the paths written.
@@ -329,8 +330,10 @@ def demo_gravity_gradient(out_dir) -> dict:
     rel = attitude_in_lvlh(traj, GG_ORBIT)
     s = gravity_gradient_stability(GG_SATELLITE)
     paths = {key: os.path.join(out_dir, name) for key, name in
-             (("nc", "gravity_gradient.nc"), ("png", "gravity_gradient.png"), ("regions", "passive_gg_regions.png"))}
+             (("nc", "gravity_gradient.nc"), ("png", "gravity_gradient.png"), ("regions", "passive_gg_regions.png"),
+              ("html", "gravity_gradient.html"))}
     traj.save(paths["nc"])
+    traj.to_html(paths["html"])
     _save_png(_libration_figure(traj, GG_ORBIT, GG_SATELLITE), paths["png"])
     _save_png(gravity_gradient_stability_figure(GG_SATELLITE, label="boom satellite"), paths["regions"])
     return {
@@ -439,7 +442,8 @@ def demo_explorer1(out_dir, spacecraft: Explorer1 = EXPLORER1) -> dict:
 
     Integrates hub + damper (:meth:`Explorer1.spacecraft` through :func:`tumble.simulate`,
     dop853, rtol 1e-12) for ``spacecraft.duration`` s, writes
-    ``explorer1.nc`` and ``explorer1.png`` in ``out_dir`` atomically, and
+    ``explorer1.nc``, ``explorer1.png`` and ``explorer1.html`` (the offline viewer,
+    :mod:`tumble.viewer`) in ``out_dir`` atomically, and
     returns: the time constant measured (fit of ln θ for θ between 2θ₀ and
     0.2 rad) and estimated (s), the final nutation angle (deg) and spin axis
     (unit ``L`` in body axes), the relative drift of ``|L|`` and of the
@@ -449,15 +453,17 @@ def demo_explorer1(out_dir, spacecraft: Explorer1 = EXPLORER1) -> dict:
     _check_dir(out_dir)
     dm = spacecraft.damper()
     t = np.linspace(0.0, spacecraft.duration, int(round(spacecraft.duration * 2)) + 1)
-    traj = simulate(spacecraft.spacecraft(), spacecraft.omega0(), t=t, rtol=1e-12, atol=1e-12)
+    craft = spacecraft.spacecraft()
+    traj = simulate(craft, spacecraft.omega0(), t=t, rtol=1e-12, atol=1e-12)
     theta = _damper.nutation_angle(traj, [0.0, 0.0, 1.0])
     i_s, i_t = spacecraft.locked_moments()
     momentum = traj.momentum_inertial
     size = np.linalg.norm(momentum, axis=-1)
     energy = traj.energy
     final_axis = traj.momentum_body[-1] / size[-1]
-    paths = {"nc": os.path.join(out_dir, "explorer1.nc"), "png": os.path.join(out_dir, "explorer1.png")}
+    paths = {name: os.path.join(out_dir, f"explorer1.{name}") for name in ("nc", "png", "html")}
     traj.save(paths["nc"])
+    traj.to_html(paths["html"], model=craft)
     _save_png(explorer1_figure(traj, spacecraft), paths["png"])
     return {
         "time_constant_s": _damper.measured_time_constant(t, theta, window=(2 * spacecraft.nutation0, 0.2)),

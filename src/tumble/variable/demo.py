@@ -28,7 +28,8 @@ def demo_diver(out_dir) -> dict:
     ``diver_twist_rule.png`` (b), ``diver_513xd.png`` (c) and ``diver_513xd.nc``
     (the dive as a :class:`~tumble.Trajectory`; extras: ``inertia_t``,
     ``shape_momentum``, ``angular_momentum``, ``energy_rotational``,
-    ``joint_angles``, ``shape_energy``). Returns the numbers: somersaults and
+    ``joint_angles``, ``shape_energy``), and ``diver_513xd.html``, the dive
+    in the offline viewer (:mod:`tumble.viewer`). Returns the numbers: somersaults and
     twists of (a) and (c), the largest relative ``|L|`` drift, the final tilt
     of (c), the rule-of-thumb comparison of (b), and the paths written.
     ``out_dir`` must be an existing directory.
@@ -50,8 +51,9 @@ def demo_diver(out_dir) -> dict:
     }
     for name, fig in figures.items():
         write_atomic(paths[name], lambda tmp, fig=fig: fig.savefig(tmp, format="png", dpi=110))
-    nc_path = os.path.join(out_dir, "diver_513xd.nc")
+    nc_path, html_path = os.path.join(out_dir, "diver_513xd.nc"), os.path.join(out_dir, "diver_513xd.html")
     dive.trajectory.save(nc_path)
+    dive.trajectory.to_html(html_path, model=human)
     tilts = np.array(RULE_TILTS_DEG)
     moderate = (tilts >= 10.0) & (tilts <= 30.0)
     return {
@@ -69,6 +71,7 @@ def demo_diver(out_dir) -> dict:
         "dive_final_tilt_deg": float(np.degrees(dive.angles.tilt[-1])),
         "dive_momentum_drift": dive.momentum_drift,
         "nc": nc_path,
+        "html": html_path,
         **{f"png_{name}": path for name, path in paths.items()},
     }
 

@@ -1,0 +1,30 @@
+"""The scene of a body with an attitude and nothing more to draw: a rigid body, a gyroscope, a variable body.
+
+The body is the user's shape (``shape=``), else the equivalent box of the
+model's inertia (with its mass when the model is a :class:`tumble.RigidBody`
+that has one), else the equivalent box of the trajectory's ``inertia``
+(:func:`tumble.viewer._shapes.body_mesh`); the rest is
+:func:`~tumble.viewer.scenes._attitude.attitude_scene`.
+"""
+
+from __future__ import annotations
+
+from tumble.body import RigidBody
+from tumble.viewer._scene import check_model
+from tumble.viewer._shapes import body_mesh
+from tumble.viewer.scenes._attitude import attitude_scene
+
+__all__ = ["hub_mesh", "scene"]
+
+
+def hub_mesh(traj, body, shape):
+    """The mesh and its note of the body: ``shape``, else ``body`` (a RigidBody or None), else ``traj.inertia``."""
+    if isinstance(body, RigidBody):
+        return body_mesh(body.inertia, mass=body.mass, com=body.com, shape=shape)
+    return body_mesh(traj.inertia, shape=shape)
+
+
+def scene(traj, idx, model, options):
+    check_model(model, (RigidBody,), traj)
+    mesh, note = hub_mesh(traj, model, options.shape)
+    return attitude_scene(traj, idx, mesh=mesh, mesh_note=note, axis=options.axis, title=options.title)

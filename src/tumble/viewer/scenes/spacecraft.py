@@ -1,0 +1,108 @@
+"""The scene of a spacecraft: hub, reaction wheels spinning, CMG rotors on their gimbals, thruster firings, and
+the nadir and orbit-normal directions when there is an orbit.
+
+Drawn from the :class:`tumble.spacecraft.Spacecraft` (its parts) and its trajectory, all turned by the hub's
+``R(q)``:
+
+* the hub: the user's shape, else the equivalent box of ``hub`` (without wheels) or of the total inertia;
+* wheel ``i``: a disk on its axis ``a_i`` at its ``position`` (less the centre of mass), or, without one,
+  just outside the hub on its axis; its spin angle relative to the hub ``θ_i(t) = ∫ Ω_i dt`` is the
+  trapezoidal integral of the sampled ``wheel_speed`` over every sample (exact for speeds linear between
+  samples), shown by a spoke; a disk at ``θ`` has axes ``Rot(a_i, θ) Z(a_i)``, ``Z`` taking z onto ``a_i``;
+* CMG ``i``: its rotor disk on the spin axis ``s_i(δ) = cos δ s0_i + sin δ (g_i × s0_i)``, axes
+  ``Rot(g_i, δ) Z(s0_i)``, and its gimbal axis ``g_i`` as a line, just outside the hub along ``g_i``;
+* thruster ``i``: a plume from its position against its direction while ``thruster_firing`` is 1;
+* with an orbit: the nadir ``−r/|r|`` and the orbit normal ``r × v/|r × v|`` (inertial axes).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tumble.spacecraft import Spacecraft
+from tumble.viewer._scene import Lines, Solid, check_model
+from tumble.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
+from tumble.viewer.scenes._attitude import attitude_scene, rotations
+from tumble.viewer.scenes.rigid import hub_mesh
+
+__all__ = ["scene", "spin_angles"]
+
+_DISK = (0.22, 0.07)     # wheel and rotor disk radius and thickness, × the hub's half-diagonal
+_OUTSIDE = 1.05          # a part without a position sits at this × the half-diagonal along its axis
+_PLUME = 0.5             # plume length, × the half-diagonal
+
+
+def spin_angles(t: np.ndarray, speed: np.ndarray) -> np.ndarray:
+    """``θ(t) = ∫ Ω dt`` from ``t[0]`` (rad), trapezoidal over the samples: ``t`` (n,), ``speed`` (n, k) rad/s."""
+    steps = 0.5 * (speed[1:] + speed[:-1]) * np.diff(t)[:, None]
+    return np.concatenate([np.zeros((1, speed.shape[1])), np.cumsum(steps, axis=0)])
+
+
+def _about(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """Rotations (F, 3, 3) by ``angle`` (F,) about the unit ``axis`` (3,): Rodrigues' formula."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + np.sin(angle)[:, None, None] * k + (1.0 - np.cos(angle))[:, None, None] * (k @ k)
+
+
+def _rotor(radius: float, thickness: float) -> tuple[Mesh, Mesh]:
+    """A disk along z and its spoke (a bar along x standing proud of the disk's faces)."""
+    spoke = box_mesh([radius, 0.25 * radius, 1.6 * thickness]).moved(np.eye(3), [0.5 * radius, 0.0, 0.0])
+    return cylinder_mesh(radius, thickness), spoke
+
+
+def scene(traj, idx, model, options):
+    check_model(model, (Spacecraft,), traj)
+    craft = model if isinstance(model, Spacecraft) else None
+    body = None if craft is None else (craft.hub if craft.hub is not None else craft.body)
+    mesh, note = hub_mesh(traj, body, options.shape)
+    scene = attitude_scene(traj, idx, mesh=mesh, mesh_note=note, axis=options.axis, title=options.title, body="hub")
+    if craft is None:
+        scene.notes.append("wheels, gyros and thrusters not drawn: their geometry is in the model (pass model=)")
+        return scene
+    half = float(np.linalg.norm(mesh.vertices, axis=-1).max())
+    com = np.zeros(3) if craft.body.com is None else craft.body.com
+    R = rotations(traj.q[idx])
+    disk, spoke = _rotor(_DISK[0] * half, _DISK[1] * half)
+    if craft.wheels:
+        theta = spin_angles(traj.t, traj.wheel_speed)[idx]
+        for i, wheel in enumerate(craft.wheels):
+            where = (wheel.position - com) if wheel.position is not None else _OUTSIDE * half * wheel.axis
+            axes = R @ _about(wheel.axis, theta[:, i]) @ turn_z_to(wheel.axis)
+            position = np.einsum("fij,j->fi", R, where)
+            scene.solids.append(Solid(f"wheel {i + 1}", disk, axes, position, "#7f7f7f"))
+            scene.solids.append(Solid(f"wheel {i + 1} spoke", spoke, axes, position, "#ffffff", legend=False))
+        scene.notes.append("wheels: disks on their axes (at their positions, or just outside the hub); the spoke "
+                           "turns by the spin angle relative to the hub, the integral of the sampled wheel speed "
+                           "(at the frames: a fast wheel aliases)")
+    if craft.cmgs is not None:
+        gimbal = traj.gimbal_angle[idx]
+        for i, (g, s0) in enumerate(zip(craft.cmgs.gimbal_axes, craft.cmgs.spin_axes)):
+            where = _OUTSIDE * half * g
+            axes = R @ _about(g, gimbal[:, i]) @ turn_z_to(s0)
+            position = np.einsum("fij,j->fi", R, where)
+            scene.solids.append(Solid(f"CMG {i + 1} rotor", disk, axes, position, "#8c564b"))
+            ends = np.array([where - 0.4 * half * g, where + 0.4 * half * g])
+            scene.lines.append(Lines(f"CMG {i + 1} gimbal axis", np.einsum("fij,pj->fpi", R, ends), "#8c564b",
+                                     width=3.0, legend=False))
+        scene.notes.append("CMGs: each rotor disk spins about s(δ), turned about its gimbal axis (line) by the "
+                           "gimbal angle δ")
+    if craft.thrusters:
+        firing = traj.thruster_firing[idx] > 0.5
+        for i, thruster in enumerate(craft.thrusters):
+            ends = np.array([thruster.position - com, thruster.position - com - _PLUME * half * thruster.direction])
+            plume = np.einsum("fij,pj->fpi", R, ends)
+            plume[~firing[:, i]] = np.nan
+            scene.lines.append(Lines(f"thruster {i + 1} firing", plume, "#ff7f0e", width=9.0))
+        scene.notes.append("thrusters: a plume (against the thrust) while the thruster fires")
+    if craft.orbit is not None:
+        r, v = craft.orbit.state(traj.t[idx])
+        normal = np.cross(r, v)
+        for name, direction, color in (("nadir", -r, "#2ca02c"), ("orbit normal", normal, "#e377c2")):
+            unit = direction / np.linalg.norm(direction, axis=-1, keepdims=True)
+            scene.lines.append(Lines(name, np.stack([np.zeros_like(unit), 1.6 * half * unit], axis=1), color,
+                                     width=3.0, markers=True))
+        scene.notes.append("nadir −r/|r| and orbit normal r × v/|r × v| of the orbit, inertial axes")
+    for solid in scene.solids[1:]:
+        reach = np.linalg.norm(solid.position, axis=-1).max() + np.linalg.norm(solid.mesh.vertices, axis=-1).max()
+        scene.extent = max(scene.extent, 1.1 * float(reach))
+    return scene
