@@ -35,7 +35,7 @@ def local_cluster(workers: int | None = None):
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
     return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                        dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"})
+                        dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
 
 
 def _run_chunk(plan: Plan, k: int):
