@@ -77,9 +77,9 @@ class NutationAngle:
         object.__setattr__(self, "axis", tuple((a / np.linalg.norm(a)).tolist()))
 
     def __call__(self, traj: Trajectory) -> np.ndarray:
-        momentum = traj.momentum_body
-        a = np.array(self.axis)
-        return np.arctan2(np.linalg.norm(np.cross(a, momentum), axis=-1), momentum @ a)
+        from tumble.spacecraft.damper import nutation_angle  # the one implementation
+
+        return nutation_angle(traj, self.axis)
 
 
 @dataclass(frozen=True)

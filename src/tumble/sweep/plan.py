@@ -250,6 +250,12 @@ def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, t
     parameters = set(inspect.signature(model).parameters) if builder else (
         {"inertia"} if isinstance(model, RigidBody) or isinstance(model, (list, np.ndarray)) else set())
     names = list(dispersions) + list(fixed)
+    if builder:
+        required = [p.name for p in inspect.signature(model).parameters.values()
+                    if p.default is inspect.Parameter.empty and p.name not in dispersions]
+        if required:
+            raise ValidationError(f"dispersions: the model's build function {describe(model)} needs "
+                                  f"{', '.join(map(repr, required))} (a dispersion, or a fixed value)")
     probe = model(**{n: d.values(np.zeros((1, d.n_raw)), np.zeros(1, dtype=int))[0]
                      for n, d in dispersions.items() if n in parameters}) if builder else model
     fields = {f.name: f for f in as_model(probe).state_fields()}
