@@ -51,7 +51,7 @@ from tumble.sweep.plan import _is_builder, make_plan
 from tumble.sweep.runner import local_cluster, run_chunks
 from tumble.sweep.store import SweepStore
 
-__all__ = ["sweep", "open_sweep", "local_cluster", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
+__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
            "Component", "Max", "Final", "SettlingTime", "CrossingTime"]
 
@@ -138,6 +138,9 @@ def sweep(
         ``chunks_computed``: the chunks this call computed.
     """
     times = output_times(t)
+    if _is_scenario(model):
+        raise ValidationError("model: a scenario sweeps with sweep_scenario(scenario, ...) (its [sweep] table "
+                              "gives the dispersions, times and solver)")
     if not _is_builder(model):
         as_model(model)  # refuse what is not a model before anything else
     m, options = _solver_options(as_model(model) if not _is_builder(model) else None, method,
@@ -157,6 +160,26 @@ def sweep(
     ds = result.dataset()
     ds.attrs["chunks_computed"] = computed
     return ds
+
+
+def _is_scenario(model) -> bool:
+    from tumble.scenario import Scenario
+
+    return isinstance(model, Scenario)
+
+
+def sweep_scenario(scenario, *, samples: int | None = None, store=None, client=None, workers: int | None = None,
+                   progress: Callable[[int, int], None] | None = None, retries: int = 2):
+    """:func:`sweep` of a scenario (a :class:`tumble.scenario.Scenario` or the path of its file) as its
+    ``[sweep]`` table describes (:mod:`tumble.scenario.sweep`); ``samples`` overrides the table's."""
+    from tumble.scenario import load
+    from tumble.scenario.sweep import sweep_arguments
+
+    if not _is_scenario(scenario):
+        scenario = load(scenario)
+    arguments = sweep_arguments(scenario, samples=samples)
+    return sweep(arguments.pop("model"), arguments.pop("dispersions"), store=store, client=client,
+                 workers=workers, progress=progress, retries=retries, **arguments)
 
 
 def open_sweep(path):

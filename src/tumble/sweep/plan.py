@@ -174,7 +174,7 @@ class Plan:
             "seed": int(self.seed),
             "samples": int(self.samples),
             "chunk": int(self.chunk),
-            "t": f"{t.size} times from {t[0]!r} to {t[-1]!r} s, sha256 {hashlib.sha256(t.tobytes()).hexdigest()}",
+            "t": f"{t.size} times from {float(t[0])!r} to {float(t[-1])!r} s, sha256 {hashlib.sha256(t.tobytes()).hexdigest()}",
             "method": self.method,
             "options": {k: float(v) for k, v in self.options.items()},
             "torque": "none" if self.torque is None else describe(self.torque) if inspect.isfunction(
@@ -247,10 +247,11 @@ def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, t
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
     builder = _is_builder(model)
-    parameters = set(inspect.signature(model).parameters) if builder else (
+    named = getattr(model, "parameters", None) if builder else None  # a scenario's model: its dotted keys
+    parameters = set(named) if named is not None else set(inspect.signature(model).parameters) if builder else (
         {"inertia"} if isinstance(model, RigidBody) or isinstance(model, (list, np.ndarray)) else set())
     names = list(dispersions) + list(fixed)
-    if builder:
+    if builder and named is None:
         required = [p.name for p in inspect.signature(model).parameters.values()
                     if p.default is inspect.Parameter.empty and p.name not in dispersions]
         if required:
