@@ -335,3 +335,49 @@ def test_a_run_too_big_for_memory_is_refused_before_allocation():
     with pytest.raises(tumble.ValidationError, match=r"^store: 1000000 members x 100000 output times need at least "
                                                      r"14,400,000,000,000 bytes .* pass store="):
         tumble.simulate(BODY, np.zeros((1_000_000, 3)), t=np.linspace(0.0, 1.0, 100_000), method="rk4", dt=1e-5)
+
+
+# -- scenario files and the command line ----------------------------------------------
+
+SPINNER = Path(__file__).parents[1] / "examples" / "sweep" / "spinner.toml"
+
+
+def test_tumble_sweep_of_a_scenario_file_writes_the_store_and_the_figure(tmp_path):
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    runner = CliRunner()
+    store, figure = tmp_path / "spinner.zarr", tmp_path / "spinner.png"
+    result = runner.invoke(app, ["sweep", str(SPINNER), "-o", str(store), "--samples", "12", "--workers", "0",
+                                 "--plot", str(figure), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert "samples   12 (seed 2026), 1 of 1 chunks of 50 done" in result.output
+    assert figure.stat().st_size > 10_000
+    # the same sweep from Python: the scenario's model rebuilt per sample with its dispersed inertia
+    ds = tumble.sweep.sweep_scenario(SPINNER, samples=12, workers=0)
+    stored = tumble.sweep.open_sweep(store)
+    for name in ("body.inertia", "omega0", "q0", "nutation", "nutation_angle"):
+        np.testing.assert_array_equal(stored[name].values, ds[name].values, err_msg=name)
+    j = ds["body.inertia"].values
+    traj = tumble.simulate(j, t=ds.time.values, method="rk4", dt=0.01, omega0=ds.omega0.values, q0=ds.q0.values)
+    np.testing.assert_array_equal(ds.nutation.values, Max(NutationAngle([0.0, 0.0, 1.0]))(traj))
+    info = runner.invoke(app, ["info", str(store)])
+    assert info.exit_code == 0 and "a sweep, complete" in info.output and "nutation  1%:" in info.output
+
+
+def test_a_bad_sweep_table_exits_2_and_writes_nothing(tmp_path):
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    text = SPINNER.read_text().replace('"initial.q" = { uniform_attitude = true }',
+                                       '"time.stop" = { uniform = { low = 10.0, high = 20.0 } }\n'
+                                       '"initial.q" = { normal = { mean = 1.0, std = -1.0 } }')
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    result = CliRunner().invoke(app, ["sweep", str(bad), "-o", str(tmp_path / "out.zarr"), "--workers", "0"])
+    assert result.exit_code == 2
+    assert "sweep.dispersions.time.stop: the samples of a sweep share time, solver, torque" in result.output
+    assert "sweep.dispersions.initial.q: std: must be >= 0" in result.output
+    assert sorted(os.listdir(tmp_path)) == ["bad.toml"]
