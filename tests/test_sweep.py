@@ -92,8 +92,10 @@ def test_sweep_results_do_not_depend_on_the_chunk_size():
 
 
 def test_sweep_equals_the_batch_run_through_simulate():
-    ds = tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=7, **RUN)
+    ds = tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=7, trajectories=True, **RUN)
     traj = tumble.simulate(BODY, t=T, **RK4, omega0=ds.omega0.values, q0=ds.q0.values)
+    for name in ("q", "omega", "energy", "momentum_body"):  # every sample's run, sample-major
+        np.testing.assert_array_equal(ds[name].values, np.swapaxes(getattr(traj, name), 0, 1), err_msg=name)
     np.testing.assert_array_equal(ds.nutation.values, OUTCOMES["nutation"](traj))
     np.testing.assert_array_equal(ds.pointing.values, OUTCOMES["pointing"](traj))
     w = traj.omega[..., 2]

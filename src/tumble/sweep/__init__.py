@@ -75,6 +75,7 @@ def sweep(
     outcomes: Mapping[str, Callable] | None = None,
     statistics: Mapping[str, Callable] | None = None,
     percentiles=PERCENTILES,
+    trajectories: bool = False,
     chunk: int | None = None,
     store=None,
     client=None,
@@ -110,6 +111,10 @@ def sweep(
         min, max and ``percentiles``.
     percentiles : sequence of numbers in [0, 100]
         Kept for every outcome and, per output time, for every series.
+    trajectories : bool
+        Also keep every sample's trajectory: ``q`` (sample, time, 4), ``omega``
+        (sample, time, 3), the model's extras and totals, chunked by sample
+        (with a store, they go to disk as the chunks come).
     chunk : int
         Samples per Dask task (default: a chunk's run takes about 200 MB,
         ``tumble.ensemble.SAMPLES_PER_CHUNK`` body-samples, at most ``samples``).
@@ -152,7 +157,7 @@ def sweep(
         raise ValidationError(f"percentiles: must lie in [0, 100], got {list(percentiles)}")
     plan = make_plan(model, dispersions or {}, samples=samples, seed=seed, chunk=chunk, t=times, method=m.name,
                      options=options, torque=torque, outcomes=dict(outcomes or {}), series=dict(statistics or {}),
-                     fixed=initial_state)
+                     fixed=initial_state, trajectories=trajectories)
     result = SweepStore(store, plan)
     computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
     if computed or not result.complete or not result.has_percentiles(percentiles):

@@ -48,13 +48,15 @@ __all__ = ["Plan", "ChunkResult", "make_plan"]
 @dataclass(frozen=True)
 class ChunkResult:
     """What one chunk ``[lo, hi)`` gives: per-sample ``inputs``, ``outcomes`` (name → (m, ...)) and
-    ``series`` (name → (m, n): one row per sample, one column per output time)."""
+    ``series`` (name → (m, n): one row per sample, one column per output time) and, when asked, the
+    ``trajectories`` (``q``, ``omega``, the extras and totals: name → (m, n, ...))."""
 
     lo: int
     hi: int
     inputs: dict
     outcomes: dict
     series: dict
+    trajectories: dict
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,7 @@ class Plan:
     seed, samples, chunk : the random seed, the number of samples, the samples per chunk (a Dask task)
     t, method, options, torque : the arguments of :func:`tumble.simulate`
     outcomes, series : name → function of a chunk's trajectory (:mod:`tumble.sweep.outcomes`)
+    trajectories : keep every sample's trajectory (``q``, ``omega``, the extras and totals) too
     """
 
     model: object
@@ -84,6 +87,7 @@ class Plan:
     torque: object
     outcomes: dict
     series: dict
+    trajectories: bool = False
     grid: tuple = field(init=False)
 
     def __post_init__(self):
@@ -139,7 +143,13 @@ class Plan:
                 raise ValidationError(f"statistics[{name!r}]: must give one value per output time and sample "
                                       f"({len(self.t)}, {m}), got shape {value.shape}")
             series[name] = np.ascontiguousarray(value.T)
-        return ChunkResult(lo, hi, inputs, outcomes, series)
+        kept = {}
+        if self.trajectories:  # sample-major, as the store is chunked
+            momentum = traj.momentum_body if traj.q is not None or "momentum_body" in traj.totals else None
+            fields = {"q": traj.q, "omega": traj.omega, **{name: e.data for name, e in traj.extras.items()},
+                      "energy": traj.energy, "momentum_body": momentum}
+            kept = {name: np.ascontiguousarray(np.swapaxes(v, 0, 1)) for name, v in fields.items() if v is not None}
+        return ChunkResult(lo, hi, inputs, outcomes, series, kept)
 
     def simulate(self, inputs: Mapping[str, np.ndarray]) -> Trajectory:
         """The batched trajectory (axes (time, member, ...)) of the samples whose inputs are ``inputs``."""
@@ -181,6 +191,7 @@ class Plan:
                 self.torque) else repr(self.torque),
             "outcomes": {name: describe(f) for name, f in self.outcomes.items()},
             "statistics": {name: describe(f) for name, f in self.series.items()},
+            "trajectories": self.trajectories,
         }
 
     def token(self) -> str:
@@ -224,7 +235,7 @@ def _stack(members: list[Trajectory]) -> Trajectory:
 
 
 def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, torque, outcomes, series,
-              fixed) -> Plan:
+              fixed, trajectories=False) -> Plan:
     """Check the names of a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
@@ -282,12 +293,13 @@ def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, t
     states = tuple(n for n in dispersions if n in fields and n not in parameters)
     for group, kind in ((outcomes, "outcomes"), (series, "statistics")):
         for name, f in group.items():
-            if not str(name).isidentifier() or name in dispersions or (kind == "statistics" and name in outcomes):
+            if (not str(name).isidentifier() or name in dispersions or (kind == "statistics" and name in outcomes)
+                    or (trajectories and name in ("q", "omega", "energy", "momentum_body"))):
                 raise ValidationError(f"{kind}[{name!r}]: names must be identifiers, different from the "
                                       f"dispersed inputs and from each other")
             describe(f)
     return Plan(model=model if builder else as_model(model) if "inertia" not in dispersions else model,
                 dispersions=dispersions, states=states, fixed=dict(fixed), seed=int(seed), samples=samples,
                 chunk=chunk, t=np.asarray(t, dtype=np.float64), method=method, options=options, torque=torque,
-                outcomes=dict(outcomes), series=dict(series))
+                outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
 

@@ -9,6 +9,7 @@ variable                    dimensions               what
 each dispersed input        (sample, NAME_dim0, ...) the sample's value (SI units)
 each outcome                (sample, ...)            one value per sample
 each series                 (sample, time)           one value per sample and output time
+``q``, ``omega``, extras    (sample, time, ...)      with ``trajectories=True``: every sample's run
 ``done``                    (chunk,)                 True once the chunk's results are written
 ``NAME_mean`` ... ``_max``  (time,)                  per-time mean, std (ddof 0), min, max of a series
 ``NAME_percentiles``        (percentile, time)       per-time percentiles of a series
@@ -61,6 +62,8 @@ class SweepStore:
         self.path = None if path is None else os.fspath(path)
         self.plan = plan
         self._memory = None
+        self._writable = None  # the group open for writing, once the store exists, and its arrays
+        self._arrays = {}
         self._done = np.zeros(plan.n_chunks, dtype=bool)
         if self.path is not None and os.path.exists(self.path):
             self._check()
@@ -70,7 +73,12 @@ class SweepStore:
     def _group(self, mode="r+"):
         import zarr
 
-        return zarr.open_group(self._memory if self.path is None else self.path, mode=mode, zarr_format=3)
+        if mode == "r+" and self._writable is not None:
+            return self._writable
+        group = zarr.open_group(self._memory if self.path is None else self.path, mode=mode, zarr_format=3)
+        if mode == "r+":
+            self._writable = group
+        return group
 
     @property
     def exists(self) -> bool:
@@ -125,6 +133,9 @@ class SweepStore:
         data = {name: empty(name, v, ("sample",)) for name, v in {**first.inputs, **first.outcomes}.items()}
         for name, v in first.series.items():
             data[name] = ("sample", "time"), da.zeros((s, len(plan.t)), chunks=(c, len(plan.t)))
+        for name, v in first.trajectories.items():
+            dims = ("sample", "time") + tuple(f"{name}_dim{k}" for k in range(v.ndim - 2))
+            data[name] = dims, da.zeros((s, *v.shape[1:]), chunks=(c, *v.shape[1:]))
         data["done"] = "chunk", da.zeros(plan.n_chunks, chunks=1, dtype=bool)
         ds = xr.Dataset(data, coords={"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})},
                         attrs={SETTINGS_ATTR: plan.settings(), COMPLETE_ATTR: False})
@@ -151,10 +162,16 @@ class SweepStore:
         if not self.exists:
             self._create(result)
         group = self._group()
-        for name, value in {**result.inputs, **result.outcomes, **result.series}.items():
-            group[name][result.lo:result.hi] = value
-        group["done"][k] = True
+        for name, value in {**result.inputs, **result.outcomes, **result.series, **result.trajectories}.items():
+            self._array(group, name)[result.lo:result.hi] = value
+        self._array(group, "done")[k] = True
         self._done[k] = True
+
+    def _array(self, group, name):
+        """The store's array ``name``, opened once."""
+        if name not in self._arrays:
+            self._arrays[name] = group[name]
+        return self._arrays[name]
 
     # -- statistics -------------------------------------------------------------------
 
@@ -191,5 +208,6 @@ class SweepStore:
         memory."""
         import xarray as xr
 
-        ds = xr.open_zarr(self._memory if self.path is None else self.path, consolidated=False, zarr_format=3)
-        return ds.load() if self.path is None else ds
+        if self.path is None:  # read here, not through whatever Dask scheduler is the default now
+            return xr.open_zarr(self._memory, consolidated=False, zarr_format=3, chunks=None).load()
+        return xr.open_zarr(self.path, consolidated=False, zarr_format=3)
