@@ -34,11 +34,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tumble._inertia import principal_axes
 from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.rigid import RigidBodies
 from tumble.simulate import Model, as_model, simulate
-from tumble.sweep.dispersions import Dispersion, Grid, as_dispersion, sample_stream
+from tumble.sweep.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_stream
 from tumble.sweep.outcomes import describe
 from tumble.trajectory import Extra, Trajectory
 
@@ -236,70 +237,101 @@ def _stack(members: list[Trajectory]) -> Trajectory:
 
 def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, torque, outcomes, series,
               fixed, trajectories=False) -> Plan:
-    """Check the names of a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
+    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
     dispersions = {str(name): as_dispersion(d, name) for name, d in dispersions.items()}
-    grid = math.prod(len(d) for d in dispersions.values() if isinstance(d, Grid))
-    if samples is None:
-        if not any(isinstance(d, Grid) for d in dispersions.values()) or any(d.n_raw for d in dispersions.values()):
-            raise ValidationError("samples: needed unless every dispersion is a grid (then one sample per point)")
-        samples = grid
-    samples = int(samples)
-    if samples < 1:
-        raise ValidationError(f"samples: must be >= 1, got {samples}")
-    if chunk is None:
-        from tumble.ensemble import SAMPLES_PER_CHUNK  # the same memory budget per chunk as the ensemble's
-
-        chunk = max(1, min(samples, SAMPLES_PER_CHUNK // len(t)))
-    chunk = int(chunk)
-    if chunk < 1:
-        raise ValidationError(f"chunk: must be >= 1 sample, got {chunk}")
+    samples, chunk = _sizes(dispersions, samples, chunk, len(t))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
     builder = _is_builder(model)
-    named = getattr(model, "parameters", None) if builder else None  # a scenario's model: its dotted keys
-    parameters = set(named) if named is not None else set(inspect.signature(model).parameters) if builder else (
-        {"inertia"} if isinstance(model, RigidBody) or isinstance(model, (list, np.ndarray)) else set())
-    names = list(dispersions) + list(fixed)
-    if builder and named is None:
-        required = [p.name for p in inspect.signature(model).parameters.values()
-                    if p.default is inspect.Parameter.empty and p.name not in dispersions]
-        if required:
-            raise ValidationError(f"dispersions: the model's build function {describe(model)} needs "
-                                  f"{', '.join(map(repr, required))} (a dispersion, or a fixed value)")
+    parameters = _parameters(model, dispersions)
     probe = model(**{n: d.values(np.zeros((1, d.n_raw)), np.zeros(1, dtype=int))[0]
                      for n, d in dispersions.items() if n in parameters}) if builder else model
     fields = {f.name: f for f in as_model(probe).state_fields()}
-    for name in names:
+    for name in list(dispersions) + list(fixed):
         if name not in fields and name not in parameters:
             known = ", ".join(sorted(fields) + sorted(parameters))
             raise ValidationError(f"dispersions[{name!r}]: not an initial state or a parameter of the "
                                   f"{'model built by ' + describe(model) if builder else type(probe).__name__}; "
                                   f"it takes {known}")
-    for name in fixed:
-        if name in dispersions:
+        if name in fixed and name in dispersions:
             raise ValidationError(f"{name}: given both as a dispersion and as a fixed value")
-    for name in (n for n in dispersions if n in fields):
-        d, want = dispersions[name], (fields[name].size,)
-        if d.shape != want and not (want == (1,) and d.shape == ()):
-            raise ValidationError(f"dispersions[{name!r}]: a value of shape {want} ({fields[name].description}), "
-                                  f"got {d.shape}")
-        if fields[name].quaternion and isinstance(d, Grid) and np.any(np.linalg.norm(d.points, axis=-1) == 0):
-            raise ValidationError(f"dispersions[{name!r}]: a zero quaternion")
-    if "inertia" in dispersions and not builder and dispersions["inertia"].shape != (3, 3):
-        raise ValidationError(f"dispersions['inertia']: must give (3, 3) tensors (kg m^2), got "
-                              f"{dispersions['inertia'].shape}")
     states = tuple(n for n in dispersions if n in fields and n not in parameters)
-    for group, kind in ((outcomes, "outcomes"), (series, "statistics")):
-        for name, f in group.items():
-            if (not str(name).isidentifier() or name in dispersions or (kind == "statistics" and name in outcomes)
-                    or (trajectories and name in ("q", "omega", "energy", "momentum_body"))):
-                raise ValidationError(f"{kind}[{name!r}]: names must be identifiers, different from the "
-                                      f"dispersed inputs and from each other")
-            describe(f)
-    return Plan(model=model if builder else as_model(model) if "inertia" not in dispersions else model,
+    for name in states:
+        _check_state(name, dispersions[name], fields[name])
+    if "inertia" in dispersions and not builder:
+        _check_inertia(dispersions["inertia"])
+    _check_reductions(outcomes, series, dispersions, trajectories)
+    return Plan(model=model if builder or "inertia" in dispersions else as_model(model),
                 dispersions=dispersions, states=states, fixed=dict(fixed), seed=int(seed), samples=samples,
                 chunk=chunk, t=np.asarray(t, dtype=np.float64), method=method, options=options, torque=torque,
                 outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
 
+
+def _sizes(dispersions: dict, samples, chunk, n_times: int) -> tuple[int, int]:
+    """The number of samples (default: one per grid point when every dispersion is a grid) and the chunk
+    (default: :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
+    if samples is None:
+        if not any(isinstance(d, Grid) for d in dispersions.values()) or any(d.n_raw for d in dispersions.values()):
+            raise ValidationError("samples: needed unless every dispersion is a grid (then one sample per point)")
+        samples = math.prod(len(d) for d in dispersions.values() if isinstance(d, Grid))
+    samples = int(samples)
+    if samples < 1:
+        raise ValidationError(f"samples: must be >= 1, got {samples}")
+    if chunk is None:
+        from tumble.ensemble import SAMPLES_PER_CHUNK
+
+        chunk = max(1, min(samples, SAMPLES_PER_CHUNK // n_times))
+    if int(chunk) < 1:
+        raise ValidationError(f"chunk: must be >= 1 sample, got {chunk}")
+    return samples, int(chunk)
+
+
+def _parameters(model, dispersions: dict) -> set:
+    """The parameters a sweep may disperse besides the initial state: a build function's (a scenario's
+    model names its dotted keys), ``inertia`` for a rigid body; a build function's required ones must be
+    given."""
+    if not _is_builder(model):
+        return {"inertia"} if isinstance(model, (RigidBody, list, np.ndarray)) else set()
+    named = getattr(model, "parameters", None)
+    if named is not None:
+        return set(named)
+    signature = inspect.signature(model).parameters
+    required = [p.name for p in signature.values() if p.default is inspect.Parameter.empty and p.name not in
+                dispersions]
+    if required:
+        raise ValidationError(f"dispersions: the model's build function {describe(model)} needs "
+                              f"{', '.join(map(repr, required))} (a dispersion, or a fixed value)")
+    return set(signature)
+
+
+def _check_state(name: str, d: Dispersion, state) -> None:
+    """A dispersed initial state: the shape of its field; no zero quaternion in a grid."""
+    want = (state.size,)
+    if d.shape != want and not (want == (1,) and d.shape == ()):
+        raise ValidationError(f"dispersions[{name!r}]: a value of shape {want} ({state.description}), got {d.shape}")
+    if state.quaternion and isinstance(d, Grid) and np.any(np.linalg.norm(d.points, axis=-1) == 0):
+        raise ValidationError(f"dispersions[{name!r}]: a zero quaternion")
+
+
+def _check_inertia(d: Dispersion) -> None:
+    """A rigid body's dispersed inertia: an :class:`Inertia` (physical by its rule) or a grid of tensors
+    that pass :func:`tumble._inertia.principal_axes` here, so that no sample can be refused later."""
+    if isinstance(d, Grid) and d.shape == (3, 3):
+        principal_axes(d.points, "dispersions['inertia']")
+    elif not isinstance(d, Inertia):
+        raise ValidationError(f"dispersions['inertia']: must be a tumble.sweep.Inertia (it stays physical) or a "
+                              f"Grid of (3, 3) tensors (kg m^2), got {type(d).__name__} of shape {d.shape}")
+
+
+def _check_reductions(outcomes: dict, series: dict, dispersions: dict, trajectories: bool) -> None:
+    """Outcome and series names: identifiers, none the name of a dispersed input, of each other or of a
+    kept trajectory field; each function describable in the store."""
+    taken = set(dispersions) | ({"q", "omega", "energy", "momentum_body"} if trajectories else set())
+    for group, kind in ((outcomes, "outcomes"), (series, "statistics")):
+        for name, f in group.items():
+            if not str(name).isidentifier() or name in taken or (kind == "statistics" and name in outcomes):
+                raise ValidationError(f"{kind}[{name!r}]: names must be identifiers, different from the "
+                                      f"dispersed inputs and from each other")
+            describe(f)
