@@ -366,7 +366,8 @@ def test_tumble_sweep_of_a_scenario_file_writes_the_store_and_the_figure(tmp_pat
     for name in ("body.inertia", "omega0", "q0", "nutation", "nutation_angle"):
         np.testing.assert_array_equal(stored[name].values, ds[name].values, err_msg=name)
     j = ds["body.inertia"].values
-    traj = tumble.simulate(j, t=ds.time.values, method="rk4", dt=0.01, omega0=ds.omega0.values, q0=ds.q0.values)
+    t = np.array(ds.time.values)  # writable, as the sweep's: a read-only array would compile another kernel
+    traj = tumble.simulate(j, t=t, method="rk4", dt=0.01, omega0=ds.omega0.values, q0=ds.q0.values)
     np.testing.assert_array_equal(ds.nutation.values, Max(NutationAngle([0.0, 0.0, 1.0]))(traj))
     info = runner.invoke(app, ["info", str(store)])
     assert info.exit_code == 0 and "a sweep, complete" in info.output and "nutation  1%:" in info.output

@@ -60,13 +60,13 @@ def local_client(reference):
 
 
 def stop(*processes):
-    """End processes this module started: SIGTERM to all, then SIGKILL to any not exited within 20 s."""
+    """End processes this module started: SIGTERM to all, then SIGKILL to any not exited within 5 s."""
     for process in processes:
         if process.poll() is None:
             process.terminate()
     for process in processes:
         try:
-            process.wait(timeout=20)
+            process.wait(timeout=5)
         except subprocess.TimeoutExpired:
             process.kill()
             process.wait(timeout=20)
