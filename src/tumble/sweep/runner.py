@@ -2,7 +2,7 @@
 
 By default the chunks run on a :class:`distributed.LocalCluster` started for
 the sweep and closed after it: one worker process per core, one thread each,
-listening on 127.0.0.1 only, with Numba held to one thread per process
+listening on 127.0.0.1 only (``workers=0``: in this process, without Dask), with Numba held to one thread per process
 (``NUMBA_NUM_THREADS=1``) so that the processes do not oversubscribe the
 cores. ``client=`` runs them on any existing cluster instead (a
 ``LocalCluster``, ``dask scheduler`` + ``dask worker`` processes on other
@@ -29,8 +29,8 @@ __all__ = ["local_cluster", "run_chunks"]
 
 
 def local_cluster(workers: int | None = None):
-    """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: one per core)
-    on 127.0.0.1, without a dashboard."""
+    """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: one per core),
+    every server on 127.0.0.1 (the scheduler's HTTP endpoint on a free port there)."""
     from distributed import LocalCluster
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
