@@ -86,6 +86,10 @@ def _where(bad: np.ndarray) -> str:
     return f" at index {idx[0] if len(idx) == 1 else idx}"
 
 
+#: Rotation angles (rad) above which :func:`from_rotvec` reduces modulo 4π: ``θ²`` overflows past ~1.3e154.
+_HUGE_ANGLE = 1e150
+
+
 def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
     """``q`` as a float64 (…, 4) array; with ``nonzero``, refuse q = 0 (it is no rotation)."""
     q = as_array(q, name, tail=(4,))
@@ -96,6 +100,12 @@ def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
                 f"{name}: must be non-zero to represent a rotation (|{name}| = 0{_where(zero)})"
             )
     return q
+
+
+def _scaled(q: np.ndarray) -> np.ndarray:
+    """``q`` divided by its largest |component| (non-zero): the same rotation, with components in [−1, 1] so that
+    squares neither underflow (``q = [1e-200, 1e-200, 0, 0]``) nor overflow."""
+    return q / np.abs(q).max(axis=-1, keepdims=True)
 
 
 def _flat(arr: np.ndarray, batch: tuple[int, ...], tail: tuple[int, ...]) -> np.ndarray:
@@ -368,9 +378,18 @@ def from_rotvec(r) -> np.ndarray:
     """Unit quaternion (…, 4) of rotation vectors ``r`` (…, 3, rad).
 
     ``q = exp(r/2) = [cos(θ/2), sin(θ/2) r/θ]`` with ``θ = |r|`` (a Taylor
-    series for ``θ < 1e-4``).
+    series for ``θ < 1e-4``). An angle past 1e150 rad, whose square would
+    overflow, is first reduced modulo 4π (the period of ``q``; :func:`numpy.fmod`
+    is exact), so that the result is a unit quaternion, not NaN.
     """
     r = as_array(r, "r", tail=(3,))
+    largest = np.abs(r).max(axis=-1, initial=0.0) if r.size else np.zeros(r.shape[:-1])
+    huge = largest > _HUGE_ANGLE
+    if np.any(huge):
+        unit = r[huge] / largest[huge][..., None]
+        norm = np.linalg.norm(unit, axis=-1)
+        r = r.copy()
+        r[huge] = unit / norm[..., None] * np.fmod(largest[huge] * norm, 4.0 * math.pi)[..., None]
     out = np.empty((math.prod(r.shape[:-1]), 4))
     _from_rotvec_loop(_flat(r, r.shape[:-1], (3,)), out)
     return out.reshape((*r.shape[:-1], 4))
@@ -378,7 +397,7 @@ def from_rotvec(r) -> np.ndarray:
 
 def to_rotvec(q) -> np.ndarray:
     """Rotation vector (…, 3, rad) of ``q / |q|``, angle ``θ = 2 atan2(|u|, |w|)`` in [0, π]."""
-    q = _as_quat(q)
+    q = _scaled(_as_quat(q))
     out = np.empty((math.prod(q.shape[:-1]), 3))
     _to_rotvec_loop(_flat(q, q.shape[:-1], (4,)), out)
     return out.reshape((*q.shape[:-1], 3))
@@ -389,7 +408,7 @@ def angle(q) -> np.ndarray:
 
     ``θ = 2 atan2(|u|, |w|)`` with ``q = [w, u]``: accurate near 0 and near π.
     """
-    q = _as_quat(q)
+    q = _scaled(_as_quat(q))
     out = np.empty(math.prod(q.shape[:-1]))
     _angle_loop(_flat(q, q.shape[:-1], (4,)), out)
     return out.reshape(q.shape[:-1])

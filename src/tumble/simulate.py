@@ -43,7 +43,7 @@ from tumble.trajectory import Extra, Trajectory
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
 
 #: Solver options when not given (those the method reads).
-DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": 10**9}
+DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
 
 
 @dataclass(frozen=True)
@@ -179,11 +179,13 @@ def simulate(
         Output times, s, strictly increasing; ``t[0]`` is the start.
     method : str, one of ``tumble.integrate.METHODS``
         ``"dop853"`` (default): adaptive 8th-order Dormand–Prince (``rtol``,
-        default 1e-10; ``atol``, default 1e-12; ``max_steps`` per body, default
-        1e9); ``"rk4"``, ``"cf4"`` (Lie group), ``"splitting2"``/``"splitting4"``
-        (Lie–Poisson, torque-free rigid bodies), ``"exact_split2"``/``"exact_split4"``
-        (exact free flow + torque kicks): fixed step ``dt`` (s); ``"exact"``: the
-        closed-form torque-free motion. A method the model does not provide for
+        default 1e-10; ``atol``, default 1e-12); ``"rk4"``, ``"cf4"`` (Lie group),
+        ``"splitting2"``/``"splitting4"`` (Lie–Poisson, torque-free rigid bodies),
+        ``"exact_split2"``/``"exact_split4"`` (exact free flow + torque kicks):
+        fixed step ``dt`` (s); ``"exact"``: the closed-form torque-free motion.
+        Every stepping method takes ``max_steps`` per body (default
+        ``tumble.integrate.MAX_STEPS`` = 1e8): a fixed-step run that needs more
+        is refused before it starts, an adaptive one stops there. A method the model does not provide for
         is refused, naming those that work; so is an option the method does not
         read. See ``docs/integrators.md``.
     torque
@@ -231,11 +233,28 @@ def simulate(
                                   f"progress reporting; got method={m.name!r} on {who}"
                                   + (" and a progress callback" if progress is not None else ""))
         y0 = model.initial_states(kernel, values, float(times[0]))
-        solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device, **options)
+        try:
+            solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device,
+                                       **options)
+        except integrate.Diverged as diverged:
+            raise _divergence(model, kernel, times, diverged) from None
         out = model.outputs(kernel, times, solution.states)
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
     return _trajectory(model, m.name, times, out, info, single=n is None)
+
+
+def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverged) -> integrate.SolverError:
+    """The message of a run whose state stopped being finite: the output time where it is first seen, and
+    the body rate at the output time before (the last finite state), from the model's own outputs."""
+    k, b = diverged.index, diverged.member
+    who = f"body {b}: " if diverged.states.shape[1] > 1 else ""
+    rate = ""
+    with np.errstate(all="ignore"):
+        omega = model.outputs(kernel, t[k - 1:k], diverged.states[k - 1:k]).omega if k > 0 else None
+    if omega is not None:
+        rate = f" (|ω| = {np.linalg.norm(omega[0, b]):.3g} rad/s at t = {t[k - 1]:g} s, the last finite state)"
+    return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: reduce dt or check the torque")
 
 
 def _describe(torque) -> str:

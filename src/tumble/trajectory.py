@@ -589,12 +589,53 @@ def _tumble_version() -> str:
     return str(getattr(tumble, "__version__", "unknown"))
 
 
+#: Largest ``||q| − 1|`` a trajectory file may hold: every method keeps ``|q| = 1`` to ~1e-13 over 1e8 steps
+#: (rounding, 1e-16 per step, adds like a random walk); a file past it was altered or damaged.
+UNIT_Q_TOL = 1e-9
+
+
 def load(path: str | os.PathLike) -> Trajectory:
-    """Read a trajectory written by :meth:`Trajectory.save` (arrays bitwise equal)."""
+    """Read a trajectory written by :meth:`Trajectory.save` (arrays bitwise equal), validated as it is built.
+
+    Refused with a :class:`ValidationError` naming the file: a path that is not a regular file (a FIFO, a
+    device: reading it could block for ever), variables larger than the memory can hold (checked from the
+    header, before reading them), any file the NetCDF/HDF5 readers cannot read, and contents that break the
+    rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤`` :data:`UNIT_Q_TOL`, and an
+    inertia tensor that is symmetric, positive semi-definite and meets the triangle inequality
+    (:func:`tumble._inertia.principal_axes`). A missing or unreadable path raises :class:`OSError`.
+    """
     import xarray as xr
 
-    ds = xr.load_dataset(path, engine=_ENGINE, decode_timedelta=False)
-    return Trajectory.from_xarray(ds)
+    from ._inertia import principal_axes
+    from ._validate import require_memory
+
+    if not stat.S_ISREG(os.stat(path).st_mode):
+        raise ValidationError(f"{os.fspath(path)}: not a regular file")
+    try:
+        with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False) as lazy:
+            nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
+            require_memory(nbytes, os.fspath(path), f"its {len(lazy.variables)} variables")
+            ds = lazy.load()
+        with np.errstate(all="ignore"):
+            traj = Trajectory.from_xarray(ds)
+    except ValidationError as exc:
+        raise ValidationError(f"{os.fspath(path)}: {exc}") from None
+    except (OSError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - a hostile file may make h5py/xarray raise anything
+        raise ValidationError(f"{os.fspath(path)}: not a readable tumble trajectory "
+                              f"({type(exc).__name__}: {exc})") from None
+    if traj.q is not None:
+        error = np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0)
+        if error.max(initial=0.0) > UNIT_Q_TOL:
+            k = tuple(int(i) for i in np.unravel_index(np.argmax(error), error.shape))
+            raise ValidationError(f"{os.fspath(path)}: q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
+                                  f"|q{list(k)}| = {np.linalg.norm(traj.q[k]):.17g}")
+        try:
+            principal_axes(traj.inertia, "inertia", definite=False)
+        except ValidationError as exc:
+            raise ValidationError(f"{os.fspath(path)}: {exc}") from None
+    return traj
 
 
 def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:

@@ -1,0 +1,87 @@
+"""Reliability (issue 18): no silent wrong answer, no unbounded run, one-line errors naming the field.
+
+Every run here is a RigidBody with rk4 or dop853 and no torque, single body, a few steps: the compiled
+specializations the rest of the suite already builds.
+"""
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble import integrate
+from tumble._validate import ValidationError
+from tumble.integrate import SolverError, _fixed
+
+BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+OMEGA0 = [1e-3, 1.0, 1e-3]
+
+
+# -- step counts: exact, bounded, checked before the run --------------------------------------------
+
+
+@pytest.mark.parametrize("t, dt, needed", [
+    ([0.0, 1e20], 1.0, "1e+20"),                  # the issue's reproducer: wrapped past 2**63 to one step
+    ([0.0, 1.0], 1e-300, "1e+300"),               # the scenario of the issue: "2 steps", exit 0
+    ([0.0, 1.0], 1e-18, "1e+18"),                 # ran for ever
+    ([0.0, 1e308, 1.7e308], 1e-300, "more than 1.8e308"),  # the quotient itself overflows to inf
+])
+def test_a_run_past_max_steps_is_refused_before_it_starts_saying_how_many_steps_it_needs(t, dt, needed):
+    with pytest.raises(ValidationError, match=rf"^max_steps: the run needs {re.escape(needed)} steps of dt = "):
+        tumble.simulate(BODY, OMEGA0, t=t, method="rk4", dt=dt)
+
+
+def test_the_refusal_says_which_max_steps_allows_the_run_and_that_value_runs_it():
+    with pytest.raises(ValidationError, match=r"more than max_steps = 10; give a larger dt, or max_steps=20 to allow"):
+        tumble.simulate(BODY, OMEGA0, t=[0.0, 1.0, 2.0], method="rk4", dt=0.1, max_steps=10)
+    traj = tumble.simulate(BODY, OMEGA0, t=[0.0, 1.0, 2.0], method="rk4", dt=0.1, max_steps=20)
+    assert traj.info["n_steps"] == 20  # 10 steps of 0.1 s per unit interval, exactly
+
+
+def test_landing_steps_are_exact_integers_near_the_float64_limit():
+    # 2**53 steps of 1 s are exact in float64 and in int64; one more second needs one more step
+    m, h = _fixed.landing_steps(np.array([0.0, 2.0**53]), 1.0, 2**53)
+    assert m.dtype == np.int64 and int(m[0]) == 2**53 and h[0] == 1.0
+    with pytest.raises(ValidationError, match=r"^max_steps: the run needs 9\.01e\+15 steps"):
+        _fixed.landing_steps(np.array([0.0, 2.0**53, 2.0**53 + 2.0]), 1.0, 2**53)
+
+
+@pytest.mark.parametrize("max_steps, rule", [
+    (0, r"must be >= 1"), (2**53 + 1, r"must be a whole number from 1 to 2\*\*53"),
+    (1.5, r"must be a whole number"), (math.inf, r"must be a whole number"), ("many", r"must be a whole number"),
+])
+def test_max_steps_must_be_a_whole_number_within_the_exact_range(max_steps, rule):
+    for method, option in (("rk4", {"dt": 0.1}), ("dop853", {})):
+        with pytest.raises(ValidationError, match=rf"^max_steps: {rule}"):
+            tumble.simulate(BODY, OMEGA0, t=[0.0, 1.0], method=method, max_steps=max_steps, **option)
+
+
+def test_every_stepping_method_reads_max_steps_and_the_default_is_bounded():
+    for name, m in integrate.METHODS.items():
+        assert ("max_steps" in m.options) == m.stepper, name
+    assert integrate.MAX_STEPS == 10**8 and tumble.simulate.__globals__["DEFAULTS"]["max_steps"] == 10**8
+
+
+# -- finite state -------------------------------------------------------------------------------------
+
+
+def test_a_diverged_run_names_the_time_and_the_rate_not_an_internal_parameter():
+    # rk4 with dt = 1 s on |ω| = 1e5 rad/s: h|ω| = 1e5 ≫ 2.8 (the stability limit), so |ω| grows by
+    # ~(h|ω|)^4 per step and overflows within a few output times
+    with pytest.raises(SolverError, match=r"^simulation diverged at t = \d+ s \(\|ω\| = \S+ rad/s at t = \d+ s, "
+                                          r"the last finite state\): reduce dt or check the torque$"):
+        tumble.simulate(BODY, [1e3, 1e5, 1e3], t=np.linspace(0.0, 10.0, 11), method="rk4", dt=1.0)
+
+
+# -- sizes checked before allocation -------------------------------------------------------------------
+
+
+def test_outputs_too_large_are_refused_with_the_bytes_needed():
+    # 10**6 bodies × 10**6 output times × 7 values × 8 bytes = 5.6e13 bytes (51 TiB): refused before anything
+    # is allocated (the inputs themselves are views of 24 MB)
+    omega0 = np.broadcast_to(OMEGA0, (10**6, 3))
+    with pytest.raises(ValidationError, match=r"^t: the states at 1000000 output times × 1000000 member\(s\) × 7 "
+                                              r"values need 50\.9 TiB \(5\.6e\+13 bytes\)"):
+        tumble.simulate(BODY, omega0, t=np.linspace(0.0, 1.0, 10**6), method="rk4", dt=1.0)
