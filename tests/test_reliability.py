@@ -83,5 +83,59 @@ def test_outputs_too_large_are_refused_with_the_bytes_needed():
     # is allocated (the inputs themselves are views of 24 MB)
     omega0 = np.broadcast_to(OMEGA0, (10**6, 3))
     with pytest.raises(ValidationError, match=r"^t: the states at 1000000 output times × 1000000 member\(s\) × 7 "
-                                              r"values need 50\.9 TiB \(5\.6e\+13 bytes\)"):
+                                              r"values need 50\.9 TiB \(5\.6e\+13 bytes\), more "
+                                              r"than half this machine's memory"):
         tumble.simulate(BODY, omega0, t=np.linspace(0.0, 1.0, 10**6), method="rk4", dt=1.0)
+
+
+# -- the small reproducers of the issue -------------------------------------------------------------
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: tumble.RigidBody.sphere(mass=1.0, radius=[1, 2]), r"^radius: must be a finite number > 0, got \[1, 2\]"),
+    (lambda: tumble.RigidBody.box(mass="heavy", size=[1.0, 2.0, 3.0]),
+     r"^mass: must be a finite number > 0, got 'heavy'"),
+])
+def test_shape_constructors_name_the_field_of_a_value_that_is_not_a_number(make, message):
+    with pytest.raises(ValidationError, match=message):
+        make()
+
+
+def test_to_rotvec_of_a_tiny_quaternion_is_its_rotation():
+    # [1e-200, 1e-200, 0, 0] is [1, 1, 0, 0]/|.|: a quarter turn about x (the squares underflowed to 0/0)
+    np.testing.assert_allclose(tumble.attitude.to_rotvec([1e-200, 1e-200, 0.0, 0.0]), [math.pi / 2, 0.0, 0.0],
+                               rtol=4 * np.finfo(float).eps)  # atan2 and one division: a few ulps
+
+
+def test_from_rotvec_of_a_huge_angle_is_a_unit_quaternion_of_that_angle_modulo_4pi():
+    q = tumble.attitude.from_rotvec([1e300, 0.0, 0.0])
+    # 1e300 mod 4π, exactly (fmod is exact), then q = [cos(θ/2), sin(θ/2), 0, 0]
+    theta = math.fmod(1e300, 4.0 * math.pi)
+    np.testing.assert_allclose(q, [math.cos(theta / 2), math.sin(theta / 2), 0.0, 0.0], rtol=0, atol=1e-15)
+    assert abs(np.linalg.norm(q) - 1.0) < 1e-15
+
+
+def test_a_torque_function_returning_none_is_named_with_what_it_returned():
+    with pytest.raises(ValidationError, match=r"^torque: the function no_torque\(t, q, omega\) must return 3 finite "
+                                              r"numbers .*; at t=0\.0 it returned None$"):
+        tumble.simulate(BODY, OMEGA0, t=[0.0, 1.0], method="rk4", dt=0.5, torque=no_torque)
+
+
+def no_torque(t, q, omega):
+    return None
+
+
+def _urdf(last_link: str) -> str:
+    return ('<robot name="r"><link name="base"/>' + last_link
+            + '<joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>'
+              '<limit lower="-1" upper="1"/></joint></robot>')
+
+
+@pytest.mark.parametrize("link, message", [
+    ('<link name="a"/>', r"^link 'a' <inertial>: the last moving link has no mass .*joint 'j1' would move nothing"),
+    ('<link name="a"><inertial><mass value="inf"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/>'
+     '</inertial></link>', r"^link 'a' <inertial> <mass>: value must be a finite number >= 0 kg, got inf"),
+])
+def test_urdf_links_without_mass_or_with_infinite_mass_are_refused_naming_the_element(link, message):
+    with pytest.raises(ValidationError, match=message):
+        tumble.robot.SerialChain.from_urdf(_urdf(link))

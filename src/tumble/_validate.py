@@ -126,17 +126,17 @@ def require_memory(nbytes: int, name: str, what: str) -> None:
     when it is more than half the machine's physical memory: checked before allocating, so that a hostile
     size is a one-line error, not an hour of swapping or a process killed for memory."""
     limit = memory_bytes() // 2
-    if nbytes > limit:
-        raise ValidationError(f"{name}: {what} need {_bytes(nbytes)}, more than half this machine's memory "
-                              f"({_bytes(2 * limit)}); ask for less")
+    if not nbytes <= limit:
+        exact = f"{float(nbytes):.2g} bytes" if np.isfinite(nbytes) else "more than 1.8e308 bytes"
+        raise ValidationError(f"{name}: {what} need {_binary(nbytes)} ({exact}), more than half this machine's "
+                              f"memory ({_binary(2 * limit)}); ask for less")
 
 
-def _bytes(n: float) -> str:
-    """``n`` bytes in binary units, e.g. ``"7.3 TiB (8.0e+12 bytes)"``."""
-    units = ["bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"]
-    k = 0
-    value = float(n)
+def _binary(n: float) -> str:
+    """``n`` bytes in binary units, e.g. ``"7.3 TiB"``."""
+    units = ["bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB", "ZiB", "YiB"]
+    k, value = 0, float(n)
     while value >= 1024.0 and k < len(units) - 1:
         value /= 1024.0
         k += 1
-    return f"{value:.1f} {units[k]} ({float(n):.2g} bytes)" if k else f"{int(n)} bytes"
+    return f"{value:.1f} {units[k]}" if np.isfinite(value) else "an unbounded amount"

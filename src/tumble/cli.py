@@ -146,7 +146,8 @@ def racket(
         omega0 = body.axes @ np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
         # t, q, omega and the totals (energy, momentum): 11 float64 per sample, twice over (states and result)
         samples = duration * _RACKET_SAMPLES_PER_SECOND + 1
-        require_memory(2 * 11 * 8 * samples, "--duration", f"the {samples:.3g} samples of {duration:g} s")
+        require_memory(2 * 11 * 8 * samples, "--duration", f"the samples of {duration:g} s "
+                                                           f"({_RACKET_SAMPLES_PER_SECOND} per second)")
         n = int(np.ceil(duration * _RACKET_SAMPLES_PER_SECOND))
         with _progress_bar("simulating", enabled=not quiet) as progress:
             traj = simulate(body, omega0, t=np.linspace(0.0, duration, n + 1),

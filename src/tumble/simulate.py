@@ -254,7 +254,8 @@ def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverge
         omega = model.outputs(kernel, t[k - 1:k], diverged.states[k - 1:k]).omega if k > 0 else None
     if omega is not None:
         rate = f" (|ω| = {np.linalg.norm(omega[0, b]):.3g} rad/s at t = {t[k - 1]:g} s, the last finite state)"
-    return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: reduce dt or check the torque")
+    change = "tighten rtol/atol" if integrate.METHODS[diverged.method].adaptive else "reduce dt"
+    return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: {change} or check the torque")
 
 
 def _describe(torque) -> str:

@@ -612,7 +612,7 @@ def load(path: str | os.PathLike) -> Trajectory:
     if not stat.S_ISREG(os.stat(path).st_mode):
         raise ValidationError(f"{os.fspath(path)}: not a regular file")
     try:
-        with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False) as lazy:
+        with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False, phony_dims="access") as lazy:
             nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
             require_memory(nbytes, os.fspath(path), f"its {len(lazy.variables)} variables")
             ds = lazy.load()

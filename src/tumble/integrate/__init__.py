@@ -63,11 +63,12 @@ class SolverError(RuntimeError):
 
 class Diverged(SolverError):
     """The state stopped being finite: ``index`` is the first output sample that is not, ``member`` the batch
-    member (:func:`tumble.simulate` turns it into a message naming the time and the body rate)."""
+    member, ``states`` the output samples, ``method`` the method's name (:func:`tumble.simulate` turns it into
+    a message naming the time and the body rate)."""
 
-    def __init__(self, message: str, index: int, member: int, states: np.ndarray):
+    def __init__(self, message: str, index: int, member: int, states: np.ndarray, method: str):
         super().__init__(message)
-        self.index, self.member, self.states = index, member, states
+        self.index, self.member, self.states, self.method = index, member, states, method
 
 
 @dataclass(frozen=True)
@@ -234,7 +235,7 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
 
         states, n_steps = _cuda.solve_cuda(model, y, t, dt, max_steps)
-        _raise_on_divergence(states, 0)
+        _raise_on_divergence(states, method)
         return Solution(states, n_steps, 0, 4 * n_steps)
     steps = _fixed.landing_steps(t, dt, max_steps) if method in _SCHEMES else None
     out = np.empty((n_out, y.shape[0], y.shape[1]))
@@ -246,7 +247,7 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
         chunk = None if steps is None else (steps[0][lo:hi], steps[1][lo:hi])
         _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
                    steps=chunk, rtol=rtol, atol=atol, max_steps=max_steps, serial=model.calls_python)
-        _raise_on_divergence(out, lo, hi)
+        _raise_on_divergence(out, method, lo, hi)
         _raise_on_failure(stats, t)
         if progress is not None:
             progress(hi + 1, n_out)
@@ -279,14 +280,14 @@ def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps,
         _dop853.dop853_batch(model, y, t, rtol, atol, max_steps, _dop853.tableau(), out, stats)
 
 
-def _raise_on_divergence(states, lo=0, hi=None):
+def _raise_on_divergence(states, method, lo=0, hi=None):
     """Raise :class:`Diverged` at the first output sample of ``states[lo:hi + 1]`` that is not finite."""
     rows = states[lo:None if hi is None else hi + 1]
     finite = np.isfinite(rows).reshape(rows.shape[0], rows.shape[1], -1).all(axis=2)
     if finite.all():
         return
     k, member = (int(i) for i in np.argwhere(~finite)[0])
-    raise Diverged(f"simulation diverged at output sample {lo + k} (body {member})", lo + k, member, states)
+    raise Diverged(f"simulation diverged at output sample {lo + k} (body {member})", lo + k, member, states, method)
 
 
 def _raise_on_failure(stats, t):
