@@ -86,8 +86,8 @@ def _where(bad: np.ndarray) -> str:
     return f" at index {idx[0] if len(idx) == 1 else idx}"
 
 
-#: Rotation angles (rad) above which :func:`from_rotvec` reduces modulo 4π: ``θ²`` overflows past ~1.3e154.
-_HUGE_ANGLE = 1e150
+#: The largest rotation angle (rad) :func:`from_rotvec` takes: past it the spacing of float64 numbers is 2 rad.
+_HUGE_ANGLE = 1e16
 
 
 def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
@@ -378,18 +378,19 @@ def from_rotvec(r) -> np.ndarray:
     """Unit quaternion (…, 4) of rotation vectors ``r`` (…, 3, rad).
 
     ``q = exp(r/2) = [cos(θ/2), sin(θ/2) r/θ]`` with ``θ = |r|`` (a Taylor
-    series for ``θ < 1e-4``). An angle past 1e150 rad, whose square would
-    overflow, is first reduced modulo 4π (the period of ``q``; :func:`numpy.fmod`
-    is exact), so that the result is a unit quaternion, not NaN.
+    series for ``θ < 1e-4``). An angle past :data:`_HUGE_ANGLE` (1e16 rad) is
+    refused: float64 angles there are 2 rad apart, so they define no rotation
+    (and ``θ²`` overflows past 1.3e154, which gave NaN).
     """
     r = as_array(r, "r", tail=(3,))
-    largest = np.abs(r).max(axis=-1, initial=0.0) if r.size else np.zeros(r.shape[:-1])
-    huge = largest > _HUGE_ANGLE
+    largest = np.abs(r).max(axis=-1, initial=0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        theta = largest * np.linalg.norm(r / np.where(largest > 0.0, largest, 1.0)[..., None], axis=-1)
+    huge = ~(theta <= _HUGE_ANGLE)
     if np.any(huge):
-        unit = r[huge] / largest[huge][..., None]
-        norm = np.linalg.norm(unit, axis=-1)
-        r = r.copy()
-        r[huge] = unit / norm[..., None] * np.fmod(largest[huge] * norm, 4.0 * math.pi)[..., None]
+        raise ValidationError(f"r: rotation angle |r| = {float(np.asarray(theta)[huge].flat[0]):.3g} rad{_where(huge)} "
+                              f"is past {_HUGE_ANGLE:g} rad, where float64 angles are 2 rad apart and define no "
+                              "rotation: reduce it modulo 2π first")
     out = np.empty((math.prod(r.shape[:-1]), 4))
     _from_rotvec_loop(_flat(r, r.shape[:-1], (3,)), out)
     return out.reshape((*r.shape[:-1], 4))
