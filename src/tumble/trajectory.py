@@ -32,11 +32,16 @@ described in ``docs/trajectory.md``.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import fcntl
+import glob
 import operator
 import os
+import signal
 import stat
 import tempfile
+import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -644,9 +649,18 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
     The temporary file (suffix ``.tmp``) is made in the directory of ``path``,
     so :func:`os.replace` is an atomic rename: readers see either the old file
     or the complete new one, never a partial file. On any exception, including
-    ``KeyboardInterrupt``, the temporary file is removed, a pre-existing
-    ``path`` is left untouched, and the exception propagates. The new file gets
-    the permissions of the file it replaces, or the default ``0o666 & ~umask``.
+    ``KeyboardInterrupt`` (SIGINT) and SIGTERM (turned into ``SystemExit(143)``
+    while the write runs, in the main thread), the temporary file is removed, a
+    pre-existing ``path`` is left untouched, and the exception propagates. The
+    new file gets the permissions of the file it replaces, or the default
+    ``0o666 & ~umask``.
+
+    One writer at a time: a writer holds an exclusive :func:`fcntl.flock` on the
+    sibling ``.NAME.lock`` (removed when it is done; the kernel releases the
+    lock of a killed process), and a second writer to the same path is refused
+    at once with :class:`FileExistsError` naming it (it neither waits nor
+    silently wins). Holding the lock, a writer removes the ``.NAME.*.tmp``
+    siblings left by killed runs (``kill -9``): no live writer owns them.
 
     ``write`` must not infer the format from the file name, which ends in
     ``.tmp``: e.g. ``write_atomic("fig.png", lambda p: fig.savefig(p, format="png"))``.
@@ -657,25 +671,62 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise FileNotFoundError(f"path: directory {directory!r} does not exist (writing {path!r})")
-    with tempfile.NamedTemporaryFile(
-        dir=directory, prefix=f".{os.path.basename(path)}.", suffix=".tmp", delete=False
-    ) as tmp:
-        tmp_path = tmp.name
+    name = os.path.basename(path)
+    with _exclusive(os.path.join(directory, f".{name}.lock"), path), _terminate_as_exit():
+        for stale in glob.glob(os.path.join(glob.escape(directory), f".{glob.escape(name)}.*.tmp")):
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(stale)
+        with tempfile.NamedTemporaryFile(dir=directory, prefix=f".{name}.", suffix=".tmp", delete=False) as tmp:
+            tmp_path = tmp.name
+        try:
+            write(tmp_path)
+            _set_mode(tmp_path, path)
+            fd = os.open(tmp_path, os.O_RDWR)
+            try:
+                os.fsync(fd)  # the data reach the disk before the rename makes them visible
+            finally:
+                os.close(fd)
+            os.replace(tmp_path, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(tmp_path)
+            raise
+
+
+@contextlib.contextmanager
+def _exclusive(lock_path: str, path: str):
+    """Hold an exclusive flock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
+    fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
     try:
-        write(tmp_path)
-        _set_mode(tmp_path, path)
-        fd = os.open(tmp_path, os.O_RDWR)
         try:
-            os.fsync(fd)  # the data reach the disk before the rename makes them visible
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise FileExistsError(f"{path}: another process is writing it now (it holds {lock_path}); wait for it "
+                                  "to finish, or write elsewhere") from None
+        try:
+            yield
         finally:
-            os.close(fd)
-        os.replace(tmp_path, path)
-    except BaseException:
-        try:
-            os.remove(tmp_path)
-        except FileNotFoundError:
-            pass
-        raise
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(lock_path)
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def _terminate_as_exit():
+    """While the block runs in the main thread, SIGTERM raises ``SystemExit(143)`` (so cleanups run)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def exit_(signum, frame):
+        raise SystemExit(128 + signal.SIGTERM)
+
+    previous = signal.signal(signal.SIGTERM, exit_)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def _set_mode(tmp_path: str, path: str) -> None:
