@@ -250,8 +250,11 @@ def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverge
     k, b = diverged.index, diverged.member
     who = f"body {b}: " if diverged.states.shape[1] > 1 else ""
     rate = ""
-    with np.errstate(all="ignore"):
-        omega = model.outputs(kernel, t[k - 1:k], diverged.states[k - 1:k]).omega if k > 0 else None
+    try:
+        with np.errstate(all="ignore"):
+            omega = model.outputs(kernel, t[k - 1:k], diverged.states[k - 1:k]).omega if k > 0 else None
+    except ValueError:  # a model may refuse states near overflow: the time alone is said
+        omega = None
     if omega is not None:
         rate = f" (|ω| = {np.linalg.norm(omega[0, b]):.3g} rad/s at t = {t[k - 1]:g} s, the last finite state)"
     change = "tighten rtol/atol" if integrate.METHODS[diverged.method].adaptive else "reduce dt"
