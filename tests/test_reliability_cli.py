@@ -56,8 +56,7 @@ def _altered(saved, tmp_path, name, change):
 @pytest.mark.parametrize("text, message, code", [
     (SCENARIO.format(stop=1.0) + '[solver]\nmethod = "rk4"\ndt = 1e-300\n', "max_steps: the run needs 1e+300 steps",
      2),
-    # dop853's step overflows t: the integrator gives up (exit code 1, as every solver failure)
-    (SCENARIO.format(stop=1e308), "simulation diverged at t = 5e+307 s", 1),
+    (SCENARIO.format(stop=1e308) + '[solver]\nmethod = "rk4"\ndt = 1.0\n', "max_steps: the run needs 1e+308 steps", 2),
     ("a = " + "{b = " * 1000 + "1" + "}" * 1000 + "\n", "bad.toml: ", 2),
 ], ids=["dt 1e-300", "stop 1e308", "1000-deep inline table"])
 def test_run_refuses_bad_scenarios_in_one_line(tmp_path, text, message, code):
@@ -92,7 +91,8 @@ def test_info_reads_the_undamaged_file(saved):
     ("q off the unit sphere", "q: must be unit quaternions (||q| - 1| <= 1e-09), |q[1]| = 0.99999818"),
     ("negative inertia", "inertia: must be positive semi-definite"),
     ("nan omega", "omega: must be finite"),
-    ("1e12 elements declared", "need 7.3 TiB (8e+12 bytes), more than half this machine's memory"),
+    ("1e12 elements declared", "variables: the 1 variable(s) it declares need 7.3 TiB (8e+12 bytes), more than half "
+                               "this machine's memory"),
 ])
 def test_info_refuses_damaged_and_hostile_files_in_one_line(saved, tmp_path, damage, message):
     path = tmp_path / "bad.nc"

@@ -619,7 +619,7 @@ def load(path: str | os.PathLike) -> Trajectory:
     try:
         with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False, phony_dims="access") as lazy:
             nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
-            require_memory(nbytes, os.fspath(path), f"its {len(lazy.variables)} variables")
+            require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
             ds = lazy.load()
         with np.errstate(all="ignore"):
             traj = Trajectory.from_xarray(ds)
