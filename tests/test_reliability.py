@@ -12,7 +12,8 @@ import pytest
 
 import tumble
 from tumble import integrate
-from tumble._validate import ValidationError
+from tumble import _validate
+from tumble._validate import ValidationError, require_memory
 from tumble.integrate import SolverError, _fixed
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
@@ -79,13 +80,20 @@ def test_a_diverged_run_names_the_time_and_the_rate_not_an_internal_parameter():
 
 
 def test_outputs_too_large_are_refused_with_the_bytes_needed():
-    # 10**6 bodies × 10**6 output times × 7 values × 8 bytes = 5.6e13 bytes (51 TiB): refused before anything
-    # is allocated (the inputs themselves are views of 24 MB)
+    # 10**6 bodies × 10**6 output times × (7 state + 11 output) values × 8 bytes = 1.44e14 bytes: refused before
+    # anything is allocated (the inputs themselves are views of 24 MB)
     omega0 = np.broadcast_to(OMEGA0, (10**6, 3))
-    with pytest.raises(ValidationError, match=r"^t: the states at 1000000 output times × 1000000 member\(s\) × 7 "
-                                              r"values need 50\.9 TiB \(5\.6e\+13 bytes\), more "
-                                              r"than half this machine's memory"):
+    with pytest.raises(ValidationError, match=r"^store: 1000000 members x 1000000 output times need at least "
+                                              r"144,000,000,000,000 bytes"):
         tumble.simulate(BODY, omega0, t=np.linspace(0.0, 1.0, 10**6), method="rk4", dt=1.0)
+
+
+def test_every_allocation_sized_from_input_is_checked_against_half_the_memory():
+    # the check of integrate.solve (for its direct callers), of tumble.load and of the demos
+    with pytest.raises(ValidationError, match=r"^t: the states need 50\.9 TiB \(5\.6e\+13 bytes\), more than half "
+                                              r"this machine's memory"):
+        require_memory(7 * 8 * 10**12, "t", "the states")
+    require_memory(_validate.memory_bytes() // 2, "t", "the states")  # exactly half: allowed
 
 
 # -- the small reproducers of the issue -------------------------------------------------------------

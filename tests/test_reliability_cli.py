@@ -84,7 +84,7 @@ def test_info_reads_the_undamaged_file(saved):
 @pytest.mark.parametrize("damage, message", [
     ("junk", "not a readable tumble trajectory"),
     ("truncated", "not a readable tumble trajectory"),
-    ("directory", "not a regular file"),
+    ("directory", "not a readable Zarr store"),  # a directory is read as a sweep's store
     ("fifo", "not a regular file"),
     ("missing", "not a readable tumble trajectory"),
     ("not a trajectory", "not a tumble trajectory (missing time, q, omega, inertia)"),

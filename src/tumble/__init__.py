@@ -32,7 +32,7 @@ __version__ = "0.1.0"
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
 _LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot")
+         "robot", "sweep")
 
 
 def __getattr__(name):
@@ -64,6 +64,7 @@ __all__ = [
     "simulate",
     "slosh",
     "spacecraft",
+    "sweep",
     "torques",
     "variable",
     "viz",

@@ -6,7 +6,8 @@
     tumble demo top [-o DIRECTORY] [--duration 1.5]
     tumble demo NAME [-o DIRECTORY]        (the demos of tumble._demos.DEMOS: diver, flexible, ...)
     tumble robot torques ROBOT_FILE --q ...
-    tumble info out.nc
+    tumble sweep SCENARIO.toml -o out.zarr [--samples N] [--scheduler ADDR] [--workers N] [--plot out.png]
+    tumble info out.nc | out.zarr
     tumble view out.nc -o out.html [--scenario SCENARIO.toml] [--frames 600] [--axis x]
     tumble --version
 
@@ -250,13 +251,86 @@ for _name, _demo in DEMOS.items():
     demo_app.command(_name)(_demo_command(_demo))
 
 
-@app.command()
-def info(path: Annotated[Path, typer.Argument(help="NetCDF file written by tumble run / tumble demo.")]) -> None:
-    """Print what a trajectory file holds: times, bodies, method, solver info and drifts.
+@app.command("sweep")
+def sweep_command(
+    scenario: Annotated[Path, typer.Argument(help="Scenario file (TOML) with a [sweep] table; see docs/sweeps.md.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Zarr store to write or resume (e.g. out.zarr).")],
+    samples: Annotated[int | None, typer.Option("--samples", help="Number of samples (default: the file's).")] = None,
+    scheduler: Annotated[str | None, typer.Option("--scheduler", help="Address of a running Dask scheduler, "
+                                                  "e.g. tcp://host:8786 (default: a local cluster).")] = None,
+    workers: Annotated[int | None, typer.Option("--workers", help="Worker processes of the local cluster "
+                                                "(default: one per core; 0: this process only).")] = None,
+    plot: Annotated[Path | None, typer.Option("--plot", help="Also write a PNG figure of the outcomes.")] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+) -> None:
+    """Run the Monte-Carlo or grid sweep of a scenario's [sweep] table on Dask; write its results to a Zarr store.
 
-    The file is validated as it is read (tumble.load): not a regular file, damaged, too large for the memory,
-    not unit quaternions or not a physical inertia: one line on stderr, exit code 2.
+    Running it again on the same store computes only the chunks not yet written. A bad file or a store of
+    another sweep is reported on stderr with exit code 2, and nothing is written.
     """
+    from tumble.sweep import sweep_scenario
+    from tumble.sweep.figure import sweep_figure
+
+    with _exit_codes():
+        spec = scenarios.load(scenario)
+        for option, path in (("--output", output), ("--plot", plot)):
+            if path is not None and not path.parent.is_dir():
+                raise ValidationError(f"{option}: directory {str(path.parent)!r} does not exist")
+        if plot is not None and (plot.is_dir() or plot.resolve() in (scenario.resolve(), output.resolve())):
+            raise ValidationError(f"--plot: {str(plot)!r} is a directory, the scenario or the store")
+        if scheduler is not None and workers is not None:
+            raise ValidationError("--workers: give it only without --scheduler (a scheduler has its own workers)")
+        client = None
+        if scheduler is not None:
+            from distributed import Client
+
+            try:
+                client = Client(scheduler, timeout=30)
+            except OSError as exc:
+                raise ValidationError(f"--scheduler: cannot reach {scheduler} ({exc})") from None
+        try:
+            with _progress_bar("sweeping", enabled=not quiet, unit="chunks") as progress:
+                ds = sweep_scenario(spec, samples=samples, store=output, client=client, workers=workers,
+                                    progress=progress)
+        finally:
+            if client is not None:
+                client.close()
+        if plot is not None:
+            figure = sweep_figure(ds, title=spec.name)
+            write_atomic(plot, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+    _print_rows([("scenario", f"{scenario}" + (f" ({spec.name})" if spec.name else "")), *_sweep_rows(ds),
+                 ("wrote", _written(output, plot))])
+
+
+def _sweep_rows(ds) -> list[tuple[str, str]]:
+    """Rows: samples and chunks, and each scalar outcome's percentiles."""
+    settings = ds.attrs["tumble_sweep"]
+    done = int(ds["done"].sum())
+    rows = [("samples", f"{settings['samples']} (seed {settings['seed']}), {done} of {ds.sizes['chunk']} chunks "
+                        f"of {settings['chunk']} done"),
+            ("method", f"{settings['method']} {settings['options']}, {settings['t']}")]
+    if "chunks_computed" in ds.attrs:
+        rows.append(("computed", f"{ds.attrs['chunks_computed']} chunks in this run"))
+    if "percentile" in ds.coords:
+        for name in settings["outcomes"]:
+            if ds[f"{name}_percentiles"].ndim == 1:
+                values = ", ".join(f"{p:g}%: {v:.6g}" for p, v in zip(ds.percentile.values,
+                                                                      ds[f"{name}_percentiles"].values, strict=True))
+                rows.append((name, values))
+    return rows
+
+
+@app.command()
+def info(path: Annotated[Path, typer.Argument(help="NetCDF file written by tumble run / tumble demo, or a Zarr "
+                                                    "store written by tumble sweep or simulate(store=).")]) -> None:
+    """Print what a trajectory file or a sweep's store holds: times, bodies, method, solver info and drifts.
+
+    A trajectory file is validated as it is read (tumble.load): not a regular file, damaged, too large for the
+    memory, not unit quaternions or not a physical inertia: one line on stderr, exit code 2.
+    """
+    if path.is_dir():
+        _info_store(path)
+        return
     with _exit_codes(path):
         try:
             traj = load(path)
@@ -303,6 +377,28 @@ def view(
         write_html(path, output, model=model, frames=frames, axis=axis)
     _print_rows([("trajectory", str(path)), ("wrote", str(output))])
 
+def _info_store(path: Path) -> None:
+    """``tumble info`` of a Zarr store: a sweep's samples and outcomes, or a streamed run's dimensions."""
+    import xarray as xr
+
+    with _exit_codes(path):
+        try:
+            ds = xr.open_zarr(path, consolidated=False)
+        except Exception as exc:  # noqa: BLE001 - a damaged store may make zarr raise anything
+            raise ValidationError(f"{path}: not a readable Zarr store ({type(exc).__name__}: {exc})") from None
+        if "tumble_sweep" in ds.attrs:
+            complete = "complete" if ds.attrs.get("tumble_sweep_complete") else "incomplete (run tumble sweep again)"
+            rows = [("store", f"{path}: a sweep, {complete}"), *_sweep_rows(ds)]
+        else:
+            sizes = ", ".join(f"{name} {size}" for name, size in ds.sizes.items())
+            rows = [("store", f"{path}: a run streamed by simulate(store=)"),
+                    ("model", str(ds.attrs.get("model", "?"))), ("sizes", sizes),
+                    ("times", f"{float(ds.time[0]):g} to {float(ds.time[-1]):g} s, {ds.sizes['time']} samples"),
+                    ("method", str(ds.attrs.get("method", "?")))]
+            rows += [("solver" if i == 0 else "", f"{key[7:]} = {value}")
+                     for i, (key, value) in enumerate((k, v) for k, v in ds.attrs.items() if k.startswith("solver_"))]
+    _print_rows(rows)
+
 
 # --------------------------------------------------------------------------
 # Helpers
@@ -325,12 +421,13 @@ def _check_outputs(output: Path, plot: Path | None, *, inputs: tuple[Path, ...] 
 
 
 @contextmanager
-def _progress_bar(description: str, *, enabled: bool) -> Iterator[Callable[[int, int], None] | None]:
+def _progress_bar(description: str, *, enabled: bool,
+                  unit: str = "samples") -> Iterator[Callable[[int, int], None] | None]:
     """A rich progress bar on stderr, as a ``progress(done, total)`` callback; ``None`` when not a terminal."""
     if not (enabled and _stderr.is_terminal):
         yield None
         return
-    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn("samples"),
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TextColumn(unit),
                TimeRemainingColumn())
     with Progress(*columns, console=_stderr, transient=True) as bar:
         task = bar.add_task(description, total=None)

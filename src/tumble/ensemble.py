@@ -115,9 +115,7 @@ def ensemble_statistics(
             if values.ndim < 2 or values.shape[:2] != (len(traj), hi - lo):
                 raise ValidationError(f"quantities[{name!r}]: must return an array (n_times, bodies, ...) = "
                                       f"({len(traj)}, {hi - lo}, ...), got shape {values.shape}")
-            part = [np.full(values.shape[:1] + values.shape[2:], float(hi - lo)), values.mean(axis=1),
-                    ((values - values.mean(axis=1, keepdims=True)) ** 2).sum(axis=1),
-                    values.min(axis=1), values.max(axis=1)]
+            part = moments(values)
             stats[name] = part if name not in stats else _merge(stats[name], part)
         if progress is not None:
             progress(hi, n_bodies)
@@ -134,6 +132,14 @@ def ensemble_statistics(
                            {"units": units, "description": description})
     return xr.Dataset(data_vars, coords={"time": ("time", times, {"units": "s"}), "statistic": list(STATISTICS)},
                       attrs={"bodies": n_bodies})
+
+
+def moments(values: np.ndarray) -> list[np.ndarray]:
+    """Statistics ``[count, mean, M₂, min, max]`` of ``values`` (n_times, members, ...) over the members
+    (axis 1), ``M₂ = Σ (x − x̄)²``: one chunk's part, merged with :func:`_merge`."""
+    mean = values.mean(axis=1)
+    return [np.full(values.shape[:1] + values.shape[2:], float(values.shape[1])), mean,
+            ((values - mean[:, None]) ** 2).sum(axis=1), values.min(axis=1), values.max(axis=1)]
 
 
 def _merge(a: list[np.ndarray], b: list[np.ndarray]) -> list[np.ndarray]:

@@ -160,6 +160,7 @@ def simulate(
     torque=None,
     progress: Callable[[int, int], None] | None = None,
     device: str = "cpu",
+    store=None,
     **initial_state,
 ) -> Trajectory:
     """Integrate any model through the output times ``t``: the one front door.
@@ -198,6 +199,13 @@ def simulate(
     device : {"cpu", "cuda"}
         ``"cuda"``: ``method="rk4"`` batches of rigid bodies on an NVIDIA GPU,
         one thread per body (compiled torque models only; ``docs/gpu.md``).
+    store : path of a Zarr store (a directory that does not exist), optional
+        Run the batch in chunks of members, each written to the store as it
+        completes, and return the run as a lazily opened ``xarray.Dataset``
+        (:mod:`tumble.sweep.stream`): memory bounded by a chunk, not by the
+        batch. Without it, a run whose states and outputs cannot fit in the
+        memory available is refused before they are allocated, with the bytes
+        it needs.
     **initial_state
         The model's initial state by name (:meth:`Model.state_fields`), e.g.
         ``q0`` (unit quaternion ``[w, x, y, z]``, body → inertial, default
@@ -215,6 +223,12 @@ def simulate(
     times = output_times(t)
     if omega0 is not None:
         initial_state["omega0"] = omega0
+    if store is not None:  # streamed in chunks by the layer above, each chunk through this function
+        from tumble.sweep.stream import simulate_to_store
+
+        return simulate_to_store(model, store, t=times, initial_state=initial_state, progress=progress,
+                                 options=dict(method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
+                                              torque=torque, device=device))
     m, options = _solver_options(model, method, dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if device not in ("cpu", "cuda"):
         raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
@@ -233,6 +247,7 @@ def simulate(
                                   f"progress reporting; got method={m.name!r} on {who}"
                                   + (" and a progress callback" if progress is not None else ""))
         y0 = model.initial_states(kernel, values, float(times[0]))
+        _check_memory(times.size, y0)
         try:
             solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device,
                                        **options)
@@ -259,6 +274,25 @@ def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverge
         rate = f" (|ω| = {np.linalg.norm(omega[0, b]):.3g} rad/s at t = {t[k - 1]:g} s, the last finite state)"
     change = "tighten rtol/atol" if integrate.METHODS[diverged.method].adaptive else "reduce dt"
     return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: {change} or check the torque")
+
+
+#: Output words per member and time beyond the states: q (4), omega (3), energy (1), momentum (3).
+_OUTPUT_WORDS = 11
+
+
+def _check_memory(n_times: int, y0: np.ndarray) -> None:
+    """Refuse a run whose sampled states and outputs (float64, ``n_times × members × (state + 11)`` words)
+    exceed the memory available now, before they are allocated: the error says how many bytes and
+    suggests ``store=``."""
+    import psutil
+
+    members, size = y0.shape
+    need = 8 * n_times * members * (size + _OUTPUT_WORDS)
+    available = psutil.virtual_memory().available
+    if need > available:
+        raise ValidationError(f"store: {members} members x {n_times} output times need at least {need:,} bytes "
+                              f"({need / 2**30:.1f} GiB) of memory, more than the {available:,} available; pass "
+                              "store='run.zarr' to stream the run to a Zarr store in chunks")
 
 
 def _describe(torque) -> str:

@@ -25,7 +25,9 @@ from tumble.integrate import _fixed
 ORDER = 4
 
 
-@register_jitable(inline="always")
+# Not inline="always": numba-cuda (0.68) binds the arguments of an IR-inlined register_jitable
+# as omitted ones on a real GPU (the CUDA simulator does not compile); LLVM inlines it anyway.
+@register_jitable
 def weighted_sum(h, k1, k2, k3, k4):
     """``h (k₁ + 2k₂ + 2k₃ + k₄)/6``: the RK4 increment from the four stage slopes (scalars or arrays).
 

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from pydantic import PrivateAttr
 
 from tumble.scenario._values import _Table, _Text
+from tumble.scenario.sweep import SweepTable
 from tumble.trajectory import Trajectory
 
 __all__ = ["Scenario"]
@@ -30,7 +31,11 @@ class Scenario(_Table):
     #: The kind of the file (a row of tumble.scenario.KINDS): given, or inferred from its tables.
     kind: _Text
 
+    #: ``[sweep]``: a Monte-Carlo or grid sweep of the scenario (:mod:`tumble.scenario.sweep`), or None.
+    sweep: SweepTable | None = None
+
     _source: str = PrivateAttr("<scenario>")
+    _data: dict = PrivateAttr(default_factory=dict)
 
     @property
     def source(self) -> str:

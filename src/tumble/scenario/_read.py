@@ -13,7 +13,7 @@ from tumble.scenario._errors import ScenarioError, describe, in_file, toml_probl
 from tumble.scenario.kinds import kind_of, scenario_class
 from tumble.trajectory import Trajectory
 
-__all__ = ["load", "parse", "run_scenario"]
+__all__ = ["load", "parse", "parse_data", "run_scenario"]
 
 
 def parse(text: str, *, source: str = "<string>") -> Scenario:
@@ -28,12 +28,18 @@ def parse(text: str, *, source: str = "<string>") -> Scenario:
         raise ScenarioError(source, [toml_problem(exc)]) from None
     with in_file(source):
         kind = kind_of(data)
-    cls = scenario_class(kind)
+    return parse_data(scenario_class(kind), {**data, "kind": kind}, source)
+
+
+def parse_data(cls: type[Scenario], data: dict, source: str) -> Scenario:
+    """Validate the parsed TOML ``data`` as a scenario of class ``cls``; it keeps ``data`` (a sweep rebuilds
+    its model from it with dispersed values in place)."""
     try:
-        scenario = cls.model_validate({**data, "kind": kind})
+        scenario = cls.model_validate(data)
     except pydantic.ValidationError as exc:
         raise ScenarioError(source, [describe(error, cls) for error in exc.errors()]) from None
     scenario._source = source
+    scenario._data = data
     return scenario
 
 

@@ -19,6 +19,7 @@ from tumble import torques
 from tumble.body import RigidBody
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import in_file, keyed
+from tumble.scenario._run import Run
 from tumble.scenario._values import _Vector
 from tumble.scenario.damper import SphericalDamperTable
 from tumble.scenario.tables import Body, Initial, Solver, Time
@@ -75,6 +76,12 @@ class Problem:
         if self.damper is None:
             return self.body
         return Spacecraft(hub=self.body, damper=self.damper)
+
+    def as_run(self) -> Run:
+        """The same arguments as a :class:`~tumble.scenario.Run` (what a sweep of the scenario reads)."""
+        damper = {} if self.damper_omega0 is None else {"damper_omega0": self.damper_omega0}
+        return Run(model=self.model, initial={"omega0": self.omega0, "q0": self.q0, **damper}, t=self.t,
+                   method=self.method, options=self.options, torque=self.torque, keys=_RUN_KEYS, source=self.source)
 
     def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
         """Run :func:`tumble.simulate`; an argument it refuses is reported against its scenario key."""

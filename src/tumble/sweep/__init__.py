@@ -1,0 +1,209 @@
+"""Monte-Carlo and parameter sweeps of any model of :func:`tumble.simulate`, on Dask, streamed to Zarr.
+
+    >>> import numpy as np, tumble
+    >>> from tumble.sweep import Normal, UniformAttitude, NutationAngle, Final
+    >>> ds = tumble.sweep(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])),
+    ...                   {"omega0": Normal([0.0, 0.0, 1.0], 0.05), "q0": UniformAttitude()},
+    ...                   samples=10_000, seed=1, t=np.linspace(0, 10, 101), method="rk4", dt=0.01,
+    ...                   outcomes={"nutation": Final(NutationAngle([0, 0, 1]))}, store="mc.zarr")
+    >>> ds.nutation_percentiles.sel(percentile=99).item()       # rad
+
+Sample ``i`` draws its dispersed inputs from its own stream
+``SeedSequence(seed, spawn_key=(i,))`` (:mod:`tumble.sweep.dispersions`), so
+every input and result of sample ``i`` depends on ``(seed, i)`` alone, never
+on the chunk size or the number of workers. The samples run in chunks, one
+Dask task per chunk, each chunk one batched call of :func:`tumble.simulate`
+where the model allows it (:mod:`tumble.sweep.plan`); the results are written
+to a Zarr store as the chunks complete (:mod:`tumble.sweep.store`) and a
+sweep run again on the same store resumes, computing only what is missing.
+See ``docs/sweeps.md``.
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+from collections.abc import Callable, Mapping
+
+from tumble._validate import ValidationError, output_times
+from tumble.simulate import _solver_options, as_model
+from tumble.sweep.dispersions import (
+    Dispersion,
+    Grid,
+    Inertia,
+    Misalignment,
+    NoiseSeed,
+    Normal,
+    TruncatedNormal,
+    Uniform,
+    UniformAttitude,
+)
+from tumble.sweep.outcomes import (
+    Component,
+    CrossingTime,
+    Final,
+    Max,
+    NutationAngle,
+    PointingError,
+    SettlingTime,
+)
+from tumble.sweep.plan import _is_builder, make_plan
+from tumble.sweep.runner import local_cluster, run_chunks
+from tumble.sweep.store import SweepStore
+
+__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
+           "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
+           "Component", "Max", "Final", "SettlingTime", "CrossingTime"]
+
+#: Percentiles kept by default, of every outcome and (per output time) of every series.
+PERCENTILES = (1.0, 5.0, 50.0, 95.0, 99.0)
+
+
+def sweep(
+    model,
+    dispersions: Mapping | None = None,
+    *,
+    samples: int | None = None,
+    seed: int = 0,
+    t,
+    method: str = "dop853",
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
+    torque=None,
+    outcomes: Mapping[str, Callable] | None = None,
+    statistics: Mapping[str, Callable] | None = None,
+    percentiles=PERCENTILES,
+    trajectories: bool = False,
+    chunk: int | None = None,
+    store=None,
+    client=None,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    retries: int = 2,
+    **initial_state,
+):
+    """Run ``samples`` simulations of ``model`` with dispersed inputs on Dask; return their outcomes.
+
+    Parameters
+    ----------
+    model : Model (what :func:`tumble.simulate` takes), or a callable ``build(**parameters) -> Model``
+        What to simulate. With a ``build`` function, the dispersions named
+        after its parameters (inertia, wheel axes, gains, noise seeds, ...)
+        are passed to it per sample; a rigid body's ``inertia`` may be
+        dispersed directly (:class:`Inertia`).
+    dispersions : mapping name → :class:`Dispersion` or a fixed value
+        The inputs that vary: initial states of the model (``omega0``,
+        ``q0``, ``wheel_speeds0``, ...; units of :func:`tumble.simulate`) and
+        parameters of ``build``. Random ones draw in the mapping's order from
+        the sample's stream; :class:`Grid` ones form a Cartesian product.
+    samples : int
+        Number of samples (default: one per grid point when every dispersion is a grid).
+    seed : int
+        The sweep's seed: sample ``i``'s stream is ``SeedSequence(seed, spawn_key=(i,))``.
+    t, method, dt, rtol, atol, max_steps, torque
+        As :func:`tumble.simulate` (output times in s; the options the method reads).
+    outcomes : mapping name → ``f(traj) -> (m, ...)``
+        Per-sample results from a chunk's batched trajectory (:mod:`tumble.sweep.outcomes`).
+    statistics : mapping name → ``f(traj) -> (n, m)``
+        Series kept per sample and output time, with their per-time mean, std,
+        min, max and ``percentiles``.
+    percentiles : sequence of numbers in [0, 100]
+        Kept for every outcome and, per output time, for every series.
+    trajectories : bool
+        Also keep every sample's trajectory: ``q`` (sample, time, 4), ``omega``
+        (sample, time, 3), the model's extras and totals, chunked by sample
+        (with a store, they go to disk as the chunks come).
+    chunk : int
+        Samples per Dask task (default: a chunk's run takes about 200 MB,
+        ``tumble.ensemble.SAMPLES_PER_CHUNK`` body-samples, at most ``samples``).
+    store : path of a Zarr store (directory), or None
+        Where the results are written as they come; an existing store of the
+        same sweep is resumed (only missing chunks are computed), one of
+        another sweep is refused. None: in memory.
+    client : ``distributed.Client``, optional
+        Run on this cluster. Default: a :class:`~distributed.LocalCluster` of
+        ``workers`` processes (default one per core) started for the sweep;
+        ``workers=0`` runs the chunks in this process without Dask.
+    progress : callable ``progress(done, total)``, optional
+        Called with the number of chunks done (the store's included).
+    retries : int
+        Retries of a task that raised (a killed worker's tasks are rescheduled by Dask regardless).
+    **initial_state
+        Initial states shared by every sample (e.g. ``q0=[1, 0, 0, 0]``).
+
+    Returns
+    -------
+    xarray.Dataset
+        Dimensions ``sample``, ``time``, ``percentile``: each dispersed input
+        and outcome per sample, each series per sample and time, with
+        ``NAME_mean``/``_std``/``_min``/``_max`` (time) and ``NAME_percentiles``;
+        opened lazily from the store (loaded when in memory); attribute
+        ``chunks_computed``: the chunks this call computed.
+    """
+    times = output_times(t)
+    if _is_scenario(model):
+        raise ValidationError("model: a scenario sweeps with sweep_scenario(scenario, ...) (its [sweep] table "
+                              "gives the dispersions, times and solver)")
+    if not _is_builder(model):
+        as_model(model)  # refuse what is not a model before anything else
+    m, options = _solver_options(as_model(model) if not _is_builder(model) else None, method,
+                                 dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
+    if workers is not None and int(workers) < 0:
+        raise ValidationError(f"workers: must be >= 0 (0: in this process), got {workers}")
+    percentiles = tuple(float(p) for p in percentiles)
+    if any(not 0.0 <= p <= 100.0 for p in percentiles):
+        raise ValidationError(f"percentiles: must lie in [0, 100], got {list(percentiles)}")
+    plan = make_plan(model, dispersions or {}, samples=samples, seed=seed, chunk=chunk, t=times, method=m.name,
+                     options=options, torque=torque, outcomes=dict(outcomes or {}), series=dict(statistics or {}),
+                     fixed=initial_state, trajectories=trajectories)
+    result = SweepStore(store, plan)
+    computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
+    if computed or not result.complete or not result.has_percentiles(percentiles):
+        result.finalize(percentiles)
+    ds = result.dataset()
+    ds.attrs["chunks_computed"] = computed
+    return ds
+
+
+def _is_scenario(model) -> bool:
+    from tumble.scenario import Scenario
+
+    return isinstance(model, Scenario)
+
+
+def sweep_scenario(scenario, *, samples: int | None = None, store=None, client=None, workers: int | None = None,
+                   progress: Callable[[int, int], None] | None = None, retries: int = 2):
+    """:func:`sweep` of a scenario (a :class:`tumble.scenario.Scenario` or the path of its file) as its
+    ``[sweep]`` table describes (:mod:`tumble.scenario.sweep`); ``samples`` overrides the table's."""
+    from tumble.scenario import load
+    from tumble.scenario.sweep import sweep_arguments
+
+    if not _is_scenario(scenario):
+        scenario = load(scenario)
+    arguments = sweep_arguments(scenario, samples=samples)
+    return sweep(arguments.pop("model"), arguments.pop("dispersions"), store=store, client=client,
+                 workers=workers, progress=progress, retries=retries, **arguments)
+
+
+def open_sweep(path):
+    """The sweep stored at ``path`` as an :class:`xarray.Dataset`, opened lazily (Dask arrays)."""
+    import xarray as xr
+
+    from tumble.sweep.store import SETTINGS_ATTR
+
+    ds = xr.open_zarr(path, consolidated=False, zarr_format=3)
+    if SETTINGS_ATTR not in ds.attrs:
+        raise ValidationError(f"path: {path} is not a tumble sweep store")
+    return ds
+
+
+class _SweepModule(types.ModuleType):
+    """``tumble.sweep`` is both this package and its function: ``tumble.sweep(model, ...)`` calls :func:`sweep`."""
+
+    def __call__(self, *args, **kwargs):
+        return sweep(*args, **kwargs)
+
+
+sys.modules[__name__].__class__ = _SweepModule

@@ -1,0 +1,337 @@
+"""The plan of a sweep: what sample ``i`` is, and how a chunk of samples runs through :func:`tumble.simulate`.
+
+A :class:`Plan` is a plain, picklable value: the model (or a function that
+builds one from dispersed parameters), the dispersions, the seed, the output
+times and solver options, and the outcome and series functions. A Dask task
+calls :meth:`Plan.run` on a chunk ``[lo, hi)`` of samples; it draws the
+samples' inputs from their own streams (:func:`tumble.sweep.dispersions.sample_stream`),
+simulates the chunk as **one batch** where the model allows it, and reduces
+the batched trajectory to per-sample outcomes and series. Nothing in a chunk's
+result depends on the chunk's bounds: sample ``i`` is a function of ``(seed,
+i)`` (a member of a compiled batch integrates on its own, so its result does
+not depend on the batch around it either).
+
+How a chunk is batched:
+
+* dispersed initial states (``omega0``, ``q0``, ``wheel_speeds0``, ...): one
+  :func:`~tumble.simulate` call with a leading axis of ``m`` members;
+* a dispersed ``inertia`` of a rigid body, or a ``build`` function returning
+  rigid bodies: one call on the batch of bodies (:class:`tumble.rigid.RigidBodies`);
+* a ``build`` function returning other models (a spacecraft with dispersed
+  inertia or wheel axes): one call per sample inside the chunk's task (the
+  compiled kernel is shared; such a model has no batched form of its
+  parameters), the trajectories then stacked into one batch.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tumble._inertia import principal_axes
+from tumble._validate import ValidationError
+from tumble.body import RigidBody
+from tumble.rigid import RigidBodies
+from tumble.simulate import Model, as_model, simulate
+from tumble.sweep.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_stream
+from tumble.sweep.outcomes import describe
+from tumble.trajectory import Extra, Trajectory
+
+__all__ = ["Plan", "ChunkResult", "make_plan"]
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """What one chunk ``[lo, hi)`` gives: per-sample ``inputs``, ``outcomes`` (name → (m, ...)) and
+    ``series`` (name → (m, n): one row per sample, one column per output time) and, when asked, the
+    ``trajectories`` (``q``, ``omega``, the extras and totals: name → (m, n, ...))."""
+
+    lo: int
+    hi: int
+    inputs: dict
+    outcomes: dict
+    series: dict
+    trajectories: dict
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A sweep, fully described (see the module docstring); made and checked by :func:`tumble.sweep.sweep`.
+
+    model       : a :class:`~tumble.simulate.Model` (or what :func:`~tumble.simulate.as_model` takes), or a
+                  function ``build(**parameters) -> Model`` of the dispersed parameters
+    dispersions : name → :class:`~tumble.sweep.dispersions.Dispersion`, in drawing order
+    states      : the dispersed names that are initial states of the model (the others are parameters)
+    fixed       : initial states given as one value shared by every sample
+    seed, samples, chunk : the random seed, the number of samples, the samples per chunk (a Dask task)
+    t, method, options, torque : the arguments of :func:`tumble.simulate`
+    outcomes, series : name → function of a chunk's trajectory (:mod:`tumble.sweep.outcomes`)
+    trajectories : keep every sample's trajectory (``q``, ``omega``, the extras and totals) too
+    """
+
+    model: object
+    dispersions: dict
+    states: tuple
+    fixed: dict
+    seed: int
+    samples: int
+    chunk: int
+    t: np.ndarray
+    method: str
+    options: dict
+    torque: object
+    outcomes: dict
+    series: dict
+    trajectories: bool = False
+    grid: tuple = field(init=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "grid", tuple(len(d) for d in self.dispersions.values() if isinstance(d, Grid)))
+
+    # -- what sample i is -------------------------------------------------------------
+
+    @property
+    def n_chunks(self) -> int:
+        return math.ceil(self.samples / self.chunk)
+
+    def bounds(self, k: int) -> tuple[int, int]:
+        """The samples ``[lo, hi)`` of chunk ``k``."""
+        return k * self.chunk, min(self.samples, (k + 1) * self.chunk)
+
+    def inputs(self, lo: int, hi: int) -> dict[str, np.ndarray]:
+        """The dispersed inputs of samples ``lo`` to ``hi − 1`` (name → (m, *shape)), each a function of
+        ``(seed, i)`` only."""
+        randoms = [(name, d) for name, d in self.dispersions.items() if d.n_raw]
+        raw = {name: np.empty((hi - lo, d.n_raw)) for name, d in randoms}
+        if randoms:
+            for j, i in enumerate(range(lo, hi)):
+                rng = sample_stream(self.seed, i)
+                for name, d in randoms:
+                    raw[name][j] = d.raw(rng)
+        index = np.arange(lo, hi) % math.prod(self.grid)
+        points = iter(np.unravel_index(index, self.grid)) if self.grid else iter(())
+        out = {}
+        for name, d in self.dispersions.items():
+            p = next(points) if isinstance(d, Grid) else index
+            out[name] = d.values(raw.get(name, np.empty((hi - lo, 0))), p)
+        return out
+
+    # -- one chunk --------------------------------------------------------------------
+
+    def run(self, k: int) -> ChunkResult:
+        """Simulate chunk ``k`` and reduce it (what a Dask task does)."""
+        lo, hi = self.bounds(k)
+        inputs = self.inputs(lo, hi)
+        traj = self.simulate(inputs)
+        m = hi - lo
+        outcomes = {}
+        for name, f in self.outcomes.items():
+            value = np.asarray(f(traj))
+            if value.ndim < 1 or value.shape[0] != m:
+                raise ValidationError(f"outcomes[{name!r}]: must give one value per sample ({m}, ...), "
+                                      f"got shape {value.shape}")
+            outcomes[name] = value
+        series = {}
+        for name, f in self.series.items():
+            value = np.asarray(f(traj), dtype=np.float64)
+            if value.shape != (len(self.t), m):
+                raise ValidationError(f"statistics[{name!r}]: must give one value per output time and sample "
+                                      f"({len(self.t)}, {m}), got shape {value.shape}")
+            series[name] = np.ascontiguousarray(value.T)
+        kept = {}
+        if self.trajectories:  # sample-major, as the store is chunked
+            momentum = traj.momentum_body if traj.q is not None or "momentum_body" in traj.totals else None
+            fields = {"q": traj.q, "omega": traj.omega, **{name: e.data for name, e in traj.extras.items()},
+                      "energy": traj.energy, "momentum_body": momentum}
+            kept = {name: np.ascontiguousarray(np.swapaxes(v, 0, 1)) for name, v in fields.items() if v is not None}
+        return ChunkResult(lo, hi, inputs, outcomes, series, kept)
+
+    def simulate(self, inputs: Mapping[str, np.ndarray]) -> Trajectory:
+        """The batched trajectory (axes (time, member, ...)) of the samples whose inputs are ``inputs``."""
+        m = len(next(iter(inputs.values()))) if inputs else 0
+        state = {**self.fixed, **{name: inputs[name].reshape(m, -1) for name in self.states}}
+        parameters = {name: v for name, v in inputs.items() if name not in self.states}
+        run = dict(t=self.t, method=self.method, torque=self.torque, **self.options)
+        if not _is_builder(self.model):
+            model = self.model
+            if "inertia" in parameters:
+                model = RigidBodies.of(parameters["inertia"])
+            elif not any(np.ndim(v) == 2 for v in state.values()):
+                state = {name: np.broadcast_to(v, (m, np.size(v))) for name, v in state.items()}
+            return simulate(model, **run, **state)
+        models = [self.model(**{name: v[j] for name, v in parameters.items()}) for j in range(m)]
+        if all(isinstance(b, RigidBody) for b in models):
+            return simulate(RigidBodies.of(models), **run, **_members(state, m))
+        members = [simulate(model, **run, **{name: v[j:j + 1] if np.ndim(v) == 2 else v for name, v in
+                                             _members(state, m).items()}) for j, model in enumerate(models)]
+        return _stack(members)
+
+    # -- what the store records -------------------------------------------------------
+
+    def settings(self) -> dict:
+        """Everything the samples' results depend on, as JSON values: a store written with other settings is
+        refused (naming the one that differs) rather than mixed."""
+        t = np.ascontiguousarray(self.t)
+        return {
+            "model": _describe_model(self.model),
+            "dispersions": [[name, repr(d)] for name, d in self.dispersions.items()],
+            "fixed": {name: np.asarray(v).tolist() for name, v in self.fixed.items()},
+            "seed": int(self.seed),
+            "samples": int(self.samples),
+            "chunk": int(self.chunk),
+            "t": f"{t.size} times from {float(t[0])!r} to {float(t[-1])!r} s, sha256 {hashlib.sha256(t.tobytes()).hexdigest()}",
+            "method": self.method,
+            "options": {k: float(v) for k, v in self.options.items()},
+            "torque": "none" if self.torque is None else describe(self.torque) if inspect.isfunction(
+                self.torque) else repr(self.torque),
+            "outcomes": {name: describe(f) for name, f in self.outcomes.items()},
+            "statistics": {name: describe(f) for name, f in self.series.items()},
+            "trajectories": self.trajectories,
+        }
+
+    def token(self) -> str:
+        """A short digest of :meth:`settings` (the Dask keys of this sweep's tasks)."""
+        return hashlib.sha256(json.dumps(self.settings(), sort_keys=True).encode()).hexdigest()[:16]
+
+
+def _is_builder(model) -> bool:
+    return callable(model) and not isinstance(model, (Model, np.ndarray))
+
+
+def _members(state: dict, m: int) -> dict:
+    """Initial states with one row per member: a shared value broadcast to (m, size)."""
+    return {name: v if np.ndim(v) == 2 else np.broadcast_to(v, (m, np.size(v))) for name, v in state.items()}
+
+
+def _describe_model(model) -> str:
+    if _is_builder(model):
+        return describe(model)
+    model = as_model(model)
+    inertia = getattr(model, "inertia", None)
+    extra = "" if inertia is None or not isinstance(inertia, np.ndarray) else f", inertia {inertia.tolist()}"
+    return repr(model) + extra
+
+
+def _stack(members: list[Trajectory]) -> Trajectory:
+    """One batched trajectory (member axis 1) from single-member runs (each with a member axis of 1)."""
+    first = members[0]
+
+    def cat(get):
+        parts = [get(tr) for tr in members]
+        return None if parts[0] is None else np.concatenate(parts, axis=1)
+
+    inertia = None if first.inertia is None else np.stack(
+        [tr.inertia if tr.inertia.ndim == 2 else tr.inertia[0] for tr in members])
+    extras = {name: Extra(cat(lambda tr, name=name: tr.extras[name].data), e.dims, e.units, e.description)
+              for name, e in first.extras.items()}
+    totals = {name: cat(lambda tr, name=name: tr.totals[name]) for name in first.totals}
+    return Trajectory(t=first.t, q=cat(lambda tr: tr.q), omega=cat(lambda tr: tr.omega), inertia=inertia,
+                      method=first.method, info=first.info, extras=extras, totals=totals, model=first.model)
+
+
+def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, torque, outcomes, series,
+              fixed, trajectories=False) -> Plan:
+    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
+    if not isinstance(dispersions, Mapping):
+        raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
+    dispersions = {str(name): as_dispersion(d, name) for name, d in dispersions.items()}
+    samples, chunk = _sizes(dispersions, samples, chunk, len(t))
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
+    builder = _is_builder(model)
+    parameters = _parameters(model, dispersions)
+    probe = model(**{n: d.values(np.zeros((1, d.n_raw)), np.zeros(1, dtype=int))[0]
+                     for n, d in dispersions.items() if n in parameters}) if builder else model
+    fields = {f.name: f for f in as_model(probe).state_fields()}
+    for name in list(dispersions) + list(fixed):
+        if name not in fields and name not in parameters:
+            known = ", ".join(sorted(fields) + sorted(parameters))
+            raise ValidationError(f"dispersions[{name!r}]: not an initial state or a parameter of the "
+                                  f"{'model built by ' + describe(model) if builder else type(probe).__name__}; "
+                                  f"it takes {known}")
+        if name in fixed and name in dispersions:
+            raise ValidationError(f"{name}: given both as a dispersion and as a fixed value")
+    states = tuple(n for n in dispersions if n in fields and n not in parameters)
+    for name in states:
+        _check_state(name, dispersions[name], fields[name])
+    if "inertia" in dispersions and not builder:
+        _check_inertia(dispersions["inertia"])
+    _check_reductions(outcomes, series, dispersions, trajectories)
+    return Plan(model=model if builder or "inertia" in dispersions else as_model(model),
+                dispersions=dispersions, states=states, fixed=dict(fixed), seed=int(seed), samples=samples,
+                chunk=chunk, t=np.asarray(t, dtype=np.float64), method=method, options=options, torque=torque,
+                outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
+
+
+def _sizes(dispersions: dict, samples, chunk, n_times: int) -> tuple[int, int]:
+    """The number of samples (default: one per grid point when every dispersion is a grid) and the chunk
+    (default: :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
+    if samples is None:
+        if not any(isinstance(d, Grid) for d in dispersions.values()) or any(d.n_raw for d in dispersions.values()):
+            raise ValidationError("samples: needed unless every dispersion is a grid (then one sample per point)")
+        samples = math.prod(len(d) for d in dispersions.values() if isinstance(d, Grid))
+    samples = int(samples)
+    if samples < 1:
+        raise ValidationError(f"samples: must be >= 1, got {samples}")
+    if chunk is None:
+        from tumble.ensemble import SAMPLES_PER_CHUNK
+
+        chunk = max(1, min(samples, SAMPLES_PER_CHUNK // n_times))
+    if int(chunk) < 1:
+        raise ValidationError(f"chunk: must be >= 1 sample, got {chunk}")
+    return samples, int(chunk)
+
+
+def _parameters(model, dispersions: dict) -> set:
+    """The parameters a sweep may disperse besides the initial state: a build function's (a scenario's
+    model names its dotted keys), ``inertia`` for a rigid body; a build function's required ones must be
+    given."""
+    if not _is_builder(model):
+        return {"inertia"} if isinstance(model, (RigidBody, list, np.ndarray)) else set()
+    named = getattr(model, "parameters", None)
+    if named is not None:
+        return set(named)
+    signature = inspect.signature(model).parameters
+    required = [p.name for p in signature.values() if p.default is inspect.Parameter.empty and p.name not in
+                dispersions]
+    if required:
+        raise ValidationError(f"dispersions: the model's build function {describe(model)} needs "
+                              f"{', '.join(map(repr, required))} (a dispersion, or a fixed value)")
+    return set(signature)
+
+
+def _check_state(name: str, d: Dispersion, state) -> None:
+    """A dispersed initial state: the shape of its field; no zero quaternion in a grid."""
+    want = (state.size,)
+    if d.shape != want and not (want == (1,) and d.shape == ()):
+        raise ValidationError(f"dispersions[{name!r}]: a value of shape {want} ({state.description}), got {d.shape}")
+    if state.quaternion and isinstance(d, Grid) and np.any(np.linalg.norm(d.points, axis=-1) == 0):
+        raise ValidationError(f"dispersions[{name!r}]: a zero quaternion")
+
+
+def _check_inertia(d: Dispersion) -> None:
+    """A rigid body's dispersed inertia: an :class:`Inertia` (physical by its rule) or a grid of tensors
+    that pass :func:`tumble._inertia.principal_axes` here, so that no sample can be refused later."""
+    if isinstance(d, Grid) and d.shape == (3, 3):
+        principal_axes(d.points, "dispersions['inertia']")
+    elif not isinstance(d, Inertia):
+        raise ValidationError(f"dispersions['inertia']: must be a tumble.sweep.Inertia (it stays physical) or a "
+                              f"Grid of (3, 3) tensors (kg m^2), got {type(d).__name__} of shape {d.shape}")
+
+
+def _check_reductions(outcomes: dict, series: dict, dispersions: dict, trajectories: bool) -> None:
+    """Outcome and series names: identifiers, none the name of a dispersed input, of each other or of a
+    kept trajectory field; each function describable in the store."""
+    taken = set(dispersions) | ({"q", "omega", "energy", "momentum_body"} if trajectories else set())
+    for group, kind in ((outcomes, "outcomes"), (series, "statistics")):
+        for name, f in group.items():
+            if not str(name).isidentifier() or name in taken or (kind == "statistics" and name in outcomes):
+                raise ValidationError(f"{kind}[{name!r}]: names must be identifiers, different from the "
+                                      f"dispersed inputs and from each other")
+            describe(f)

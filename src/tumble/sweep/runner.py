@@ -1,0 +1,89 @@
+"""Running a sweep's chunks on Dask (``dask.distributed``): one task per chunk, results written as they come.
+
+By default the chunks run on a :class:`distributed.LocalCluster` started for
+the sweep and closed after it: one worker process per core, one thread each,
+listening on 127.0.0.1 only (``workers=0``: in this process, without Dask), with Numba held to one thread per process
+(``NUMBA_NUM_THREADS=1``) so that the processes do not oversubscribe the
+cores. ``client=`` runs them on any existing cluster instead (a
+``LocalCluster``, ``dask scheduler`` + ``dask worker`` processes on other
+machines, dask-jobqueue, Kubernetes): only the chunks' small results travel
+back to the client, which writes them to the store, so the workers need no
+shared file system.
+
+A task that fails with an exception is retried ``retries`` times; a task whose
+worker dies (killed, out of memory) is given to another worker by the
+scheduler, as Dask does for every task. On Ctrl-C the tasks not finished are
+cancelled and the chunks already written stay in the store.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable
+
+from tumble._validate import ValidationError
+from tumble.sweep.plan import Plan
+from tumble.sweep.store import SweepStore
+
+__all__ = ["local_cluster", "run_chunks"]
+
+
+def local_cluster(workers: int | None = None):
+    """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: one per core),
+    every server on 127.0.0.1 (the scheduler's HTTP endpoint on a free port there)."""
+    from distributed import LocalCluster
+
+    n = (os.cpu_count() or 1) if workers is None else int(workers)
+    return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                        dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
+
+
+def _run_chunk(plan: Plan, k: int):
+    return plan.run(k)
+
+
+def run_chunks(plan: Plan, store: SweepStore, *, client=None, workers: int | None = None,
+               progress: Callable[[int, int], None] | None = None, retries: int = 2) -> int:
+    """Compute the chunks missing from ``store`` on Dask and write each as it completes; return how many
+    were computed. ``progress(done, total)`` counts chunks (those already in the store included)."""
+    from distributed import Client, as_completed
+
+    missing = store.missing()
+    total = plan.n_chunks
+    if progress is not None:
+        progress(total - len(missing), total)
+    if not missing:
+        return 0
+    if workers == 0 and client is None:  # in this process, chunk after chunk
+        for n, k in enumerate(missing, start=total - len(missing) + 1):
+            store.write(k, plan.run(k))
+            if progress is not None:
+                progress(n, total)
+        return len(missing)
+    cluster = None
+    if client is None:
+        cluster = local_cluster(workers)
+        client = Client(cluster)
+    elif workers is not None:
+        raise ValidationError("workers: give it only without client= (a client's cluster has its own workers)")
+    token = plan.token()
+    futures = {}
+    try:
+        for k in missing:
+            futures[client.submit(_run_chunk, plan, k, key=f"tumble-sweep-{token}-{k}", retries=retries,
+                                  pure=False)] = k
+        done = total - len(missing)
+        for future in as_completed(futures):
+            store.write(futures[future], future.result())
+            future.release()
+            done += 1
+            if progress is not None:
+                progress(done, total)
+        return len(missing)
+    finally:
+        for future in futures:
+            if not future.done():
+                future.cancel()
+        if cluster is not None:
+            client.close()
+            cluster.close()

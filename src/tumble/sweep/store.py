@@ -1,0 +1,213 @@
+"""A sweep's Zarr store: results written chunk by chunk as they come, resumable, opened lazily with xarray.
+
+Layout (Zarr format 3, one group; ``S`` samples, ``n`` output times):
+
+==========================  =======================  ==========================================
+variable                    dimensions               what
+==========================  =======================  ==========================================
+``sample``, ``time``        (S,), (n,)               sample index; output times, s
+each dispersed input        (sample, NAME_dim0, ...) the sample's value (SI units)
+each outcome                (sample, ...)            one value per sample
+each series                 (sample, time)           one value per sample and output time
+``q``, ``omega``, extras    (sample, time, ...)      with ``trajectories=True``: every sample's run
+``done``                    (chunk,)                 True once the chunk's results are written
+``NAME_mean`` ... ``_max``  (time,)                  per-time mean, std (ddof 0), min, max of a series
+``NAME_percentiles``        (percentile, time)       per-time percentiles of a series
+``OUTCOME_percentiles``     (percentile, ...)        percentiles of an outcome over the samples
+==========================  =======================  ==========================================
+
+The store's arrays are chunked along ``sample`` exactly as the sweep is, so a
+chunk's results are whole Zarr chunks, each written atomically by Zarr's
+local store (a temporary file, then a rename). A chunk counts as done only
+when its flag in ``done`` is set, after its data: an interruption (Ctrl-C, a
+killed client) loses at most the chunks in flight, and running the same sweep
+on the store computes only the chunks not done. The sweep's settings
+(:meth:`tumble.sweep.plan.Plan.settings`) are the group's attribute
+``tumble_sweep``; a store written with other settings is refused, naming the
+first setting that differs. The store is created under a temporary name and
+renamed into place, so its name never points at a half-made store.
+
+The per-time statistics merge the chunks' moments in chunk order with
+:mod:`tumble.ensemble`'s exact pairwise update (Chan, Golub & LeVeque 1979),
+so they are the same bit for bit whatever the number of workers or the order
+in which chunks finished; the percentiles are exact (``numpy.percentile``,
+linear interpolation), read from the stored series in blocks of output times.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+
+import numpy as np
+
+from tumble._validate import ValidationError
+from tumble.ensemble import STATISTICS, _merge, moments
+from tumble.sweep.plan import ChunkResult, Plan
+
+__all__ = ["SweepStore", "SETTINGS_ATTR", "COMPLETE_ATTR"]
+
+#: Group attributes: the sweep's settings, and whether its statistics are written.
+SETTINGS_ATTR = "tumble_sweep"
+COMPLETE_ATTR = "tumble_sweep_complete"
+#: Values of a series read at once when taking its percentiles (float64 words): 256 MB.
+_BLOCK_WORDS = 2**25
+
+
+class SweepStore:
+    """The results of one sweep in a Zarr store at ``path`` (a directory), or in memory when ``path`` is None."""
+
+    def __init__(self, path, plan: Plan):
+        self.path = None if path is None else os.fspath(path)
+        self.plan = plan
+        self._memory = None
+        self._writable = None  # the group open for writing, once the store exists, and its arrays
+        self._arrays = {}
+        self._done = np.zeros(plan.n_chunks, dtype=bool)
+        if self.path is not None and os.path.exists(self.path):
+            self._check()
+
+    # -- opening ----------------------------------------------------------------------
+
+    def _group(self, mode="r+"):
+        import zarr
+
+        if mode == "r+" and self._writable is not None:
+            return self._writable
+        group = zarr.open_group(self._memory if self.path is None else self.path, mode=mode, zarr_format=3)
+        if mode == "r+":
+            self._writable = group
+        return group
+
+    @property
+    def exists(self) -> bool:
+        return self._memory is not None or (self.path is not None and os.path.exists(self.path))
+
+    def _check(self) -> None:
+        """Refuse a store that is not this sweep's; read which chunks are done."""
+        try:
+            group = self._group("r")
+            stored = dict(group.attrs).get(SETTINGS_ATTR)
+        except Exception as exc:  # noqa: BLE001 - any unreadable directory is "not a sweep store"
+            raise ValidationError(f"store: {self.path} exists and is not a tumble sweep store ({exc})") from None
+        if not isinstance(stored, dict):
+            raise ValidationError(f"store: {self.path} exists and is not a tumble sweep store (no {SETTINGS_ATTR} "
+                                  "attribute); give a new path")
+        here = self.plan.settings()
+        for key in here:
+            if stored.get(key) != here[key]:
+                raise ValidationError(f"store: {self.path} was written with other settings: {key} = "
+                                      f"{stored.get(key)!r} there, {here[key]!r} here; give a new path or the "
+                                      "same settings")
+        self._done = np.asarray(group["done"][:], dtype=bool)
+
+    @property
+    def complete(self) -> bool:
+        return self.exists and bool(dict(self._group("r").attrs).get(COMPLETE_ATTR, False))
+
+    def has_percentiles(self, percentiles) -> bool:
+        """Whether the store's statistics are those of ``percentiles``."""
+        group = self._group("r")
+        return "percentile" in group and np.array_equal(group["percentile"][:], np.asarray(percentiles, float))
+
+    def missing(self) -> list[int]:
+        """The chunks whose results are not in the store."""
+        return [int(k) for k in np.flatnonzero(~self._done)]
+
+    # -- writing ----------------------------------------------------------------------
+
+    def _create(self, first: ChunkResult) -> None:
+        """Make the empty store (arrays shaped from the first chunk's results), under a temporary name first."""
+        import dask.array as da
+        import xarray as xr
+
+        plan = self.plan
+        s, c = plan.samples, plan.chunk
+
+        def empty(name, value, lead):
+            tail = value.shape[1:]
+            dims = lead + tuple(f"{name}_dim{k}" for k in range(len(tail)))
+            return dims, da.zeros((s, *tail), chunks=(c, *tail), dtype=value.dtype)
+
+        data = {name: empty(name, v, ("sample",)) for name, v in {**first.inputs, **first.outcomes}.items()}
+        for name, v in first.series.items():
+            data[name] = ("sample", "time"), da.zeros((s, len(plan.t)), chunks=(c, len(plan.t)))
+        for name, v in first.trajectories.items():
+            dims = ("sample", "time") + tuple(f"{name}_dim{k}" for k in range(v.ndim - 2))
+            data[name] = dims, da.zeros((s, *v.shape[1:]), chunks=(c, *v.shape[1:]))
+        data["done"] = "chunk", da.zeros(plan.n_chunks, chunks=1, dtype=bool)
+        ds = xr.Dataset(data, coords={"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})},
+                        attrs={SETTINGS_ATTR: plan.settings(), COMPLETE_ATTR: False})
+        encoding = {name: {"fill_value": None} for name in ds.data_vars}
+        if self.path is None:
+            import zarr
+
+            self._memory = zarr.storage.MemoryStore()
+            ds.to_zarr(self._memory, compute=False, consolidated=False, encoding=encoding, zarr_format=3)
+            return
+        parent = os.path.dirname(os.path.abspath(self.path))
+        if not os.path.isdir(parent):
+            raise FileNotFoundError(f"store: directory {parent!r} does not exist")
+        tmp = tempfile.mkdtemp(dir=parent, prefix=f".{os.path.basename(self.path)}.", suffix=".tmp")
+        try:
+            ds.to_zarr(tmp, mode="a", compute=False, consolidated=False, encoding=encoding, zarr_format=3)
+            os.rename(tmp, self.path)  # atomic; fails if the name appeared meanwhile
+        except BaseException:
+            shutil.rmtree(tmp, ignore_errors=True)
+            raise
+
+    def write(self, k: int, result: ChunkResult) -> None:
+        """Write chunk ``k``'s results, then mark it done."""
+        if not self.exists:
+            self._create(result)
+        group = self._group()
+        for name, value in {**result.inputs, **result.outcomes, **result.series, **result.trajectories}.items():
+            self._array(group, name)[result.lo:result.hi] = value
+        self._array(group, "done")[k] = True
+        self._done[k] = True
+
+    def _array(self, group, name):
+        """The store's array ``name``, opened once."""
+        if name not in self._arrays:
+            self._arrays[name] = group[name]
+        return self._arrays[name]
+
+    # -- statistics -------------------------------------------------------------------
+
+    def finalize(self, percentiles) -> None:
+        """Write the per-time statistics and the percentiles once every chunk is done (idempotent)."""
+        import xarray as xr
+
+        plan = self.plan
+        group = self._group()
+        p = np.asarray(percentiles, dtype=np.float64)
+        data = {}
+        for name in plan.series:
+            stats = None
+            for k in range(plan.n_chunks):
+                lo, hi = plan.bounds(k)
+                part = moments(group[name][lo:hi].T)
+                stats = part if stats is None else _merge(stats, part)
+            count, mean, m2, low, high = stats
+            for stat, value in zip(STATISTICS, (mean, np.sqrt(m2 / count), low, high), strict=True):
+                data[f"{name}_{stat}"] = ("time", value)
+            block = max(1, _BLOCK_WORDS // plan.samples)
+            bands = [np.percentile(group[name][:, a:a + block], p, axis=0) for a in range(0, len(plan.t), block)]
+            data[f"{name}_percentiles"] = ("percentile", "time"), np.concatenate(bands, axis=1)
+        for name in plan.outcomes:
+            values = group[name][:]
+            dims = ("percentile",) + tuple(f"{name}_dim{k}" for k in range(values.ndim - 1))
+            data[f"{name}_percentiles"] = dims, np.percentile(values, p, axis=0)
+        ds = xr.Dataset(data, coords={"percentile": p})
+        ds.to_zarr(self._memory if self.path is None else self.path, mode="a", consolidated=False, zarr_format=3)
+        group.attrs[COMPLETE_ATTR] = True
+
+    def dataset(self):
+        """The store as an :class:`xarray.Dataset`: lazily (Dask arrays) for a store on disk, loaded for one in
+        memory."""
+        import xarray as xr
+
+        if self.path is None:  # read here, not through whatever Dask scheduler is the default now
+            return xr.open_zarr(self._memory, consolidated=False, zarr_format=3, chunks=None).load()
+        return xr.open_zarr(self.path, consolidated=False, zarr_format=3)

@@ -1,0 +1,122 @@
+"""``tumble.simulate(..., store="run.zarr")``: a batch larger than memory, run in chunks and streamed to Zarr.
+
+The batch's members are cut into chunks of ``chunk`` members; each chunk is
+one :func:`tumble.simulate` call (in parallel over the cores, as any batch)
+whose trajectory (:meth:`tumble.Trajectory.to_xarray`: ``q``, ``omega``, the
+extras and the totals, dimensions ``(time, body, ...)``) is written to the
+store's region of those members before the next chunk starts. The peak memory
+is that of one chunk (about 400 bytes per member and output time, plus the
+compressor's buffers), whatever the batch. The store is written under a
+temporary name and renamed onto ``store`` when complete, so the name never
+points at a half-written run; the result opens lazily with xarray
+(:func:`xarray.open_zarr`), chunked by member as written. The solver
+statistics ``n_steps``, ``n_rejected`` and ``n_rhs`` are summed over the
+chunks (as they are over a batch).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from collections.abc import Callable
+
+import numpy as np
+
+from tumble._validate import ValidationError
+from tumble.ensemble import SAMPLES_PER_CHUNK
+from tumble.rigid import RigidBodies
+from tumble.simulate import as_model, simulate
+
+__all__ = ["simulate_to_store"]
+
+_SUMMED = ("solver_n_steps", "solver_n_rejected", "solver_n_rhs")
+
+
+def _members(model, values: dict) -> int:
+    sizes = {np.shape(v)[0] for v in values.values() if np.ndim(v) == 2}
+    if model.batch_size is not None:
+        sizes.add(model.batch_size)
+    if len(sizes) > 1:
+        raise ValidationError(f"batch sizes disagree: {sorted(sizes)}")
+    return sizes.pop() if sizes else 1
+
+
+def _chunk_of(model, lo: int, hi: int):
+    """Members ``lo:hi`` of a model that carries its own batch (a batch of rigid bodies)."""
+    if model.batch_size is None:
+        return model
+    if not isinstance(model, RigidBodies):
+        raise ValidationError(f"store: a {type(model).__name__} with its own batch cannot be cut into chunks")
+    masses = None if model.masses is None else model.masses[lo:hi]
+    return RigidBodies(model.inertia[lo:hi], model.moments[lo:hi], model.axes[lo:hi], masses)
+
+
+def simulate_to_store(model, store, *, t, initial_state: dict, options: dict, chunk: int | None = None,
+                      progress: Callable[[int, int], None] | None = None):
+    """Run ``simulate(model, t=t, **options, **initial_state)`` in chunks of ``chunk`` members, written to the
+    Zarr store ``store`` (a directory that must not exist); return the run as a lazily opened
+    :class:`xarray.Dataset`.
+
+    ``options`` are the other arguments of :func:`tumble.simulate` (``method``, ``dt``, ``torque``, ...);
+    ``chunk`` defaults to ``tumble.ensemble.SAMPLES_PER_CHUNK // len(t)`` members (about 200 MB a chunk);
+    ``progress(done, total)`` counts members.
+    """
+    import dask.array as da
+    import xarray as xr
+
+    path = os.fspath(store)
+    if os.path.exists(path):
+        raise ValidationError(f"store: {path} exists; give a new path (a run is never written over another)")
+    parent = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(parent):
+        raise FileNotFoundError(f"store: directory {parent!r} does not exist")
+    model = as_model(model)
+    values = {name: np.asarray(v) for name, v in initial_state.items() if v is not None}
+    n = _members(model, values)
+    t = np.asarray(t, dtype=np.float64)
+    chunk = max(1, SAMPLES_PER_CHUNK // max(1, t.size)) if chunk is None else int(chunk)
+    if chunk < 1:
+        raise ValidationError(f"chunk: must be >= 1 member, got {chunk}")
+    tmp = None
+    summed = {}
+    try:
+        for lo in range(0, n, chunk):
+            hi = min(n, lo + chunk)
+            part = {name: v[lo:hi] if np.ndim(v) == 2 else v for name, v in values.items()}
+            traj = simulate(_chunk_of(model, lo, hi), t=t, **options, **part)
+            ds = traj.to_xarray()
+            # labels as variable-length strings: Zarr 3 specifies those, not NumPy's fixed-width ones
+            ds = ds.assign_coords({name: c.astype(object) for name, c in ds.coords.items() if c.dtype.kind == "U"})
+            if "body" not in ds.dims:
+                ds = ds.expand_dims(body=[0], axis=1).transpose("time", "body", ...)
+            if tmp is None:  # the whole store, laid out from the first chunk
+                tmp = tempfile.mkdtemp(dir=parent, prefix=f".{os.path.basename(path)}.", suffix=".tmp")
+                template = xr.Dataset(
+                    {name: (var.dims, da.zeros(tuple(n if d == "body" else s for d, s in zip(var.dims, var.shape,
+                                                                                           strict=True)),
+                                               chunks=tuple(chunk if d == "body" else s for d, s in
+                                                            zip(var.dims, var.shape, strict=True))), var.attrs)
+                     for name, var in ds.data_vars.items() if "body" in var.dims},
+                    coords={**{name: c for name, c in ds.coords.items() if name != "body"},
+                            "body": ("body", np.arange(n), ds["body"].attrs)},
+                    attrs=ds.attrs)
+                fixed = {name: var for name, var in ds.data_vars.items() if "body" not in var.dims}
+                template = template.assign(fixed)  # written now; the members' arrays as their chunks come
+                template.to_zarr(tmp, mode="a", compute=False, consolidated=False, zarr_format=3)
+            region = ds.drop_vars([name for name, var in ds.variables.items() if "body" not in var.dims])
+            region = region.assign_coords(body=np.arange(lo, hi))
+            region.to_zarr(tmp, region={"body": slice(lo, hi)}, consolidated=False, zarr_format=3)
+            for key in _SUMMED:
+                summed[key] = summed.get(key, 0) + int(ds.attrs.get(key, 0))
+            if progress is not None:
+                progress(hi, n)
+        import zarr
+
+        zarr.open_group(tmp, mode="r+", zarr_format=3).attrs.update(summed)
+        os.rename(tmp, path)
+    except BaseException:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return xr.open_zarr(path, consolidated=False, zarr_format=3)

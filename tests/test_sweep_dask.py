@@ -1,0 +1,182 @@
+"""tumble.sweep on real Dask components: a LocalCluster of 2 worker processes, and a ``dask scheduler`` with two
+``dask worker`` processes started here on 127.0.0.1; a worker killed mid-sweep, a client killed and resumed.
+
+Every result is compared bit for bit with the same sweep run in this process
+(``workers=0``), which is computed first: it compiles the kernel (a batch of
+rigid bodies under rk4, as elsewhere in the suite) into Numba's on-disk cache,
+from which the worker processes load it instead of compiling again.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.sweep import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
+
+distributed = pytest.importorskip("distributed")
+
+BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+# 8 chunks of 24 bodies, each 80 000 rk4 steps: about 0.3 s a chunk on one core, long enough for a worker
+# or the client to be killed while chunks are in flight
+SWEEP = dict(dispersions={"omega0": Normal([0.0, 0.0, 1.0], 0.05), "q0": UniformAttitude()}, samples=192, seed=5,
+             chunk=24, t=np.linspace(0.0, 20.0, 21), method="rk4", dt=2.5e-4,
+             outcomes={"nutation": Final(NutationAngle([0.0, 0.0, 1.0])), "pointing": Max(PointingError())},
+             statistics={"omega_z": tumble.sweep.Component("omega", 2)})
+CHUNKS = 8
+SRC = str(Path(tumble.__file__).parents[1])
+ENV = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", ""), "NUMBA_NUM_THREADS": "1"}
+TIMEOUT = 60  # s: the longest a step of these tests may take before it is counted as hung
+
+
+@pytest.fixture(scope="module")
+def reference():
+    """The sweep in this process, without Dask (and the compiled kernel in the on-disk cache)."""
+    return tumble.sweep(BODY, workers=0, **SWEEP)
+
+
+def assert_same(ds, reference):
+    assert ds.attrs["tumble_sweep_complete"]
+    for name in reference.data_vars:
+        np.testing.assert_array_equal(ds[name].values, reference[name].values, err_msg=name)
+
+
+@pytest.fixture(scope="module")
+def local_client(reference):
+    cluster = tumble.sweep.local_cluster(2)
+    client = distributed.Client(cluster)
+    yield client
+    client.close(timeout=TIMEOUT)
+    cluster.close(timeout=TIMEOUT)
+
+
+def stop(*processes):
+    """End processes this module started: SIGTERM to all, then SIGKILL to any not exited within 5 s."""
+    for process in processes:
+        if process.poll() is None:
+            process.terminate()
+    for process in processes:
+        try:
+            process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=20)
+
+
+@pytest.fixture(scope="module")
+def scheduler_file(reference, tmp_path_factory):
+    """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1, started and stopped here."""
+    path = tmp_path_factory.mktemp("dask") / "scheduler.json"
+    cli = [sys.executable, "-m"]
+    commands = [["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(path)]]
+    commands += [["distributed.cli.dask_worker", "--scheduler-file", str(path), "--host", "127.0.0.1", "--nthreads",
+                  "1", "--nworkers", "1", "--name", name, "--dashboard-address", "127.0.0.1:0"]
+                 for name in ("w1", "w2")]  # a worker waits for the scheduler's file
+    processes = []
+    try:
+        for command in commands:
+            processes.append(subprocess.Popen(cli + command, env=ENV, stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL))
+        deadline = time.monotonic() + TIMEOUT
+        while not path.exists():
+            assert time.monotonic() < deadline, "the scheduler did not start"
+            time.sleep(0.1)
+        with distributed.Client(scheduler_file=str(path), timeout=TIMEOUT) as client:
+            client.wait_for_workers(2, timeout=TIMEOUT)
+        yield path
+    finally:
+        stop(*processes)
+
+
+def test_local_cluster_of_two_processes_equals_the_run_in_this_process(local_client, reference):
+    assert len(local_client.scheduler_info()["workers"]) == 2
+    pids = set(local_client.run(os.getpid).values())
+    assert len(pids) == 2 and os.getpid() not in pids
+    done = []
+    ds = tumble.sweep(BODY, client=local_client, progress=lambda k, n: done.append((k, n)), **SWEEP)
+    assert_same(ds, reference)
+    assert ds.attrs["chunks_computed"] == CHUNKS and done == [(k, CHUNKS) for k in range(CHUNKS + 1)]
+
+
+def test_a_worker_killed_mid_sweep_has_its_chunk_recomputed(local_client, reference, tmp_path):
+    pids = list(local_client.run(os.getpid).values())
+    killed = []
+
+    def kill_one(done, total):
+        if done == 1 and not killed:  # the other worker is running a chunk now
+            os.kill(pids[0], signal.SIGKILL)
+            killed.append(pids[0])
+
+    ds = tumble.sweep(BODY, client=local_client, progress=kill_one, store=tmp_path / "mc.zarr", **SWEEP)
+    assert killed and not _alive(killed[0])
+    assert_same(ds, reference)
+    local_client.wait_for_workers(2, timeout=TIMEOUT)  # the nanny restarted it: the cluster is whole again
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def test_scheduler_and_worker_processes_equal_the_run_in_this_process(scheduler_file, reference):
+    with distributed.Client(scheduler_file=str(scheduler_file), timeout=TIMEOUT) as client:
+        assert sorted(w["name"] for w in client.scheduler_info()["workers"].values()) == ["w1", "w2"]
+        ds = tumble.sweep(BODY, client=client, **SWEEP)
+    assert_same(ds, reference)
+
+
+CLIENT = textwrap.dedent("""
+    import sys
+    import distributed, numpy as np, tumble
+    sys.path.insert(0, {tests!r})
+    from test_sweep_dask import BODY, SWEEP
+    if __name__ == "__main__":
+        with distributed.Client(scheduler_file={scheduler!r}) as client:
+            tumble.sweep(BODY, client=client, store={store!r}, **SWEEP)
+""")
+
+
+def test_a_client_killed_mid_sweep_resumes_computing_only_the_missing_chunks(scheduler_file, reference, tmp_path):
+    store = tmp_path / "mc.zarr"
+    script = CLIENT.format(tests=str(Path(__file__).parent), scheduler=str(scheduler_file), store=str(store))
+    client_process = subprocess.Popen([sys.executable, "-c", script], env=ENV, stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + TIMEOUT
+        while _done(store) < 2:  # some chunks written, the others still to come
+            assert client_process.poll() is None, client_process.stderr.read().decode()
+            assert time.monotonic() < deadline, "the client wrote no chunk"
+            time.sleep(0.02)
+        client_process.send_signal(signal.SIGKILL)
+        client_process.wait(timeout=TIMEOUT)
+    finally:
+        stop(client_process)
+        client_process.stderr.close()
+    written = _done(store)
+    assert 2 <= written < CHUNKS
+    with distributed.Client(scheduler_file=str(scheduler_file), timeout=TIMEOUT) as client:
+        ds = tumble.sweep(BODY, client=client, store=store, **SWEEP)
+    assert ds.attrs["chunks_computed"] == CHUNKS - written
+    assert_same(ds, reference)
+
+
+def _done(store):
+    """Chunks marked done in the store (0 while it does not exist)."""
+    if not store.exists():
+        return 0
+    import zarr
+
+    return int(np.sum(zarr.open_group(store, mode="r")["done"][:]))
