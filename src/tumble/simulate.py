@@ -42,6 +42,9 @@ from tumble.trajectory import Extra, Trajectory
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
 
+#: The largest |component| of an initial state (quaternions aside: normalised): its square stays finite in float64.
+_LARGEST_STATE = 1e150
+
 #: Solver options when not given (those the method reads).
 DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
 
@@ -346,6 +349,9 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
             arr = arr.reshape(1)
         if arr.ndim > 2:
             raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
+        if not f.quaternion and arr.size and np.abs(arr).max() > _LARGEST_STATE:
+            raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
+                                  f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
         if f.quaternion and np.any(np.linalg.norm(arr, axis=-1) == 0.0):
             raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
         if arr.ndim == 2 and f.name in given:
