@@ -153,4 +153,5 @@ def test_urdf_links_without_mass_or_with_infinite_mass_are_refused_naming_the_el
 def test_rates_whose_square_overflows_are_refused_naming_omega0(method):
     # 1e200 rad/s: ω·Iω overflows; dop853 and the exact flow raised ZeroDivisionError from compiled code
     with pytest.raises(ValidationError, match=r"^omega0: must be at most 1e\+150 in magnitude .* got 1e\+200"):
-        tumble.simulate(BODY, [0.0, 1e200, 1.0], t=[0.0, 1.0], method=method, **({"dt": 0.1} if method == "rk4" else {}))
+        tumble.simulate(BODY, [0.0, 1e200, 1.0], t=[0.0, 1.0], method=method,
+                        **({"dt": 0.1} if method == "rk4" else {}))
