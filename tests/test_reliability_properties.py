@@ -11,6 +11,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -178,3 +179,65 @@ def test_mutated_scenarios_are_built_or_refused_naming_the_key(path, pick, repla
             parse(text, source=str(path)).build()
     except ValidationError as error:
         assert str(error).startswith(f"{path}: "), str(error)  # the file, then the key (or TOML position)
+
+
+# -- URDF: mutations of the example arm (40 examples) ----------------------------------------------------
+
+URDF = (EXAMPLES / "robots" / "panda.urdf").read_text()
+ATTRIBUTE_NUMBER = re.compile(r'(?<==")[-+\d.eE ]+(?=")')  # the numbers of xyz="…", value="…", ixx="…"
+
+
+@fixed(40)
+@given(st.integers(0, 10**6), st.sampled_from(REPLACEMENTS + ["", "1 2", "0 0 0 0"]))
+def test_mutated_urdf_is_a_physical_chain_or_refused_naming_the_element(pick, replacement):
+    numbers = list(ATTRIBUTE_NUMBER.finditer(URDF))
+    m = numbers[pick % len(numbers)]
+    text = URDF[:m.start()] + replacement.replace('"', "") + URDF[m.end():]
+    try:
+        with np.errstate(all="ignore"):
+            chain = tumble.robot.SerialChain.from_urdf(text)
+    except ValidationError as error:
+        assert str(error).split(":")[0].startswith(("link ", "joint ", "URDF")), str(error)
+        return
+    for link in chain.links:
+        assert math.isfinite(link.mass) and link.mass >= 0.0
+        assert np.all(np.isfinite(link.inertia)) and np.linalg.eigvalsh(link.inertia).min() >= -1e-12
+
+
+# -- result files: one value of a saved run altered (15 examples: a write and a read each, ~0.2 s) ------------
+
+
+@pytest.fixture(scope="module")
+def saved_run(tmp_path_factory):
+    """The dataset of a 3-sample rk4 run of BODY, as tumble writes it, and a directory to write variants in."""
+    import xarray as xr
+
+    path = tmp_path_factory.mktemp("saved") / "run.nc"
+    tumble.simulate(BODY, [0.1, 1.0, 0.1], t=[0.0, 0.5, 1.0], method="rk4", dt=0.5).save(path)
+    return xr.load_dataset(path, engine="h5netcdf"), path.parent
+
+
+@fixed(15)
+@given(st.sampled_from(["time", "q", "omega", "inertia"]), st.integers(0, 10**6),
+       st.sampled_from([math.nan, math.inf, -1.0, 0.0, 1e308, 1.0 + 1e-6, 0.5, -1e-300]))
+def test_a_result_file_with_one_value_altered_loads_valid_or_is_refused_naming_the_file(saved_run, name, pick, value):
+    dataset, directory = saved_run
+    values = dataset[name].values.copy()
+    flat = values.reshape(-1)
+    flat[pick % flat.size] = value
+    if name == "time":
+        ds = dataset.assign_coords(time=values)
+    else:
+        ds = dataset.assign({name: (dataset[name].dims, values)})
+    path = directory / f"variant-{name}-{pick % flat.size}-{value}.nc"
+    ds.to_netcdf(path, engine="h5netcdf")
+    try:
+        traj = tumble.load(path)
+    except ValidationError as error:
+        assert str(error).startswith(f"{path}: "), str(error)
+        return
+    finally:
+        path.unlink()
+    assert np.all(np.diff(traj.t) > 0.0) and np.all(np.isfinite(traj.q)) and np.all(np.isfinite(traj.omega))
+    assert np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0).max() <= tumble.trajectory.UNIT_Q_TOL
+    assert np.linalg.eigvalsh(traj.inertia).min() >= 0.0
