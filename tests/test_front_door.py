@@ -18,7 +18,7 @@ T = [0.0, 1.0]
 
 
 @pytest.mark.parametrize("method, option", [("dop853", "dt"), ("rk4", "rtol"), ("rk4", "atol"),
-                                            ("cf4", "max_steps"), ("exact", "dt"), ("exact", "rtol")])
+                                            ("cf4", "rtol"), ("exact", "dt"), ("exact", "max_steps")])
 def test_an_option_the_method_does_not_read_is_refused(method, option):
     with pytest.raises(ValidationError, match=rf"^{option}: method '{method}' does not use {option}"):
         tumble.simulate(tumble.RigidBody(DIAG), OMEGA0, t=T, method=method, **{option: 0.1})
@@ -26,7 +26,7 @@ def test_an_option_the_method_does_not_read_is_refused(method, option):
 
 def test_every_method_names_the_options_it_reads():
     for name, m in integrate.METHODS.items():
-        expected = ("rtol", "atol", "max_steps") if m.adaptive else (("dt",) if m.stepper else ())
+        expected = ("rtol", "atol", "max_steps") if m.adaptive else (("dt", "max_steps") if m.stepper else ())
         assert m.options == expected, name
 
 
@@ -72,7 +72,7 @@ def test_a_method_is_refused_exactly_when_the_kernel_misses_what_it_needs(method
     body = tumble.RigidBody(DIAG)
     torque = tumble.torques.ConstantBody([0.0, 0.0, 0.1])
     provides = body.compile(torque, 0.0).provides
-    options = {"dt": 0.1} if integrate.METHODS[method].options == ("dt",) else {}
+    options = {"dt": 0.1} if "dt" in integrate.METHODS[method].options else {}
     if integrate.METHODS[method].needs <= provides:
         traj = tumble.simulate(body, OMEGA0, t=T, method=method, torque=torque, **options)
         assert traj.method == method

@@ -108,7 +108,7 @@ BAD = [
     (urdf(link("base") + link("a", 1.0) + joint("j1", "base", "a", xyz="0 0 x")),
      r"joint 'j1' <origin>: attribute xyz='0 0 x' must be 3 finite numbers"),
     (urdf(link("base") + link("a", "-1") + joint("j1", "base", "a")),
-     r"link 'a' <inertial> <mass>: value must be >= 0"),
+     r"link 'a' <inertial> <mass>: value must be a finite number >= 0"),
     (urdf(link("base") + link("a", 1.0, inertia=(1, 0, 0, 1, 0, -1)) + joint("j1", "base", "a")),
      r"link 'a' <inertial> <inertia>: must be positive semi-definite"),
     (urdf(link("base") + link("a", 1.0) + joint("j1", "base", "a", kind="fixed")),

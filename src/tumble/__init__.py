@@ -15,13 +15,17 @@ sloshing and shape-changing bodies, spacecraft, robot arms, gyroscopes)
 implements :class:`tumble.Model` and runs through it.
 """
 
-from tumble import attitude, dynamics, integrate, limits, torques
-from tumble._validate import ValidationError
-from tumble.body import RigidBody
-from tumble.integrate import SolverError
-from tumble.limits import RigidityWarning
-from tumble.simulate import Model, simulate
-from tumble.trajectory import Trajectory, load
+from tumble._cache import ensure_writable_cache
+
+ensure_writable_cache()  # before any compiled module: a read-only install must still import
+
+from tumble import attitude, dynamics, integrate, limits, torques  # noqa: E402
+from tumble._validate import ValidationError  # noqa: E402
+from tumble.body import RigidBody  # noqa: E402
+from tumble.integrate import SolverError  # noqa: E402
+from tumble.limits import RigidityWarning  # noqa: E402
+from tumble.simulate import Model, simulate  # noqa: E402
+from tumble.trajectory import Trajectory, load  # noqa: E402
 
 __version__ = "0.1.0"
 

@@ -74,9 +74,13 @@ def invoke(slot: int, t: float, args: tuple, out: np.ndarray) -> None:
     result does not have the shape of ``out`` or is not finite.
     """
     entry = _ENTRIES[int(slot)]
-    value = np.asarray(entry.function(float(t), *(np.array(a) for a in args)), dtype=np.float64)
-    if value.shape != out.shape or not np.all(np.isfinite(value)):
+    result = entry.function(float(t), *(np.array(a) for a in args))
+    try:
+        value = None if result is None else np.asarray(result, dtype=np.float64)  # asarray(None) would be nan
+    except (TypeError, ValueError):
+        value = None  # not numbers at all (a string, a ragged list): said as returned, below
+    if value is None or value.shape != out.shape or not np.all(np.isfinite(value)):
         name = getattr(entry.function, "__name__", repr(entry.function))
         raise ValidationError(f"{entry.field}: the function {name}{entry.signature} must return {entry.returns}; "
-                              f"at t={t} it returned {value!r}")
+                              f"at t={t} it returned {result!r}")
     out[:] = value

@@ -15,6 +15,8 @@ from tumble._validate import ValidationError, as_array
 
 # Inertia symmetric when max |I − Iᵀ| ≤ _SYMMETRY_RTOL · max |I|.
 _SYMMETRY_RTOL = 1e-12
+# Largest |entry| (kg·m²): the eigen-decomposition squares entries, and past ~1e154 LAPACK's does not converge.
+_LARGEST = 1e150
 # Positive definite when the smallest principal moment > _DEFINITE_RTOL × the
 # largest: below that a moment is indistinguishable from zero at the float64
 # rounding of the eigen-decomposition (~1e-16 × the largest moment).
@@ -84,6 +86,11 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
         return f" ({member_note(k)})" if member_note is not None and k else ""
 
     scale = np.abs(inertia).max(axis=(-2, -1))
+    bad = scale > _LARGEST
+    if bad.any():
+        field, k = where(bad)
+        raise ValidationError(f"{field}: entries must be at most {_LARGEST:g} kg m^2 in magnitude (the "
+                              f"eigen-decomposition squares them), got {scale[k]:.3g}{note(k)}")
     asym = np.abs(inertia - np.swapaxes(inertia, -1, -2)).max(axis=(-2, -1))
     bad = asym > _SYMMETRY_RTOL * scale
     if bad.any():

@@ -7,6 +7,8 @@ message that names the field and the rule it breaks, e.g.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 
@@ -58,9 +60,19 @@ def require_finite(arr: np.ndarray, name: str) -> None:
         raise ValidationError(f"{name}: must be finite (found {arr[bad].flat[0]}{where})")
 
 
+def _scalar(x, name: str, rule: str) -> float:
+    """``float(x)`` for a single number; anything else (a list, a string) is refused naming ``name``."""
+    try:
+        if np.ndim(x) != 0:
+            raise TypeError
+        return float(x)
+    except (TypeError, ValueError):
+        raise ValidationError(f"{name}: must be {rule}, got {x!r}") from None
+
+
 def require_positive(x: float, name: str) -> float:
     """Return ``float(x)`` if it is finite and > 0, else raise naming ``name``."""
-    x = float(x)
+    x = _scalar(x, name, "a finite number > 0")
     if not np.isfinite(x) or x <= 0.0:
         raise ValidationError(f"{name}: must be a finite number > 0, got {x}")
     return x
@@ -68,7 +80,7 @@ def require_positive(x: float, name: str) -> float:
 
 def require_non_negative(x: float, name: str) -> float:
     """Return ``float(x)`` if it is finite and >= 0, else raise naming ``name``."""
-    x = float(x)
+    x = _scalar(x, name, "a finite number >= 0")
     if not np.isfinite(x) or x < 0.0:
         raise ValidationError(f"{name}: must be a finite number >= 0, got {x}")
     return x
@@ -99,3 +111,32 @@ def output_times(t) -> np.ndarray:
     """
     return increasing_times(t)
 
+
+
+def memory_bytes() -> int:
+    """The machine's physical memory (bytes), or 2⁶³ − 1 where the system does not say."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return 2**63 - 1
+
+
+def require_memory(nbytes: int, name: str, what: str) -> None:
+    """Refuse (naming ``name``) an allocation of ``nbytes`` sized from input — ``what`` says what it holds —
+    when it is more than half the machine's physical memory: checked before allocating, so that a hostile
+    size is a one-line error, not an hour of swapping or a process killed for memory."""
+    limit = memory_bytes() // 2
+    if not nbytes <= limit:
+        exact = f"{float(nbytes):.2g} bytes" if np.isfinite(nbytes) else "more than 1.8e308 bytes"
+        raise ValidationError(f"{name}: {what} need {_binary(nbytes)} ({exact}), more than half this machine's "
+                              f"memory ({_binary(2 * limit)}); ask for less")
+
+
+def _binary(n: float) -> str:
+    """``n`` bytes in binary units, e.g. ``"7.3 TiB"``."""
+    units = ["bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB", "ZiB", "YiB"]
+    k, value = 0, float(n)
+    while value >= 1024.0 and k < len(units) - 1:
+        value /= 1024.0
+        k += 1
+    return f"{value:.1f} {units[k]}" if np.isfinite(value) else "an unbounded amount"

@@ -86,6 +86,10 @@ def _where(bad: np.ndarray) -> str:
     return f" at index {idx[0] if len(idx) == 1 else idx}"
 
 
+#: The largest rotation angle (rad) :func:`from_rotvec` takes: past it the spacing of float64 numbers is 2 rad.
+_HUGE_ANGLE = 1e16
+
+
 def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
     """``q`` as a float64 (…, 4) array; with ``nonzero``, refuse q = 0 (it is no rotation)."""
     q = as_array(q, name, tail=(4,))
@@ -96,6 +100,12 @@ def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
                 f"{name}: must be non-zero to represent a rotation (|{name}| = 0{_where(zero)})"
             )
     return q
+
+
+def _scaled(q: np.ndarray) -> np.ndarray:
+    """``q`` divided by its largest |component| (non-zero): the same rotation, with components in [−1, 1] so that
+    squares neither underflow (``q = [1e-200, 1e-200, 0, 0]``) nor overflow."""
+    return q / np.abs(q).max(axis=-1, keepdims=True)
 
 
 def _flat(arr: np.ndarray, batch: tuple[int, ...], tail: tuple[int, ...]) -> np.ndarray:
@@ -368,9 +378,19 @@ def from_rotvec(r) -> np.ndarray:
     """Unit quaternion (…, 4) of rotation vectors ``r`` (…, 3, rad).
 
     ``q = exp(r/2) = [cos(θ/2), sin(θ/2) r/θ]`` with ``θ = |r|`` (a Taylor
-    series for ``θ < 1e-4``).
+    series for ``θ < 1e-4``). An angle past :data:`_HUGE_ANGLE` (1e16 rad) is
+    refused: float64 angles there are 2 rad apart, so they define no rotation
+    (and ``θ²`` overflows past 1.3e154, which gave NaN).
     """
     r = as_array(r, "r", tail=(3,))
+    largest = np.abs(r).max(axis=-1, initial=0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        theta = largest * np.linalg.norm(r / np.where(largest > 0.0, largest, 1.0)[..., None], axis=-1)
+    huge = ~(theta <= _HUGE_ANGLE)
+    if np.any(huge):
+        raise ValidationError(f"r: rotation angle |r| = {float(np.asarray(theta)[huge].flat[0]):.3g} rad{_where(huge)} "
+                              f"is past {_HUGE_ANGLE:g} rad, where float64 angles are 2 rad apart and define no "
+                              "rotation: reduce it modulo 2π first")
     out = np.empty((math.prod(r.shape[:-1]), 4))
     _from_rotvec_loop(_flat(r, r.shape[:-1], (3,)), out)
     return out.reshape((*r.shape[:-1], 4))
@@ -378,7 +398,7 @@ def from_rotvec(r) -> np.ndarray:
 
 def to_rotvec(q) -> np.ndarray:
     """Rotation vector (…, 3, rad) of ``q / |q|``, angle ``θ = 2 atan2(|u|, |w|)`` in [0, π]."""
-    q = _as_quat(q)
+    q = _scaled(_as_quat(q))
     out = np.empty((math.prod(q.shape[:-1]), 3))
     _to_rotvec_loop(_flat(q, q.shape[:-1], (4,)), out)
     return out.reshape((*q.shape[:-1], 3))
@@ -389,7 +409,7 @@ def angle(q) -> np.ndarray:
 
     ``θ = 2 atan2(|u|, |w|)`` with ``q = [w, u]``: accurate near 0 and near π.
     """
-    q = _as_quat(q)
+    q = _scaled(_as_quat(q))
     out = np.empty(math.prod(q.shape[:-1]))
     _angle_loop(_flat(q, q.shape[:-1], (4,)), out)
     return out.reshape(q.shape[:-1])

@@ -33,12 +33,12 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 import tumble
 from tumble import scenario as scenarios
+from tumble._cli_errors import exit_codes as _exit_codes
 from tumble._demos import DEMOS, Demo
-from tumble._validate import ValidationError, require_positive
+from tumble._validate import ValidationError, require_memory, require_positive
 from tumble.analysis import flip_times, intermediate_rate
 from tumble.analytic._stability import flip_interval, stability
 from tumble.body import RigidBody
-from tumble.integrate import SolverError
 from tumble.robot.cli import app as robot_app
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory, load, write_atomic
@@ -56,9 +56,6 @@ app = typer.Typer(
 demo_app = typer.Typer(help="Built-in demonstrations.", no_args_is_help=True, rich_markup_mode="markdown")
 app.add_typer(demo_app, name="demo")
 app.add_typer(robot_app, name="robot", help="Robot arms (serial chains from DH tables or URDF): joint torques.")
-
-EXIT_BAD_INPUT = 2
-EXIT_FAILURE = 1
 
 # Tennis-racket demo: spin about the intermediate axis, perturbation on the
 # other two (rad/s, principal axes), and output rate. A flip of the default
@@ -113,7 +110,7 @@ def run(
 
     A bad scenario is reported on stderr (file, key, rule) with exit code 2, and nothing is written.
     """
-    with _exit_codes():
+    with _exit_codes(scenario):
         spec = scenarios.load(scenario)  # the file is read and parsed once; its kind picks the model
         problem = spec.build()  # every rule of the file is checked before anything runs
         _check_outputs(output, plot, inputs=(scenario,))
@@ -148,6 +145,10 @@ def racket(
         _check_outputs(output, plot)
         body = RigidBody.t_handle()
         omega0 = body.axes @ np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
+        # t, q, omega and the totals (energy, momentum): 11 float64 per sample, twice over (states and result)
+        samples = duration * _RACKET_SAMPLES_PER_SECOND + 1
+        require_memory(2 * 11 * 8 * samples, "--duration", f"the samples of {duration:g} s "
+                                                           f"({_RACKET_SAMPLES_PER_SECOND} per second)")
         n = int(np.ceil(duration * _RACKET_SAMPLES_PER_SECOND))
         with _progress_bar("simulating", enabled=not quiet) as progress:
             traj = simulate(body, omega0, t=np.linspace(0.0, duration, n + 1),
@@ -322,25 +323,31 @@ def _sweep_rows(ds) -> list[tuple[str, str]]:
 @app.command()
 def info(path: Annotated[Path, typer.Argument(help="NetCDF file written by tumble run / tumble demo, or a Zarr "
                                                     "store written by tumble sweep or simulate(store=).")]) -> None:
-    """Print what a trajectory file or a sweep's store holds: times, bodies, method, solver info and drifts."""
+    """Print what a trajectory file or a sweep's store holds: times, bodies, method, solver info and drifts.
+
+    A trajectory file is validated as it is read (tumble.load): not a regular file, damaged, too large for the
+    memory, not unit quaternions or not a physical inertia: one line on stderr, exit code 2.
+    """
     if path.is_dir():
         _info_store(path)
         return
-    with _exit_codes():
+    with _exit_codes(path):
         try:
             traj = load(path)
-        except (OSError, ValueError) as exc:
+        except OSError as exc:
             raise ValidationError(f"{path}: not a readable tumble trajectory ({exc})") from None
-    inertia = traj.inertia.reshape(-1, 3, 3)
-    moments = np.linalg.eigvalsh(inertia)
-    bodies = "1" if traj.batch_size is None else f"{traj.batch_size} (batch)"
-    rows = [("file", str(path)), ("bodies", bodies)]
-    rows += [("moments" if i == 0 else "", f"{m[0]:.6g}, {m[1]:.6g}, {m[2]:.6g} kg m^2 (principal)")
-             for i, m in enumerate(moments[:5])]
-    if len(moments) > 5:
-        rows.append(("", f"... {len(moments) - 5} more"))
-    rows += _summary(traj)
-    rows += [("solver" if i == 0 else "", f"{key} = {value}") for i, (key, value) in enumerate(traj.info.items())]
+        if traj.inertia is None:
+            moments = np.zeros((0, 3))
+        else:
+            moments = np.linalg.eigvalsh(traj.inertia.reshape(-1, 3, 3))
+        bodies = "1" if traj.batch_size is None else f"{traj.batch_size} (batch)"
+        rows = [("file", str(path)), ("bodies", bodies)]
+        rows += [("moments" if i == 0 else "", f"{m[0]:.6g}, {m[1]:.6g}, {m[2]:.6g} kg m^2 (principal)")
+                 for i, m in enumerate(moments[:5])]
+        if len(moments) > 5:
+            rows.append(("", f"... {len(moments) - 5} more"))
+        rows += _summary(traj)
+        rows += [("solver" if i == 0 else "", f"{key} = {value}") for i, (key, value) in enumerate(traj.info.items())]
     _print_rows(rows)
 
 
@@ -364,7 +371,7 @@ def view(
     """
     from tumble.viewer import write_html
 
-    with _exit_codes():
+    with _exit_codes(path):
         _check_outputs(output, None, inputs=(path,) + (() if scenario is None else (scenario,)))
         model = None if scenario is None else scenarios.load(scenario).model
         write_html(path, output, model=model, frames=frames, axis=axis)
@@ -374,45 +381,28 @@ def _info_store(path: Path) -> None:
     """``tumble info`` of a Zarr store: a sweep's samples and outcomes, or a streamed run's dimensions."""
     import xarray as xr
 
-    with _exit_codes():
+    with _exit_codes(path):
         try:
             ds = xr.open_zarr(path, consolidated=False)
-        except (OSError, ValueError, KeyError) as exc:
-            raise ValidationError(f"{path}: not a readable Zarr store ({exc})") from None
-    if "tumble_sweep" in ds.attrs:
-        complete = "complete" if ds.attrs.get("tumble_sweep_complete") else "incomplete (run tumble sweep again)"
-        _print_rows([("store", f"{path}: a sweep, {complete}"), *_sweep_rows(ds)])
-        return
-    sizes = ", ".join(f"{name} {size}" for name, size in ds.sizes.items())
-    rows = [("store", f"{path}: a run streamed by simulate(store=)"), ("model", str(ds.attrs.get("model", "?"))),
-            ("sizes", sizes), ("times", f"{float(ds.time[0]):g} to {float(ds.time[-1]):g} s, {ds.sizes['time']} samples"),
-            ("method", str(ds.attrs.get("method", "?")))]
-    rows += [("solver" if i == 0 else "", f"{key[7:]} = {value}")
-             for i, (key, value) in enumerate((k, v) for k, v in ds.attrs.items() if k.startswith("solver_"))]
+        except Exception as exc:  # noqa: BLE001 - a damaged store may make zarr raise anything
+            raise ValidationError(f"{path}: not a readable Zarr store ({type(exc).__name__}: {exc})") from None
+        if "tumble_sweep" in ds.attrs:
+            complete = "complete" if ds.attrs.get("tumble_sweep_complete") else "incomplete (run tumble sweep again)"
+            rows = [("store", f"{path}: a sweep, {complete}"), *_sweep_rows(ds)]
+        else:
+            sizes = ", ".join(f"{name} {size}" for name, size in ds.sizes.items())
+            rows = [("store", f"{path}: a run streamed by simulate(store=)"),
+                    ("model", str(ds.attrs.get("model", "?"))), ("sizes", sizes),
+                    ("times", f"{float(ds.time[0]):g} to {float(ds.time[-1]):g} s, {ds.sizes['time']} samples"),
+                    ("method", str(ds.attrs.get("method", "?")))]
+            rows += [("solver" if i == 0 else "", f"{key[7:]} = {value}")
+                     for i, (key, value) in enumerate((k, v) for k, v in ds.attrs.items() if k.startswith("solver_"))]
     _print_rows(rows)
 
 
 # --------------------------------------------------------------------------
 # Helpers
 # --------------------------------------------------------------------------
-
-
-@contextmanager
-def _exit_codes() -> Iterator[None]:
-    """Turn bad input into exit code 2 and known failures into exit code 1, each with a message on stderr."""
-    try:
-        yield
-    except ValidationError as exc:
-        _error(str(exc))
-        raise typer.Exit(EXIT_BAD_INPUT) from None
-    except (SolverError, OSError) as exc:
-        _error(str(exc))
-        raise typer.Exit(EXIT_FAILURE) from None
-
-
-def _error(message: str) -> None:
-    for line in message.splitlines():
-        typer.echo(f"error: {line}", err=True)
 
 
 def _check_outputs(output: Path, plot: Path | None, *, inputs: tuple[Path, ...] = ()) -> None:

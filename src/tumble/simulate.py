@@ -42,8 +42,11 @@ from tumble.trajectory import Extra, Trajectory
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
 
+#: The largest |component| of an initial state (quaternions aside: normalised): its square stays finite in float64.
+_LARGEST_STATE = 1e150
+
 #: Solver options when not given (those the method reads).
-DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": 10**9}
+DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
 
 
 @dataclass(frozen=True)
@@ -180,11 +183,13 @@ def simulate(
         Output times, s, strictly increasing; ``t[0]`` is the start.
     method : str, one of ``tumble.integrate.METHODS``
         ``"dop853"`` (default): adaptive 8th-order Dormand–Prince (``rtol``,
-        default 1e-10; ``atol``, default 1e-12; ``max_steps`` per body, default
-        1e9); ``"rk4"``, ``"cf4"`` (Lie group), ``"splitting2"``/``"splitting4"``
-        (Lie–Poisson, torque-free rigid bodies), ``"exact_split2"``/``"exact_split4"``
-        (exact free flow + torque kicks): fixed step ``dt`` (s); ``"exact"``: the
-        closed-form torque-free motion. A method the model does not provide for
+        default 1e-10; ``atol``, default 1e-12); ``"rk4"``, ``"cf4"`` (Lie group),
+        ``"splitting2"``/``"splitting4"`` (Lie–Poisson, torque-free rigid bodies),
+        ``"exact_split2"``/``"exact_split4"`` (exact free flow + torque kicks):
+        fixed step ``dt`` (s); ``"exact"``: the closed-form torque-free motion.
+        Every stepping method takes ``max_steps`` per body (default
+        ``tumble.integrate.MAX_STEPS`` = 1e8): a fixed-step run that needs more
+        is refused before it starts, an adaptive one stops there. A method the model does not provide for
         is refused, naming those that work; so is an option the method does not
         read. See ``docs/integrators.md``.
     torque
@@ -246,11 +251,32 @@ def simulate(
                                   + (" and a progress callback" if progress is not None else ""))
         y0 = model.initial_states(kernel, values, float(times[0]))
         _check_memory(times.size, y0)
-        solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device, **options)
+        try:
+            solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device,
+                                       **options)
+        except integrate.Diverged as diverged:
+            raise _divergence(model, kernel, times, diverged) from None
         out = model.outputs(kernel, times, solution.states)
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
     return _trajectory(model, m.name, times, out, info, single=n is None)
+
+
+def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverged) -> integrate.SolverError:
+    """The message of a run whose state stopped being finite: the output time where it is first seen, and
+    the body rate at the output time before (the last finite state), from the model's own outputs."""
+    k, b = diverged.index, diverged.member
+    who = f"body {b}: " if diverged.states.shape[1] > 1 else ""
+    rate = ""
+    try:
+        with np.errstate(all="ignore"):
+            omega = model.outputs(kernel, t[k - 1:k], diverged.states[k - 1:k]).omega if k > 0 else None
+    except ValueError:  # a model may refuse states near overflow: the time alone is said
+        omega = None
+    if omega is not None:
+        rate = f" (|ω| = {np.linalg.norm(omega[0, b]):.3g} rad/s at t = {t[k - 1]:g} s, the last finite state)"
+    change = "tighten rtol/atol" if integrate.METHODS[diverged.method].adaptive else "reduce dt"
+    return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: {change} or check the torque")
 
 
 #: Output words per member and time beyond the states: q (4), omega (3), energy (1), momentum (3).
@@ -323,6 +349,9 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
             arr = arr.reshape(1)
         if arr.ndim > 2:
             raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
+        if not f.quaternion and arr.size and np.abs(arr).max() > _LARGEST_STATE:
+            raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
+                                  f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
         if f.quaternion and np.any(np.linalg.norm(arr, axis=-1) == 0.0):
             raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
         if arr.ndim == 2 and f.name in given:

@@ -32,11 +32,16 @@ described in ``docs/trajectory.md``.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
+import fcntl
+import glob
 import operator
 import os
+import signal
 import stat
 import tempfile
+import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -589,12 +594,53 @@ def _tumble_version() -> str:
     return str(getattr(tumble, "__version__", "unknown"))
 
 
+#: Largest ``||q| − 1|`` a trajectory file may hold: every method keeps ``|q| = 1`` to ~1e-13 over 1e8 steps
+#: (rounding, 1e-16 per step, adds like a random walk); a file past it was altered or damaged.
+UNIT_Q_TOL = 1e-9
+
+
 def load(path: str | os.PathLike) -> Trajectory:
-    """Read a trajectory written by :meth:`Trajectory.save` (arrays bitwise equal)."""
+    """Read a trajectory written by :meth:`Trajectory.save` (arrays bitwise equal), validated as it is built.
+
+    Refused with a :class:`ValidationError` naming the file: a path that is not a regular file (a FIFO, a
+    device: reading it could block for ever), variables larger than the memory can hold (checked from the
+    header, before reading them), any file the NetCDF/HDF5 readers cannot read, and contents that break the
+    rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤`` :data:`UNIT_Q_TOL`, and an
+    inertia tensor that is symmetric, positive semi-definite and meets the triangle inequality
+    (:func:`tumble._inertia.principal_axes`). A missing or unreadable path raises :class:`OSError`.
+    """
     import xarray as xr
 
-    ds = xr.load_dataset(path, engine=_ENGINE, decode_timedelta=False)
-    return Trajectory.from_xarray(ds)
+    from ._inertia import principal_axes
+    from ._validate import require_memory
+
+    if not stat.S_ISREG(os.stat(path).st_mode):
+        raise ValidationError(f"{os.fspath(path)}: not a regular file")
+    try:
+        with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False, phony_dims="access") as lazy:
+            nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
+            require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
+            ds = lazy.load()
+        with np.errstate(all="ignore"):
+            traj = Trajectory.from_xarray(ds)
+    except ValidationError as exc:
+        raise ValidationError(f"{os.fspath(path)}: {exc}") from None
+    except (OSError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - a hostile file may make h5py/xarray raise anything
+        raise ValidationError(f"{os.fspath(path)}: not a readable tumble trajectory "
+                              f"({type(exc).__name__}: {exc})") from None
+    if traj.q is not None:
+        error = np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0)
+        if error.max(initial=0.0) > UNIT_Q_TOL:
+            k = tuple(int(i) for i in np.unravel_index(np.argmax(error), error.shape))
+            raise ValidationError(f"{os.fspath(path)}: q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
+                                  f"|q{list(k)}| = {np.linalg.norm(traj.q[k]):.17g}")
+        try:
+            principal_axes(traj.inertia, "inertia", definite=False)
+        except ValidationError as exc:
+            raise ValidationError(f"{os.fspath(path)}: {exc}") from None
+    return traj
 
 
 def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
@@ -603,9 +649,18 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
     The temporary file (suffix ``.tmp``) is made in the directory of ``path``,
     so :func:`os.replace` is an atomic rename: readers see either the old file
     or the complete new one, never a partial file. On any exception, including
-    ``KeyboardInterrupt``, the temporary file is removed, a pre-existing
-    ``path`` is left untouched, and the exception propagates. The new file gets
-    the permissions of the file it replaces, or the default ``0o666 & ~umask``.
+    ``KeyboardInterrupt`` (SIGINT) and SIGTERM (turned into ``SystemExit(143)``
+    while the write runs, in the main thread), the temporary file is removed, a
+    pre-existing ``path`` is left untouched, and the exception propagates. The
+    new file gets the permissions of the file it replaces, or the default
+    ``0o666 & ~umask``.
+
+    One writer at a time: a writer holds an exclusive :func:`fcntl.flock` on the
+    sibling ``.NAME.lock`` (removed when it is done; the kernel releases the
+    lock of a killed process), and a second writer to the same path is refused
+    at once with :class:`FileExistsError` naming it (it neither waits nor
+    silently wins). Holding the lock, a writer removes the ``.NAME.*.tmp``
+    siblings left by killed runs (``kill -9``): no live writer owns them.
 
     ``write`` must not infer the format from the file name, which ends in
     ``.tmp``: e.g. ``write_atomic("fig.png", lambda p: fig.savefig(p, format="png"))``.
@@ -616,25 +671,62 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise FileNotFoundError(f"path: directory {directory!r} does not exist (writing {path!r})")
-    with tempfile.NamedTemporaryFile(
-        dir=directory, prefix=f".{os.path.basename(path)}.", suffix=".tmp", delete=False
-    ) as tmp:
-        tmp_path = tmp.name
+    name = os.path.basename(path)
+    with _exclusive(os.path.join(directory, f".{name}.lock"), path), _terminate_as_exit():
+        for stale in glob.glob(os.path.join(glob.escape(directory), f".{glob.escape(name)}.*.tmp")):
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(stale)
+        with tempfile.NamedTemporaryFile(dir=directory, prefix=f".{name}.", suffix=".tmp", delete=False) as tmp:
+            tmp_path = tmp.name
+        try:
+            write(tmp_path)
+            _set_mode(tmp_path, path)
+            fd = os.open(tmp_path, os.O_RDWR)
+            try:
+                os.fsync(fd)  # the data reach the disk before the rename makes them visible
+            finally:
+                os.close(fd)
+            os.replace(tmp_path, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(tmp_path)
+            raise
+
+
+@contextlib.contextmanager
+def _exclusive(lock_path: str, path: str):
+    """Hold an exclusive flock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
+    fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
     try:
-        write(tmp_path)
-        _set_mode(tmp_path, path)
-        fd = os.open(tmp_path, os.O_RDWR)
         try:
-            os.fsync(fd)  # the data reach the disk before the rename makes them visible
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise FileExistsError(f"{path}: another process is writing it now (it holds {lock_path}); wait for it "
+                                  "to finish, or write elsewhere") from None
+        try:
+            yield
         finally:
-            os.close(fd)
-        os.replace(tmp_path, path)
-    except BaseException:
-        try:
-            os.remove(tmp_path)
-        except FileNotFoundError:
-            pass
-        raise
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(lock_path)
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def _terminate_as_exit():
+    """While the block runs in the main thread, SIGTERM raises ``SystemExit(143)`` (so cleanups run)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def exit_(signum, frame):
+        raise SystemExit(128 + signal.SIGTERM)
+
+    previous = signal.signal(signal.SIGTERM, exit_)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
 
 
 def _set_mode(tmp_path: str, path: str) -> None:

@@ -43,14 +43,32 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble._protocol import CAPABILITIES
-from tumble._validate import ValidationError, require_positive
+from tumble._validate import ValidationError, require_memory, require_positive
 from tumble.integrate import _dop853, _exact, _exactsplit, _fixed, _liegroup, _rk4, _splitting
 
-__all__ = ["METHODS", "Method", "Solution", "SolverError", "check_method", "check_options", "solve"]
+__all__ = ["MAX_STEPS", "METHODS", "Diverged", "Method", "Solution", "SolverError", "check_method", "check_options",
+           "solve"]
+
+#: Default ``max_steps``: the most steps per body of one run, for every method (about 10 s of ``rk4`` on a
+#: torque-free rigid body; a run past it is refused, before it starts for the fixed-step methods).
+MAX_STEPS = 10**8
+
+#: The largest ``max_steps`` accepted: step counts stay exact whole float64 numbers and fit an int64.
+MAX_STEPS_LIMIT = 2**53
 
 
 class SolverError(RuntimeError):
     """The integrator could not reach the requested times (the message says what to change)."""
+
+
+class Diverged(SolverError):
+    """The state stopped being finite: ``index`` is the first output sample that is not, ``member`` the batch
+    member, ``states`` the output samples, ``method`` the method's name (:func:`tumble.simulate` turns it into
+    a message naming the time and the body rate)."""
+
+    def __init__(self, message: str, index: int, member: int, states: np.ndarray, method: str):
+        super().__init__(message)
+        self.index, self.member, self.states, self.method = index, member, states, method
 
 
 @dataclass(frozen=True)
@@ -75,7 +93,7 @@ class Method:
         """The solver options this method reads (the others are refused by :func:`tumble.simulate`)."""
         if self.adaptive:
             return ("rtol", "atol", "max_steps")
-        return ("dt",) if self.stepper else ()
+        return ("dt", "max_steps") if self.stepper else ()
 
 
 _FREE_INVARIANTS = "|L|, L_N and |q| = 1 (exact rotations; energy error bounded, symplectic)"
@@ -129,18 +147,29 @@ def check_options(method: str, *, dt, rtol, atol, max_steps) -> Method:
     if method not in METHODS:
         raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
     m = METHODS[method]
+    if m.stepper:
+        _check_max_steps(max_steps)
     if m.adaptive:
         require_positive(rtol, "rtol")
         require_positive(atol, "atol")
         if rtol < 1e-15:
             raise ValidationError(f"rtol: must be >= 1e-15 (float64 cannot do better), got {rtol}")
-        if int(max_steps) < 1:
-            raise ValidationError(f"max_steps: must be >= 1, got {max_steps}")
     elif m.stepper:
         if dt is None:
             raise ValidationError(f"dt: method {method!r} has a fixed step: give dt > 0 (s)")
         require_positive(dt, "dt")
     return m
+
+
+def _check_max_steps(max_steps) -> None:
+    """Refuse a ``max_steps`` that is not a whole number from 1 to :data:`MAX_STEPS_LIMIT`."""
+    whole = (isinstance(max_steps, (int, float, np.integer, np.floating)) and not isinstance(max_steps, bool)
+             and float(max_steps).is_integer())
+    if whole and max_steps < 1:
+        raise ValidationError(f"max_steps: must be >= 1, got {max_steps!r}")
+    if not whole or max_steps > MAX_STEPS_LIMIT:
+        raise ValidationError(f"max_steps: must be a whole number from 1 to 2**53 = {MAX_STEPS_LIMIT}, "
+                              f"got {max_steps!r}")
 
 
 def check_method(method: str, provides, who: str) -> Method:
@@ -182,7 +211,7 @@ class Solution:
         return {"n_steps": self.n_steps, "n_rejected": self.n_rejected, "n_rhs": self.n_rhs}
 
 
-def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=10**9, progress=None,
+def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_STEPS, progress=None,
           device="cpu") -> Solution:
     """Integrate the compiled ``model`` (:mod:`tumble._protocol`) for a batch of states ``y0`` (N, n) through ``t``.
 
@@ -190,24 +219,35 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=10**
     A model whose ``calls_python`` is true runs body after body on one core.
     ``progress(done, total)`` is called after each chunk of output samples.
     ``device="cuda"`` runs ``rk4`` on an NVIDIA GPU (models that provide ``"cuda"``).
+
+    Bounded before anything runs: a fixed-step run needing more than ``max_steps`` steps per body is
+    refused (:func:`._fixed.landing_steps`), and so are states that would not fit in memory
+    (:func:`tumble._validate.require_memory`). A state that stops being finite stops the run at the
+    end of the chunk of output samples it is in, with :class:`Diverged`.
     """
     m = check_method(method, model.provides, f"a {type(model).__name__}")
     check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
     y = np.array(y0, dtype=np.float64, order="C")
     n_out = t.shape[0]
+    require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
+                   f"member(s) × {y.shape[1]} values")
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
 
-        states, n_steps = _cuda.solve_cuda(model, y, t, dt)
+        states, n_steps = _cuda.solve_cuda(model, y, t, dt, max_steps)
+        _raise_on_divergence(states, method)
         return Solution(states, n_steps, 0, 4 * n_steps)
+    steps = _fixed.landing_steps(t, dt, max_steps) if method in _SCHEMES else None
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     stats = np.zeros((y.shape[0], 5))
     bounds = [0, n_out - 1]
     if progress is not None and n_out > 2 and m.stepper:
         bounds = np.unique(np.linspace(0, n_out - 1, min(_CHUNKS, n_out - 1) + 1).astype(int)).tolist()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
+        chunk = None if steps is None else (steps[0][lo:hi], steps[1][lo:hi])
         _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
-                   dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, serial=model.calls_python)
+                   steps=chunk, rtol=rtol, atol=atol, max_steps=max_steps, serial=model.calls_python)
+        _raise_on_divergence(out, method, lo, hi)
         _raise_on_failure(stats, t)
         if progress is not None:
             progress(hi + 1, n_out)
@@ -216,7 +256,7 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=10**
     return Solution(out, int(stats[:, 0].sum()), int(stats[:, 1].sum()), int(stats[:, 2].sum()))
 
 
-def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, serial):
+def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps, serial):
     # One body, or a model that calls back into Python: no parallel region
     # (its start-up costs more than a short run, and callbacks need the GIL).
     serial = serial or y.shape[0] == 1
@@ -224,19 +264,30 @@ def _run_chunk(method, model, y, t, out, stats, *, dt, rtol, atol, max_steps, se
         _exact.run(model, y, t, out)
     elif method in _SCHEMES:
         scheme, evaluations = _SCHEMES[method]
+        m, h = steps
         if y.shape[0] == 1:
-            _fixed.run_one(scheme, model, y, t, dt, out, stats)
+            _fixed.run_one(scheme, model, y, t, m, h, out, stats)
         elif serial:
             for k in range(-(-y.shape[0] // _fixed.LANES)):
-                _fixed.run_block(scheme, model, k, y, t, dt, out, stats)
+                _fixed.run_block(scheme, model, k, y, t, m, h, out, stats)
         else:
-            _fixed.run_batch(scheme, model, y, t, dt, out, stats)
+            _fixed.run_batch(scheme, model, y, t, m, h, out, stats)
         stats[:, 2] = evaluations * stats[:, 0]
     elif serial:
         for b in range(y.shape[0]):
             _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, _dop853.tableau(), out[:, b], stats[b])
     else:
         _dop853.dop853_batch(model, y, t, rtol, atol, max_steps, _dop853.tableau(), out, stats)
+
+
+def _raise_on_divergence(states, method, lo=0, hi=None):
+    """Raise :class:`Diverged` at the first output sample of ``states[lo:hi + 1]`` that is not finite."""
+    rows = states[lo:None if hi is None else hi + 1]
+    finite = np.isfinite(rows).reshape(rows.shape[0], rows.shape[1], -1).all(axis=2)
+    if finite.all():
+        return
+    k, member = (int(i) for i in np.argwhere(~finite)[0])
+    raise Diverged(f"simulation diverged at output sample {lo + k} (body {member})", lo + k, member, states, method)
 
 
 def _raise_on_failure(stats, t):

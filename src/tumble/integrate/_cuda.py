@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import cuda, njit, types
+from numba import cuda, types
 from numba.extending import overload, register_jitable
 
 from tumble import _quat, torques
@@ -119,21 +119,6 @@ def _rk4_step(c, P, row, codes, t, h, y):
     return qw * s, qx * s, qy * s, qz * s, w1, w2, w3
 
 
-@njit(cache=True)
-def _landing(t_out, dt):
-    """``(m, h)``: the number ``m[k]`` and length ``h[k]`` (s) of the steps from ``t_out[k]`` to ``t_out[k+1]``.
-
-    The CPU's rule, :func:`tumble.integrate._fixed.landing_steps`, evaluated
-    once on the host (the built-in ``numba.cuda`` of Numba 0.68 cannot compile
-    its ``max`` for the device).
-    """
-    m = np.empty(t_out.shape[0] - 1, dtype=np.int64)
-    h = np.empty(t_out.shape[0] - 1)
-    for k in range(m.shape[0]):
-        m[k], h[k] = landing_steps(t_out[k + 1] - t_out[k], dt)
-    return m, h
-
-
 @cuda.jit(cache=True)
 def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
     """Thread ``b`` integrates body ``b`` from ``y0[b]`` through ``t_out``, ``m[k]`` steps of ``h[k]``
@@ -153,7 +138,7 @@ def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
         out[k, b, 0], out[k, b, 1], out[k, b, 2], out[k, b, 3], out[k, b, 4], out[k, b, 5], out[k, b, 6] = y
 
 
-def solve_cuda(model, y0, t_out, dt) -> tuple[np.ndarray, int]:
+def solve_cuda(model, y0, t_out, dt, max_steps=None) -> tuple[np.ndarray, int]:
     """Integrate a batch of rigid bodies with RK4 on the GPU.
 
     Returns the states (len(t_out), N, 7) at the output times and the number
@@ -170,6 +155,7 @@ def solve_cuda(model, y0, t_out, dt) -> tuple[np.ndarray, int]:
     and ``y0`` (N, 7) the initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s)
     t_out : (n,) output times (s), strictly increasing; ``t_out[0]`` is the start
     dt : the longest step (s)
+    max_steps : the most steps per body (default :data:`tumble.integrate.MAX_STEPS`), checked before the run
 
     The states equal those of ``tumble.integrate.solve(model, y0, t_out, method="rk4", dt=dt)``
     to the rounding of fused multiply–adds (bitwise under the CUDA simulator).
@@ -186,7 +172,11 @@ def solve_cuda(model, y0, t_out, dt) -> tuple[np.ndarray, int]:
         raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     t_out = np.ascontiguousarray(t_out, dtype=np.float64)
-    m, h = _landing(t_out, float(dt))
+    if max_steps is None:
+        from tumble.integrate import MAX_STEPS  # the package imports this module lazily: no cycle at run time
+
+        max_steps = MAX_STEPS
+    m, h = landing_steps(t_out, float(dt), max_steps)
     # torque-free: an empty tuple, and the kernel compiles without torque code (see _torque)
     program = () if codes is None else cuda.to_device(np.ascontiguousarray(codes, dtype=np.int64))
     out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)

@@ -14,7 +14,9 @@ of body ``b0``; overloads specialise on ``Y.ndim``.
 
 Steps land on the output times: between ``t_{k-1}`` and ``t_k`` a method takes
 ``m = ⌈(t_k − t_{k-1})/dt⌉`` equal steps of ``h = (t_k − t_{k-1})/m ≤ dt``
-(:func:`landing_steps`), so no output is interpolated.
+(:func:`landing_steps`), so no output is interpolated. The counts are
+computed once, before the run, as exact integers and checked against
+``max_steps`` (a count past 2⁶³ would otherwise wrap in compiled code).
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ import math
 import numpy as np
 from numba import njit, prange
 from numba.extending import overload
+
+from tumble._validate import ValidationError
 
 #: Bodies advanced together in one structure-of-arrays block (SIMD lanes × unrolling).
 LANES = 64
@@ -64,21 +68,36 @@ def _store(dst, Y):
     return impl
 
 
-@njit(cache=True)
-def landing_steps(span, dt):
-    """``(m, h)``: ``m = ⌈span/dt⌉`` equal steps of ``h = span/m`` that end exactly at ``span``.
+def landing_steps(t_out, dt: float, max_steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(m, h)``: ``m[k] = ⌈(t_out[k+1] − t_out[k])/dt⌉`` equal steps (int64) of ``h[k]`` (s) that end
+    exactly at ``t_out[k+1]``; the one rule of every fixed-step run, CPU and GPU.
 
     ``h ≤ dt`` to 1e-9 relative (a span that is a whole number of steps up to
-    rounding is not given one extra step).
+    rounding is not given one extra step). The counts are whole float64
+    numbers, exact while they are below ``max_steps ≤ 2⁵³``; their sum is the
+    run's number of steps per body, summed exactly (:func:`math.fsum`) and
+    refused (:class:`~tumble.ValidationError` naming ``max_steps``) when it is
+    more than ``max_steps``, before anything is integrated.
     """
-    m = max(1, int(math.ceil(span / dt - 1e-9)))
-    return m, span / m
+    spans = np.diff(np.asarray(t_out, dtype=np.float64))
+    with np.errstate(over="ignore"):
+        counts = np.maximum(1.0, np.ceil(spans / dt - 1e-9))
+    needed = math.fsum(counts)
+    if not needed <= max_steps:
+        steps = f"{needed:.3g}" if math.isfinite(needed) else "more than 1.8e308"
+        allow = (f"give a larger dt, or max_steps={int(needed)} to allow it" if needed <= 2**53
+                 else "give a larger dt (no max_steps allows it: at most 2**53)")
+        raise ValidationError(f"max_steps: the run needs {steps} steps of dt = {dt:g} s from t = {t_out[0]:g} to "
+                              f"{t_out[-1]:g} s, more than max_steps = {max_steps}; {allow}")
+    m = counts.astype(np.int64)
+    return m, spans / m
 
 
 @njit(cache=True)
-def fixed_path(scheme, model, b0, Y, t_out, dt, out):
-    """Advance ``Y`` (in place) through ``t_out``: a block (state × lanes) of bodies ``b0, b0+1, …``,
-    or the state vector of body ``b0``.
+def fixed_path(scheme, model, b0, Y, t_out, m, h, out):
+    """Advance ``Y`` (in place) through ``t_out``, ``m[k]`` steps of ``h[k]`` from ``t_out[k]`` to
+    ``t_out[k+1]`` (:func:`landing_steps`): a block (state × lanes) of bodies ``b0, b0+1, …``, or the
+    state vector of body ``b0``.
 
     ``out[k]`` receives ``Y.T`` at ``t_out[k]``. Returns the number of steps taken.
     """
@@ -86,25 +105,24 @@ def fixed_path(scheme, model, b0, Y, t_out, dt, out):
     store(out[0], Y)
     steps = 0
     for k in range(1, t_out.shape[0]):
-        m, h = landing_steps(t_out[k] - t_out[k - 1], dt)
-        advance(scheme, model, b0, t_out[k - 1], h, m, Y, work)
-        steps += m
+        advance(scheme, model, b0, t_out[k - 1], h[k - 1], m[k - 1], Y, work)
+        steps += m[k - 1]
         store(out[k], Y)
     return steps
 
 
 @njit(cache=True)
-def run_one(scheme, model, y, t_out, dt, out, stats):
+def run_one(scheme, model, y, t_out, m, h, out, stats):
     """Integrate the lone body ``y[0]`` (a batch of one, updated in place) on its state vector.
 
     Its own entry point, so that a single run compiles the state-vector path
     only, not the lane loops of a block as well (half the compile time).
     """
-    stats[0, 0] += fixed_path(scheme, model, 0, y[0], t_out, dt, out[:, 0])
+    stats[0, 0] += fixed_path(scheme, model, 0, y[0], t_out, m, h, out[:, 0])
 
 
 @njit(cache=True)
-def run_block(scheme, model, k, y, t_out, dt, out, stats):
+def run_block(scheme, model, k, y, t_out, m, h, out, stats):
     """Integrate block ``k`` (bodies ``k·LANES …``) of the batch ``y`` (bodies × state, updated in place).
 
     Every block runs its lanes as a structure of arrays, a last block of one lane included.
@@ -112,17 +130,17 @@ def run_block(scheme, model, k, y, t_out, dt, out, stats):
     b0 = k * LANES
     b1 = min(y.shape[0], b0 + LANES)
     Y = np.ascontiguousarray(y[b0:b1].T)
-    steps = fixed_path(scheme, model, b0, Y, t_out, dt, out[:, b0:b1])
+    steps = fixed_path(scheme, model, b0, Y, t_out, m, h, out[:, b0:b1])
     store(y[b0:b1], Y)
     for b in range(b0, b1):
         stats[b, 0] += steps
 
 
 @njit(cache=True, parallel=True)
-def run_batch(scheme, model, y, t_out, dt, out, stats):
+def run_batch(scheme, model, y, t_out, m, h, out, stats):
     """Integrate the bodies ``y[b]`` (updated in place), blocks in parallel over the cores.
 
     ``out[:, b]`` receives body ``b``'s path and ``stats[b, 0]`` its number of steps.
     """
     for k in prange((y.shape[0] + LANES - 1) // LANES):
-        run_block(scheme, model, np.int64(k), y, t_out, dt, out, stats)
+        run_block(scheme, model, np.int64(k), y, t_out, m, h, out, stats)

@@ -38,7 +38,7 @@ __all__ = [
 
 
 def simulate(chain, q0, qd0, *, t, torque=None, method="rk4", dt=None, rtol=1e-10, atol=1e-12, gravity=None,
-             max_steps=10**9):
+             max_steps=None):
     """Deprecated: use ``tumble.simulate(chain, q0=q0, qd0=qd0, t=t, ...)``, which this forwards to.
 
     ``gravity`` (m/s², base frame) runs ``chain.with_gravity(gravity)``; of

@@ -16,6 +16,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
+from tumble._cli_errors import exit_codes
 from tumble._validate import ValidationError
 from tumble.robot.chain import load
 from tumble.robot.dynamics import mass_matrix, rnea
@@ -24,8 +25,6 @@ __all__ = ["app"]
 
 app = typer.Typer(help="Serial robot arms: inverse dynamics of DH tables and URDF files.", no_args_is_help=True,
                   add_completion=False)
-
-EXIT_BAD_INPUT = 2
 
 
 @app.callback()
@@ -57,15 +56,15 @@ def torques(
     show_mass_matrix: Annotated[bool, typer.Option("--mass-matrix", help="Also print M(q).")] = False,
 ) -> None:
     """Print the joint torques ``τ = M(q) q̈ + C(q, q̇) q̇ + g(q)`` (recursive Newton–Euler)."""
-    try:
-        chain = load(robot_file)
+    with exit_codes(robot_file):
+        try:
+            chain = load(robot_file)
+        except OSError as exc:
+            raise ValidationError(f"{robot_file}: cannot be read ({exc})") from None
         n = chain.dof
         state = _vector(q, "q", n), _vector(qd, "qd", n), _vector(qdd, "qdd", n)
         g = None if gravity is None else _vector(gravity, "gravity", 3)
         tau = rnea(chain, *state, gravity=g)
-    except (ValidationError, OSError) as exc:
-        typer.echo(f"error: {exc}", err=True)
-        raise typer.Exit(EXIT_BAD_INPUT) from None
     typer.echo(f"{chain.name or robot_file.name}: {n} joints")
     width = max(len(str(name)) for name in chain.joint_names)
     for name, kind, value in zip(chain.joint_names, chain.joint_types, tau):

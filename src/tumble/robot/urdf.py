@@ -90,8 +90,8 @@ def _inertial(link, where: str):
     if mass_el is None:
         raise ValidationError(f"{where}: missing <mass>")
     mass = _number(mass_el, "value", f"{where} <mass>")
-    if mass < 0.0:
-        raise ValidationError(f"{where} <mass>: value must be >= 0 kg, got {mass}")
+    if not (math.isfinite(mass) and mass >= 0.0):
+        raise ValidationError(f"{where} <mass>: value must be a finite number >= 0 kg, got {mass}")
     el = inertial.find("inertia")
     if el is None:
         raise ValidationError(f"{where}: missing <inertia>")
@@ -202,6 +202,12 @@ def links_from_urdf(source, *, check_triangle: bool = True) -> tuple[str | None,
         current = child
     if not chain:
         raise ValidationError(f"{label}: no revolute, continuous or prismatic joint: nothing moves")
+    if sum(m for m, _, _ in parts) <= 0.0:
+        # every joint moves the last link, so a massless one makes no joint singular by itself; without it the
+        # last joint moves nothing, M(q) is singular for every q and a simulation is NaN
+        merged = f" (with the fixed link(s) {members[1:]} merged into it)" if len(members) > 1 else ""
+        raise ValidationError(f"link {members[0]!r} <inertial>: the last moving link{merged} has no mass (no "
+                              f"<inertial>, or <mass value=\"0\">): joint {chain[-1]['name']!r} would move nothing")
     chain[-1] = _merged(chain[-1], parts, members, check_triangle)
     return root.get("name"), chain
 

@@ -1,0 +1,68 @@
+"""Results written atomically under signals, stale temporary files, concurrent writers (issue 18)."""
+
+import fcntl
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tumble.trajectory import write_atomic
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+
+
+def test_stale_temporary_siblings_of_killed_runs_are_removed(tmp_path):
+    stale = [tmp_path / ".out.txt.k2j3.tmp", tmp_path / ".out.txt.x9.tmp"]
+    other = tmp_path / ".other.txt.k2j3.tmp"  # another output's: not touched
+    for p in [*stale, other]:
+        p.write_text("partial")
+    write_atomic(tmp_path / "out.txt", lambda tmp: Path(tmp).write_text("done"))
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".other.txt.k2j3.tmp", "out.txt"]
+    assert (tmp_path / "out.txt").read_text() == "done"
+
+
+def test_a_second_writer_to_the_same_path_is_refused_and_the_first_wins(tmp_path):
+    out = tmp_path / "out.txt"
+    out.write_text("old")
+    fd = os.open(tmp_path / ".out.txt.lock", os.O_RDWR | os.O_CREAT)  # a writer at work holds the lock
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        with pytest.raises(FileExistsError, match=r"out.txt: another process is writing it now"):
+            write_atomic(out, lambda tmp: Path(tmp).write_text("second"))
+    finally:
+        os.close(fd)
+    assert out.read_text() == "old"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.txt.lock", "out.txt"]  # the holder's, untouched
+
+
+WRITER = """
+import sys, time
+from pathlib import Path
+from tumble.trajectory import write_atomic
+
+def write(tmp):
+    Path(tmp).write_text("partial")
+    print("writing", flush=True)
+    time.sleep(60)
+
+write_atomic(sys.argv[1], write)
+"""
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, -signal.SIGINT)])
+def test_a_run_interrupted_while_writing_leaves_no_temporary_file(tmp_path, sig, code):
+    out = tmp_path / "out.txt"
+    out.write_text("old")
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    child = subprocess.Popen([sys.executable, "-c", WRITER, str(out)], stdout=subprocess.PIPE, text=True, env=env)
+    try:
+        assert child.stdout.readline() == "writing\n"
+        child.send_signal(sig)
+        assert child.wait(timeout=30) == code  # SIGINT: KeyboardInterrupt, then Python dies of SIGINT
+    finally:
+        child.kill()
+        child.wait()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"] and out.read_text() == "old"
