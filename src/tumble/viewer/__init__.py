@@ -54,7 +54,7 @@ def _trajectory(traj) -> Trajectory:
     try:
         return load(traj)
     except ValidationError as exc:
-        if exc.field == "t":
+        if exc.rule.startswith("t: "):  # load names the file, then the field: "FILE: t: ..."
             raise ValidationError(f"traj: {os.fspath(traj)!r} is an empty trajectory (no samples): nothing to show") \
                 from None
         raise ValidationError(f"traj: {os.fspath(traj)!r} is not a tumble trajectory ({exc})") from None
