@@ -28,7 +28,7 @@ from _timing import best_of
 from tumble import attitude, integrate
 from tumble.kernels import rigid as _rigid
 from tumble.dynamics import euler_coefficients
-from tumble.integrate import _cuda
+from tumble.integrate import _cuda, _fixed
 
 DT = 1e-3                                   # s
 OMEGA0 = np.array([1e-3, 1.0, 1e-3])        # rad/s, near the intermediate axis, dispersed per body
@@ -55,7 +55,8 @@ def cpu_model(coefficients, moments):
 def kernel_seconds(coefficients, y0, t):
     """Best time (s) of the kernel alone, on data already on the GPU (synchronised before the clock is read)."""
     args = [cuda.to_device(coefficients), cuda.to_device(np.zeros((y0.shape[0], 0))), (), cuda.to_device(y0),
-            cuda.to_device(t), *map(cuda.to_device, _cuda._landing(t, DT)), cuda.device_array((t.size, *y0.shape))]
+            cuda.to_device(t), *map(cuda.to_device, _fixed.landing_steps(t, DT, integrate.MAX_STEPS)),
+            cuda.device_array((t.size, *y0.shape))]
     blocks = math.ceil(y0.shape[0] / _cuda.THREADS_PER_BLOCK)
 
     def launch():
