@@ -149,16 +149,17 @@ def test_demo_racket_prints_the_predicted_flip_interval(tmp_path):
 def test_demo_polhode_writes_the_figure(tmp_path):
     from tumble.analytic._stability import stability
 
-    png = tmp_path / "polhode.png"
+    png, page = tmp_path / "polhode.png", tmp_path / "polhode.html"
     result = invoke("demo", "polhode", "-o", png)
     assert result.exit_code == 0, result.output
     assert png.read_bytes()[:8] == PNG_MAGIC
-    assert [p.name for p in tmp_path.iterdir()] == ["polhode.png"]  # no temporary files left
+    assert page.read_text()[:15] == "<!DOCTYPE html>"  # the viewer's page (tests/test_viewer*.py check its content)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["polhode.html", "polhode.png"]  # no temporary files left
     handle = tumble.RigidBody.t_handle()
     report = stability(handle, handle.axes @ np.array([1.0, 10.0, 1.0]))
     assert "axes      1: stable, 2: unstable, 3: stable" in result.stdout
     assert f"flips every 2K/lambda = {report.flip_interval:.6g} s" in result.stdout
-    assert f"wrote     {png}" in result.stdout
+    assert f"wrote     {png}, {page}" in result.stdout
 
 
 def test_demo_polhode_output_in_missing_directory_exits_2(tmp_path):
@@ -172,8 +173,9 @@ def test_demo_top_writes_the_trajectory_and_the_figure(tmp_path):
     pytest.importorskip("tumble.viz.top")  # written alongside; skipped only while the module is missing
     result = invoke("demo", "top", "-o", tmp_path, "--duration", 0.5)
     assert result.exit_code == 0, result.output
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["top.nc", "top.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["top.html", "top.nc", "top.png"]
     assert (tmp_path / "top.png").read_bytes()[:8] == PNG_MAGIC
+    assert (tmp_path / "top.html").read_text()[:15] == "<!DOCTYPE html>"
     assert len(tumble.load(tmp_path / "top.nc")) > 1
     exact, simulated = map(float, re.search(r"period\s+([0-9.]+) s \(exact\), ([0-9.]+) s \(simulated\)",
                                             result.stdout).groups())

@@ -289,7 +289,8 @@ def test_demo_top_writes_both_files_and_its_summary_agrees(tmp_path):
     traj = tumble.load(tmp_path / "top.nc")
     assert traj.t[-1] == pytest.approx(0.6, abs=0.0)
     assert (tmp_path / "top.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["top.nc", "top.png"]  # no temporary files left
+    assert (tmp_path / "top.html").read_text()[:15] == "<!DOCTYPE html>"  # the viewer's page
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["top.html", "top.nc", "top.png"]  # no temporary files
     # 500 samples per period: turning points to ~1e-10 deg, times to ~1e-9 T (see measure_nutation).
     assert abs(summary["theta_min_deg_measured"] - summary["theta_min_deg"]) <= 1e-7
     assert abs(summary["theta_max_deg_measured"] - summary["theta_max_deg"]) <= 1e-7

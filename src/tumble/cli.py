@@ -69,6 +69,8 @@ _RACKET_TOLERANCE = 1e-12
 # 1 rad/s about each of the others (principal axes): a motion just inside the
 # "major" regime, so that its polhode stands apart from the separatrix.
 _POLHODE_OMEGA = (1.0, 10.0, 1.0)
+# Samples of its viewer page: one polhode period (4K/λ) at the viewer's default frame budget.
+_POLHODE_FRAMES = 600
 # The T-handle as the viewer draws it: RigidBody.t_handle()'s handle (along x, from the origin) and cross bar
 # (along y, centred on the handle's end), solid cylinders of its default radius and lengths (m).
 _T_HANDLE_PIECES = [dict(radius=0.004, length=0.08, axis="x", position=(0.04, 0.0, 0.0)),
@@ -173,8 +175,10 @@ def polhode(
     about each of the other two. The figure (tumble.viz.polhode.polhode_figure) shows the energy
     ellipsoid with a family of polhodes, the separatrix and this motion's polhode, and the
     herpolhode on the invariable plane; the command prints the stability of the axes and the
-    predicted times.
+    predicted times. Beside the PNG, the same name with .html: the 3-D viewer of one polhode
+    period of the motion (the T-handle turning, omega and L, and its polhode on the energy ellipsoid).
     """
+    from tumble.viewer import Cylinder
     from tumble.viz.polhode import polhode_figure
 
     with _exit_codes():
@@ -184,6 +188,10 @@ def polhode(
         report = stability(body, omega0)
         figure = polhode_figure(body, omega0)
         write_atomic(output, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+        page = output.with_suffix(".html")
+        traj = simulate(body, omega0, t=np.linspace(0.0, report.polhode_period, _POLHODE_FRAMES),
+                        method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE)
+        traj.to_html(page, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
     moments = ", ".join(f"{m:.4g}" for m in report.moments)
     _print_rows([
         ("body", f"T-handle, principal moments {moments} kg m^2"),
@@ -192,13 +200,13 @@ def polhode(
                   f"regime {report.regime!r}"),
         ("timing", f"flips every 2K/lambda = {report.flip_interval:.6g} s, "
                    f"polhode period 4K/lambda = {report.polhode_period:.6g} s"),
-        ("wrote", str(output)),
+        ("wrote", f"{output}, {page}"),
     ])
 
 
 @demo_app.command("top")
 def top(
-    output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write top.nc and top.png in.")]
+    output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write top.nc, top.png and top.html in.")]
     = Path("."),
     duration: Annotated[float, typer.Option("--duration", help="Simulated time, s.")] = 1.5,
 ) -> None:
@@ -206,7 +214,8 @@ def top(
 
     Runs tumble.viz.top.demo_top: a spinning top released at 60 deg from the vertical nutates
     between two angles while it precesses. Writes top.nc and top.png in the directory and prints
-    the nutation bounds, the nutation period and the mean precession rate, exact and measured.
+    the nutation bounds, the nutation period and the mean precession rate, exact and measured; and top.html,
+    the 3-D viewer of the run.
     """
     from tumble.viz.top import demo_top
 
@@ -225,7 +234,7 @@ def top(
                  f"{summary['mean_precession_rate_measured']:.6g} rad/s (simulated)"),
         ("spin", f"{summary['spin']:.6g} rad/s (critical spin {summary['critical_spin']:.6g} rad/s: "
                  "the upright top is stable above it)"),
-        ("wrote", f"{summary['nc']}, {summary['png']}"),
+        ("wrote", f"{summary['nc']}, {summary['png']}, {summary['html']}"),
     ])
 
 

@@ -141,8 +141,9 @@ def demo_top(out_dir, *, duration: float = 1.5) -> dict:
 
     Integrates with ``tumble.simulate`` (dop853, rtol = atol = 1e-12, 500
     samples per nutation period) and ``tumble.torques.Gravity``, writes
-    ``out_dir/top.nc`` (:meth:`Trajectory.save`) and ``out_dir/top.png``
-    (:func:`top_figure`), each atomically, and returns a summary: nutation
+    ``out_dir/top.nc`` (:meth:`Trajectory.save`), ``out_dir/top.png``
+    (:func:`top_figure`) and ``out_dir/top.html`` (the 3-D viewer,
+    :mod:`tumble.viewer`), each atomically, and returns a summary: nutation
     bounds (deg), exact and measured (:func:`measure_nutation`, mean over the
     turning points), nutation period (s) and mean precession rate (rad/s),
     exact and measured, the spin and critical spin (rad/s), and the paths
@@ -160,8 +161,10 @@ def demo_top(out_dir, *, duration: float = 1.5) -> dict:
     figure = top_figure(top, trajectory)
 
     nc_path, png_path = os.path.join(out_dir, "top.nc"), os.path.join(out_dir, "top.png")
+    html_path = os.path.join(out_dir, "top.html")
     trajectory.save(nc_path)
     write_atomic(png_path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+    trajectory.to_html(html_path)
     return {
         "theta_min_deg": math.degrees(top.theta_min),
         "theta_min_deg_measured": float(np.degrees(np.arccos(measured.u_max)).mean()),
@@ -175,4 +178,5 @@ def demo_top(out_dir, *, duration: float = 1.5) -> dict:
         "critical_spin": top.critical_spin,
         "nc": nc_path,
         "png": png_path,
+        "html": html_path,
     }
