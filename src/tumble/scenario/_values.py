@@ -56,3 +56,15 @@ class _Table(BaseModel):
         keys = {name: f"{prefix}.{name}" for name in type(self).model_fields}
         keys.update({arg: f"{prefix}.{key}" for arg, key in self.renamed.items()})
         return keys
+
+
+class _InertiaOrMoments(_Table):
+    """A table that gives an inertia as ``inertia`` (3×3, kg m²) or as ``moments`` (its diagonal, kg m²):
+    the library's ``inertia`` argument is reported against whichever of the two keys the file gave.
+    A subclass declares both fields and checks that exactly one is given."""
+
+    def argument_keys(self, prefix: str) -> dict[str, str]:
+        keys = super().argument_keys(prefix)
+        if self.moments is not None:
+            keys["inertia"] = f"{prefix}.moments"
+        return keys

@@ -54,7 +54,8 @@ from tumble.body import RigidBody
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError, in_file, keyed
 from tumble.scenario._run import RUN_KEYS, Run
-from tumble.scenario._values import _Bool, _Limit, _Matrix, _Number, _Positive, _Table, _Vector
+from tumble.scenario._values import (_Bool, _InertiaOrMoments, _Limit, _Matrix, _Number, _Positive, _Table,
+                                     _Vector)
 from tumble.scenario.control import Controller, Regulator
 from tumble.scenario.damper import SphericalDamperTable
 from tumble.scenario.orbit import OrbitTable
@@ -70,8 +71,10 @@ __all__ = ["SpacecraftScenario"]
 _MAGIC_SKEW = math.degrees(math.atan(math.sqrt(2.0)))  # deg: the pyramid whose four axes are equally spaced
 
 
-class Wheel(_Table):
-    axis: _Vector
+class _WheelProperties(_Table):
+    """The keys of a reaction wheel (:class:`tumble.spacecraft.ReactionWheel`) but its axis: spin inertia
+    (kg m²), torque and speed limits (N m, rad/s), friction, and the rotor's mass properties."""
+
     inertia: _Positive
     max_torque: _Limit = math.inf
     max_speed: _Limit = math.inf
@@ -81,31 +84,26 @@ class Wheel(_Table):
     mass: _Positive | None = None
     position: _Vector | None = None
     transverse_inertia: _Positive | None = None
+
+
+class Wheel(_WheelProperties):
+    axis: _Vector
 
     def build(self):
         return actuators.ReactionWheel(**self.model_dump())
 
 
-class WheelPyramid(_Table):
+class WheelPyramid(_WheelProperties):
     """Four identical wheels in a pyramid (:func:`tumble.spacecraft.pyramid_wheels`); ``mass``,
     ``position`` and ``transverse_inertia``, as every other key, apply to each of the four."""
 
-    inertia: _Positive
     skew: _Positive = _MAGIC_SKEW
-    max_torque: _Limit = math.inf
-    max_speed: _Limit = math.inf
-    viscous: _Number = 0.0
-    coulomb: _Number = 0.0
-    coulomb_speed: _Positive = 1.0
-    mass: _Positive | None = None
-    position: _Vector | None = None
-    transverse_inertia: _Positive | None = None
 
     def build(self):
         return actuators.pyramid_wheels(**self.model_dump())
 
 
-class HubTable(_Table):
+class HubTable(_InertiaOrMoments):
     """``[spacecraft.hub]``: the hub **without** its wheels (``Spacecraft(hub=RigidBody(...))``):
     ``inertia`` (3×3, kg m², about the hub's centre of mass, body axes) or ``moments`` (its diagonal),
     ``mass`` (kg) and ``com`` (m, body axes; default the origin)."""
@@ -120,12 +118,6 @@ class HubTable(_Table):
         if (self.inertia is None) == (self.moments is None):
             raise ValueError("give exactly one of inertia or moments")
         return self
-
-    def argument_keys(self, prefix: str) -> dict[str, str]:
-        keys = super().argument_keys(prefix)
-        if self.inertia is None:
-            keys["inertia"] = f"{prefix}.moments"
-        return keys
 
     def build(self) -> RigidBody:
         inertia = self.inertia if self.inertia is not None else np.diag(self.moments)
@@ -212,7 +204,7 @@ def _built(table: _Table, key: str):
         return table.build()
 
 
-class SpacecraftTable(_Table):
+class SpacecraftTable(_InertiaOrMoments):
     """``[spacecraft]``: mass properties (``inertia`` or ``moments``: the total, wheels included; or a
     ``hub`` table: the hub without the wheels and the damper sphere, the wheels then needing mass properties),
     actuators, a nutation ``damper``, environment and controllers."""
@@ -243,12 +235,6 @@ class SpacecraftTable(_Table):
         if self.wheels and self.wheel_pyramid is not None:
             raise ValueError("give wheels or wheel_pyramid, not both")
         return self
-
-    def argument_keys(self, prefix: str) -> dict[str, str]:
-        keys = super().argument_keys(prefix)
-        if self.moments is not None:
-            keys["inertia"] = f"{prefix}.moments"
-        return keys
 
     def build(self) -> Spacecraft:
         """The :class:`~tumble.spacecraft.Spacecraft`; a refusal is reported against its key."""

@@ -32,7 +32,7 @@ from pydantic import model_validator
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import in_file, keyed
 from tumble.scenario._run import RUN_KEYS, Run
-from tumble.scenario._values import _Bool, _Matrix, _Number, _Table, _Vector
+from tumble.scenario._values import _Bool, _InertiaOrMoments, _Matrix, _Number, _Vector
 from tumble.scenario.tables import Initial, Solver, Time
 from tumble.trajectory import Trajectory
 from tumble.variable import VariableBody
@@ -40,7 +40,7 @@ from tumble.variable import VariableBody
 __all__ = ["VariableScenario", "rate_and_energy_rows"]
 
 
-class VariableTable(_Table):
+class VariableTable(_InertiaOrMoments):
     """``[variable]``: sample ``times`` (s), ``inertia`` (3×3 tensors, kg m², body axes) or ``moments``
     (their diagonals), optional ``shape_momentum`` (kg m²/s, body axes) and ``check_triangle``: the arguments
     of :class:`tumble.variable.VariableBody`."""
@@ -57,12 +57,6 @@ class VariableTable(_Table):
         if (self.inertia is None) == (self.moments is None):
             raise ValueError("give exactly one of inertia (3×3 tensors) or moments (their diagonals), one per time")
         return self
-
-    def argument_keys(self, prefix: str) -> dict[str, str]:
-        keys = super().argument_keys(prefix)
-        if self.moments is not None:
-            keys["inertia"] = f"{prefix}.moments"
-        return keys
 
     def build(self) -> VariableBody:
         inertia = self.inertia if self.moments is None else [np.diag(m) for m in self.moments]
