@@ -623,8 +623,8 @@ def load(path: str | os.PathLike) -> Trajectory:
             ds = lazy.load()
         with np.errstate(all="ignore"):
             traj = Trajectory.from_xarray(ds)
-    except ValidationError as exc:
-        raise ValidationError(f"{os.fspath(path)}: {exc}") from None
+    except ValidationError as exc:  # the file named first; the field's own error stays as the cause
+        raise ValidationError(f"{os.fspath(path)}: {exc}") from exc
     except (OSError, MemoryError):
         raise
     except Exception as exc:  # noqa: BLE001 - a hostile file may make h5py/xarray raise anything

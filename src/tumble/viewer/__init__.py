@@ -54,7 +54,8 @@ def _trajectory(traj) -> Trajectory:
     try:
         return load(traj)
     except ValidationError as exc:
-        if exc.rule.startswith("t: "):  # load names the file, then the field: "FILE: t: ..."
+        cause = exc.__cause__  # load names the file; the error of the field it read is the cause
+        if isinstance(cause, ValidationError) and cause.field == "t":
             raise ValidationError(f"traj: {os.fspath(traj)!r} is an empty trajectory (no samples): nothing to show") \
                 from None
         raise ValidationError(f"traj: {os.fspath(traj)!r} is not a tumble trajectory ({exc})") from None
