@@ -11,7 +11,7 @@ series (ω_z, with its per-time statistics and percentiles). Figures:
 * plain batch: ``tumble.simulate`` of all the samples in this process (Numba
   threads on every core), the inputs drawn beforehand;
 * the plain batch followed by the sweep's reductions, and the drawing of the
-  inputs alone (one ``SeedSequence`` stream per sample);
+  inputs alone (one vectorised Philox draw per chunk);
 * the sweep in this process (``workers=0``: draws, chunks, reductions, store in memory);
 * the sweep on a LocalCluster of 1 and of 2 single-threaded worker processes
   (started and warmed up before the timing);

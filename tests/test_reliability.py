@@ -65,6 +65,23 @@ def test_every_stepping_method_reads_max_steps_and_the_default_is_bounded():
     assert integrate.MAX_STEPS == 10**8 and tumble.simulate.__globals__["DEFAULTS"]["max_steps"] == 10**8
 
 
+@pytest.mark.parametrize("t", [[0.0, 1e300], [0.0, 5e299, 1e300]], ids=["one interval", "two"])
+def test_an_adaptive_run_that_could_only_end_at_max_steps_stops_after_its_first_thousand_steps(t):
+    # DOP853's step count is not known beforehand: after PROJECT_AFTER = 1000 steps the rest of the span at
+    # their mean step is projected, and a run projected past 100 x max_steps stops there, not 1e8 steps later
+    # (and the output rows it never reached are not mistaken for a divergence)
+    with pytest.raises(SolverError, match=r"^max_steps: the run would need \S+ steps or more to t=1e\+300") as caught:
+        tumble.simulate(BODY, OMEGA0, t=t, method="dop853")
+    assert "more than max_steps = 1e+08" in str(caught.value)
+    # rates of 1e19 rad/s: the step size falls below what float64 resolves at once
+    with pytest.raises(SolverError, match=r"^the step size fell below the float64 resolution of t"):
+        tumble.simulate(BODY, 1e19 * np.asarray(OMEGA0), t=[0.0, 10.0], method="dop853")
+    # a run within the bound is untouched: 1000 steps in, this one projects about 2e4 (max_steps 1e3 allows
+    # the projection check to fire from 1e5), and it reaches its end
+    traj = tumble.simulate(BODY, OMEGA0, t=[0.0, 2000.0], method="dop853", rtol=1e-12, atol=1e-12)
+    assert 1e3 < traj.info["n_steps"] < 1e5 and np.isfinite(traj.omega).all()
+
+
 # -- finite state -------------------------------------------------------------------------------------
 
 

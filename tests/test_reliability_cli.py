@@ -57,8 +57,10 @@ def _altered(saved, tmp_path, name, change):
     (SCENARIO.format(stop=1.0) + '[solver]\nmethod = "rk4"\ndt = 1e-300\n', "max_steps: the run needs 1e+300 steps",
      2),
     (SCENARIO.format(stop=1e308) + '[solver]\nmethod = "rk4"\ndt = 1.0\n', "max_steps: the run needs 1e+308 steps", 2),
+    # the integrator gives up (a tumble.SolverError): exit 2 too, after 1000 steps instead of 1e8
+    (SCENARIO.format(stop=1e300) + '[solver]\nmethod = "dop853"\n', "max_steps: the run would need", 2),
     ("a = " + "{b = " * 1000 + "1" + "}" * 1000 + "\n", "bad.toml: ", 2),
-], ids=["dt 1e-300", "stop 1e308", "1000-deep inline table"])
+], ids=["dt 1e-300", "stop 1e308", "dop853 stop 1e300", "1000-deep inline table"])
 def test_run_refuses_bad_scenarios_in_one_line(tmp_path, text, message, code):
     bad = tmp_path / "bad.toml"
     bad.write_text(text)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import importlib.util
 import math
 import os
+import statistics
 from pathlib import Path
 
 import numpy as np
@@ -68,12 +69,17 @@ def test_sample_inputs_depend_only_on_seed_and_index():
         part = plan.inputs(lo, hi)
         for name in whole:
             np.testing.assert_array_equal(part[name], whole[name][lo:hi], err_msg=name)
-    # sample i's stream is the i-th child of SeedSequence(seed).spawn: q0 (drawn after omega0's 3 normals)
-    child = np.random.default_rng(np.random.SeedSequence(3).spawn(8)[7])
-    z = child.standard_normal(3)
-    np.testing.assert_array_equal(whole["omega0"][7], [0.0, 0.0, 1.0] + np.array([0.05, 0.05, 0.1]) * z)
-    q = child.standard_normal(4)
-    np.testing.assert_array_equal(whole["q0"][7], q / np.linalg.norm(q))
+    # sample i's variates, rebuilt independently: words 8i .. 8i+7 of Philox4x64 keyed by SeedSequence(3)
+    # (3 for omega0, 4 for q0, 1 for the seed: 8 words, two counter steps), each word k -> (k >> 11 + 1/2) 2^-53,
+    # a normal as its inverse distribution function; omega0 takes the first three, q0 the next four
+    key = np.random.SeedSequence(3).generate_state(2, np.uint64)
+    words = np.random.Philox(key=key).random_raw(8 * 8)[8 * 7:8 * 8]
+    u = np.array([(int(k) >> 11) + 0.5 for k in words]) / 2.0**53
+    z = np.array([statistics.NormalDist().inv_cdf(x) for x in u])  # the standard library's Φ⁻¹ (Wichura AS241)
+    np.testing.assert_allclose(whole["omega0"][7], [0.0, 0.0, 1.0] + np.array([0.05, 0.05, 0.1]) * z[:3],
+                               rtol=1e-15, atol=1e-15)  # scipy's ndtri and AS241 agree to a few ulps
+    np.testing.assert_allclose(whole["q0"][7], z[3:7] / np.linalg.norm(z[3:7]), rtol=0, atol=1e-15)
+    assert whole["seed"][7] == math.floor(u[7] * 2.0**53)
     assert len(set(whole["seed"].tolist())) == N
     other = plan_of(DISPERSIONS, samples=N, seed=4).inputs(0, N)
     assert not np.any(other["omega0"] == whole["omega0"])

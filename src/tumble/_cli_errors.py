@@ -1,17 +1,20 @@
 """The one error path of the ``tumble`` command: every failure is one ``error: ...`` line and an exit code.
 
-Exit codes (``docs/cli.md``): 0 success; 2 bad input, the input files and
-options included (a :class:`~tumble.ValidationError` — a scenario's problems
-one line each — and whatever a hostile or damaged file makes a reader raise:
+Exit codes (``docs/cli.md``): 0 success; 2 every error a user can act on:
+bad input, the input files and options included (a
+:class:`~tumble.ValidationError` — a scenario's problems one line each — and
+whatever a hostile or damaged file makes a reader raise:
 :class:`RecursionError` from a deeply nested TOML table,
 :class:`OverflowError` from a number past float64, :class:`UnicodeDecodeError`,
 :class:`ZeroDivisionError` and :class:`FloatingPointError` from numbers too
-large to compute with); 1 any other failure (the integrator gave up, a file
-could not be written, memory ran out, a bug). No traceback reaches the user:
-an unexpected exception is reported in one line as a bug, with its type;
-``TUMBLE_TRACEBACK=1`` in the environment lets it propagate instead. NumPy's
-floating-point warnings are silenced inside a command: its refusals say what
-was wrong, once.
+large to compute with), the integrator giving up
+(:class:`~tumble.SolverError`: a diverged run, a step too small, more steps
+than ``max_steps``), a file that cannot be read or written (:class:`OSError`)
+and memory running out; 1 only for a bug in tumble (an unexpected
+exception). No traceback reaches the user: a bug is reported in one line
+with its type; ``TUMBLE_TRACEBACK=1`` in the environment lets it propagate
+instead. NumPy's floating-point warnings are silenced inside a command: its
+refusals say what was wrong, once.
 """
 
 from __future__ import annotations
@@ -27,10 +30,10 @@ import typer
 from tumble._validate import ValidationError
 from tumble.integrate import SolverError
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_FAILURE", "exit_codes"]
+__all__ = ["EXIT_ERROR", "EXIT_BUG", "exit_codes"]
 
-EXIT_BAD_INPUT = 2
-EXIT_FAILURE = 1
+EXIT_ERROR = 2
+EXIT_BUG = 1
 
 # What a hostile or damaged input makes Python or NumPy raise while it is read or used.
 _BAD_INPUT = (RecursionError, OverflowError, UnicodeDecodeError, ZeroDivisionError, FloatingPointError)
@@ -38,8 +41,8 @@ _BAD_INPUT = (RecursionError, OverflowError, UnicodeDecodeError, ZeroDivisionErr
 
 @contextmanager
 def exit_codes(*inputs) -> Iterator[None]:
-    """Run a command's body: bad input exits with code 2 and other failures with 1, each as ``error:`` lines
-    on stderr; ``inputs`` (paths) name the file a reader's own exception came from."""
+    """Run a command's body: every error exits with code 2 and a bug with 1, each as ``error:`` lines on
+    stderr; ``inputs`` (paths) name the file a reader's own exception came from."""
     source = f"{os.fspath(inputs[0])}: " if inputs else ""
     try:
         with warnings.catch_warnings(), np.errstate(all="ignore"):
@@ -48,18 +51,18 @@ def exit_codes(*inputs) -> Iterator[None]:
     except typer.Exit:
         raise
     except ValidationError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT)
+        _fail(str(exc), EXIT_ERROR)
     except _BAD_INPUT as exc:
-        _fail(f"{source}cannot be used ({type(exc).__name__}: {_first_line(exc)})", EXIT_BAD_INPUT)
+        _fail(f"{source}cannot be used ({type(exc).__name__}: {_first_line(exc)})", EXIT_ERROR)
     except (SolverError, OSError) as exc:
-        _fail(str(exc), EXIT_FAILURE)
+        _fail(str(exc), EXIT_ERROR)
     except MemoryError:
-        _fail("out of memory: ask for fewer output times, a shorter run or a smaller batch", EXIT_FAILURE)
+        _fail("out of memory: ask for fewer output times, a shorter run or a smaller batch", EXIT_ERROR)
     except Exception as exc:  # noqa: BLE001 - the promise is one line, never a traceback
         if os.environ.get("TUMBLE_TRACEBACK"):
             raise
         _fail(f"unexpected {type(exc).__name__}: {_first_line(exc)} (a bug: please report it; "
-              "TUMBLE_TRACEBACK=1 shows the traceback)", EXIT_FAILURE)
+              "TUMBLE_TRACEBACK=1 shows the traceback)", EXIT_BUG)
 
 
 def _first_line(exc: BaseException) -> str:

@@ -247,8 +247,8 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
         chunk = None if steps is None else (steps[0][lo:hi], steps[1][lo:hi])
         _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
                    steps=chunk, rtol=rtol, atol=atol, max_steps=max_steps, serial=model.calls_python)
+        _raise_on_failure(stats, t, max_steps)  # first: a body that gave up left its later rows unwritten
         _raise_on_divergence(out, method, lo, hi)
-        _raise_on_failure(stats, t)
         if progress is not None:
             progress(hi + 1, n_out)
     if n_out == 1:
@@ -290,7 +290,7 @@ def _raise_on_divergence(states, method, lo=0, hi=None):
     raise Diverged(f"simulation diverged at output sample {lo + k} (body {member})", lo + k, member, states, method)
 
 
-def _raise_on_failure(stats, t):
+def _raise_on_failure(stats, t, max_steps):
     bad = np.flatnonzero(stats[:, 3] != _dop853.OK)
     if bad.size == 0:
         return
@@ -299,5 +299,9 @@ def _raise_on_failure(stats, t):
     if stats[b, 3] == _dop853.STEP_TOO_SMALL:
         raise SolverError(f"{who}the step size fell below the float64 resolution of t; "
                           "the motion may be singular there, or loosen rtol/atol")
+    if stats[b, 3] == _dop853.TOO_MANY_PROJECTED:
+        raise SolverError(f"{who}max_steps: the run would need {stats[b, 4]:.2g} steps or more to t={t[-1]:g} "
+                          f"(projected from its first {int(stats[b, 0])} at their mean step size), more than "
+                          f"max_steps = {max_steps:g}; shorten the run or loosen rtol/atol")
     raise SolverError(f"{who}max_steps={int(stats[b, 0])} reached before t={t[-1]}; raise max_steps "
                       "or loosen rtol/atol")

@@ -53,7 +53,12 @@ MAX_FACTOR = 10.0
 _EXPONENT = -1.0 / 8.0  # the error estimate is of order 7
 
 # Status codes written to stats[b, 3].
-OK, STEP_TOO_SMALL, TOO_MANY_STEPS = 0, 1, 2
+OK, STEP_TOO_SMALL, TOO_MANY_STEPS, TOO_MANY_PROJECTED = 0, 1, 2, 3
+#: A run stops early (``TOO_MANY_PROJECTED``) when, after at least ``PROJECT_AFTER`` steps, the rest of its
+#: span at the mean step size so far would take more than ``PROJECT_MARGIN × max_steps`` steps: a run that
+#: could only end at ``max_steps`` hours later (``stop = 1e300``, rates of 1e19 rad/s) fails in a fraction of
+#: a second. The mean step, not the last one, so that a step cut short at a discontinuity does not trigger it.
+PROJECT_AFTER, PROJECT_MARGIN = 1000, 100.0
 
 
 @njit(cache=True)
@@ -85,7 +90,9 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
     ``tab`` is :func:`tableau`.
     ``stats`` = [steps, rejected steps, evaluations, status, next step size]:
     the step size is carried in and out, so a run split in chunks continues
-    exactly as one run would (0 on entry means "choose a starting step").
+    exactly as one run would (0 on entry means "choose a starting step"). On
+    the status ``TOO_MANY_PROJECTED`` the last entry is instead the projected
+    number of steps to the end of ``t_out`` (see :data:`PROJECT_AFTER`).
     """
     A, B, C, E3, E5 = tab
     n = state_size(model)
@@ -101,6 +108,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
         stats[2] += 1
     k = 1
     rejected_last = False
+    steps0 = stats[0]
     while k < t_out.shape[0]:
         target = t_out[k]
         # land on the output time when the proposed step reaches it or nearly (1 %)
@@ -158,6 +166,13 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
         if stats[0] >= max_steps:
             stats[3] = TOO_MANY_STEPS
             break
+        taken = stats[0] - steps0
+        if taken >= PROJECT_AFTER and t > t_out[0]:
+            projected = stats[0] + taken * ((t_out[-1] - t) / (t - t_out[0]))
+            if projected > PROJECT_MARGIN * max_steps:
+                stats[3] = TOO_MANY_PROJECTED
+                h = projected
+                break
     stats[4] = h
 
 

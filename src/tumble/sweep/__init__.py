@@ -8,8 +8,9 @@
     ...                   outcomes={"nutation": Final(NutationAngle([0, 0, 1]))}, store="mc.zarr")
     >>> ds.nutation_percentiles.sel(percentile=99).item()       # rad
 
-Sample ``i`` draws its dispersed inputs from its own stream
-``SeedSequence(seed, spawn_key=(i,))`` (:mod:`tumble.sweep.dispersions`), so
+Sample ``i`` draws its dispersed inputs from its own part of one
+counter-based random stream keyed by ``SeedSequence(seed)``
+(:func:`tumble.sweep.dispersions.sample_uniforms`), so
 every input and result of sample ``i`` depends on ``(seed, i)`` alone, never
 on the chunk size or the number of workers. The samples run in chunks, one
 Dask task per chunk, each chunk one batched call of :func:`tumble.simulate`
@@ -101,7 +102,7 @@ def sweep(
     samples : int
         Number of samples (default: one per grid point when every dispersion is a grid).
     seed : int
-        The sweep's seed: sample ``i``'s stream is ``SeedSequence(seed, spawn_key=(i,))``.
+        The sweep's seed: sample ``i``'s variates are the words ``i W …`` of Philox keyed by ``SeedSequence(seed)``.
     t, method, dt, rtol, atol, max_steps, torque
         As :func:`tumble.simulate` (output times in s; the options the method reads).
     outcomes : mapping name → ``f(traj) -> (m, ...)``

@@ -1,14 +1,20 @@
 """Dispersions: how one input of a sweep varies from sample to sample.
 
-Every sample ``i`` of a sweep draws its random inputs from its own stream,
-``numpy.random.default_rng(SeedSequence(seed, spawn_key=(i,)))`` — the
-``i``-th child of ``SeedSequence(seed).spawn(...)`` — so what sample ``i``
-gets depends on ``(seed, i)`` alone, never on the chunk it falls in or on the
-worker that runs it. A dispersion draws in two steps: :meth:`Dispersion.raw`
-takes its standard variates (uniform on [0, 1) or standard normal) from the
-sample's stream, then :meth:`Dispersion.values` turns the raw draws of a whole
-chunk into values at once (vectorised). The random dispersions of a sweep draw
-in the order of the ``dispersions`` mapping.
+Every sample ``i`` of a sweep draws its random inputs from its own part of
+one counter-based stream: the uniform variates ``u_ij`` (``j = 0 … n − 1``,
+``n`` the variates one sample takes) are the 64-bit words ``i W + j``
+(``W = 4⌈n/4⌉``) of NumPy's Philox4x64 generator keyed by
+``SeedSequence(seed)``, each word ``k`` mapped to ``u = (⌊k / 2¹¹⌋ + ½) 2⁻⁵³``,
+strictly inside (0, 1) (:func:`sample_uniforms`). A counter-based generator
+reaches any sample's words directly (Salmon et al., "Parallel random numbers:
+as easy as 1, 2, 3", SC'11), so what sample ``i`` gets depends on ``(seed,
+i)`` alone, never on the chunk it falls in or on the worker that runs it, and
+a chunk of samples draws all its variates in one vectorised call. A
+dispersion turns the uniforms of a whole chunk into values at once
+(:meth:`Dispersion.values`); standard normal variates are ``Φ⁻¹(u)``
+(``scipy.special.ndtri``, inversion: one uniform per normal, no rejection).
+The random dispersions of a sweep take their variates in the order of the
+``dispersions`` mapping.
 
 A :class:`Grid` is not random: the grids of a sweep form a Cartesian product
 whose points the samples visit in C order (the last grid fastest), over and
@@ -31,13 +37,18 @@ from tumble._inertia import as_rotation
 from tumble._validate import ValidationError, as_array
 
 __all__ = ["Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid", "UniformAttitude", "Inertia",
-           "Misalignment", "NoiseSeed", "as_dispersion", "sample_stream"]
+           "Misalignment", "NoiseSeed", "as_dispersion", "sample_uniforms"]
 
 
-def sample_stream(seed: int, i: int) -> np.random.Generator:
-    """The random stream of sample ``i``: ``default_rng(SeedSequence(seed, spawn_key=(i,)))``, which is the
-    ``i``-th child of ``SeedSequence(seed).spawn`` (NumPy's recipe for independent parallel streams)."""
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(i,)))
+def sample_uniforms(seed: int, lo: int, hi: int, n: int) -> np.ndarray:
+    """The uniform variates (hi − lo, n) in (0, 1) of samples ``lo`` to ``hi − 1``: row ``i − lo`` holds the
+    words ``i W`` to ``i W + n − 1`` (``W = 4⌈n/4⌉``, a whole number of Philox counter steps per sample) of
+    Philox4x64 keyed by ``SeedSequence(seed)``, as ``(⌊k / 2¹¹⌋ + ½) 2⁻⁵³`` (53 random bits, never 0 or 1)."""
+    steps = -(-n // 4)  # counter steps per sample, each four 64-bit words
+    generator = np.random.Philox(key=np.random.SeedSequence(seed).generate_state(2, np.uint64))
+    generator.advance(lo * steps)
+    words = generator.random_raw((hi - lo) * 4 * steps).reshape(hi - lo, 4 * steps)[:, :n]
+    return ((words >> np.uint64(11)).astype(np.float64) + 0.5) * 2.0**-53
 
 
 def _array(value, name: str) -> np.ndarray:
@@ -49,7 +60,7 @@ def _array(value, name: str) -> np.ndarray:
 class Dispersion(abc.ABC):
     """How one input varies over the samples; ``shape`` is that of one sample's value."""
 
-    #: Number of raw variates one sample takes from its stream (0 for a grid).
+    #: Number of uniform variates one sample takes from its stream (0 for a grid).
     n_raw: int = 0
 
     @property
@@ -57,14 +68,10 @@ class Dispersion(abc.ABC):
     def shape(self) -> tuple[int, ...]:
         """Shape of one sample's value."""
 
-    def raw(self, rng: np.random.Generator) -> np.ndarray:
-        """This dispersion's ``n_raw`` standard variates of one sample, from the sample's stream ``rng``."""
-        return np.empty(0)
-
     @abc.abstractmethod
-    def values(self, raw: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """Values (m, *shape) of m samples from their raw draws (m, n_raw); ``points`` (m,) are the samples'
-        indices into a grid's values (used by :class:`Grid` only)."""
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """Values (m, *shape) of m samples from their uniform variates ``u`` (m, n_raw) in (0, 1);
+        ``points`` (m,) are the samples' indices into a grid's values (used by :class:`Grid` only)."""
 
 
 @dataclass(frozen=True)
@@ -87,11 +94,8 @@ class Normal(Dispersion):
     def shape(self):
         return self.mean.shape
 
-    def raw(self, rng):
-        return rng.standard_normal(self.n_raw)
-
-    def values(self, raw, points):
-        return self.mean + self.std * raw.reshape((-1, *self.shape))
+    def values(self, u, points):
+        return self.mean + self.std * special.ndtri(u).reshape((-1, *self.shape))
 
     def __repr__(self):
         return f"Normal(mean={self.mean.tolist()}, std={self.std.tolist()})"
@@ -99,7 +103,7 @@ class Normal(Dispersion):
 
 @dataclass(frozen=True)
 class Uniform(Dispersion):
-    """``x = low + (high − low) u``, ``u`` uniform on [0, 1) per component (``low <= high``)."""
+    """``x = low + (high − low) u``, ``u`` uniform on (0, 1) per component (``low <= high``)."""
 
     low: np.ndarray
     high: np.ndarray
@@ -117,11 +121,8 @@ class Uniform(Dispersion):
     def shape(self):
         return self.low.shape
 
-    def raw(self, rng):
-        return rng.random(self.n_raw)
-
-    def values(self, raw, points):
-        return self.low + (self.high - self.low) * raw.reshape((-1, *self.shape))
+    def values(self, u, points):
+        return self.low + (self.high - self.low) * u.reshape((-1, *self.shape))
 
     def __repr__(self):
         return f"Uniform(low={self.low.tolist()}, high={self.high.tolist()})"
@@ -131,7 +132,7 @@ class Uniform(Dispersion):
 class TruncatedNormal(Dispersion):
     """A normal ``N(mean, std²)`` restricted to ``[low, high]``, drawn by inverting its distribution function:
     ``x = mean + std Φ⁻¹(Φ(a) + u (Φ(b) − Φ(a)))`` with ``a = (low − mean)/std``, ``b = (high − mean)/std``,
-    ``u`` uniform on [0, 1) (no rejection, so one variate per component). ``low`` and ``high`` default to
+    ``u`` uniform on (0, 1) (no rejection, so one variate per component). ``low`` and ``high`` default to
     ``mean ∓ 3 std``; ``std > 0``."""
 
     mean: np.ndarray
@@ -156,12 +157,9 @@ class TruncatedNormal(Dispersion):
     def shape(self):
         return self.mean.shape
 
-    def raw(self, rng):
-        return rng.random(self.n_raw)
-
-    def values(self, raw, points):
+    def values(self, u, points):
         a, b = special.ndtr((self.low - self.mean) / self.std), special.ndtr((self.high - self.mean) / self.std)
-        x = self.mean + self.std * special.ndtri(a + raw.reshape((-1, *self.shape)) * (b - a))
+        x = self.mean + self.std * special.ndtri(a + u.reshape((-1, *self.shape)) * (b - a))
         return np.clip(x, self.low, self.high)  # Φ⁻¹ rounding at the ends stays inside the bounds
 
     def __repr__(self):
@@ -189,7 +187,7 @@ class Grid(Dispersion):
     def __len__(self):
         return self.points.shape[0]
 
-    def values(self, raw, points):
+    def values(self, u, points):
         return self.points[points]
 
     def __repr__(self):
@@ -208,11 +206,9 @@ class UniformAttitude(Dispersion):
     def shape(self):
         return (4,)
 
-    def raw(self, rng):
-        return rng.standard_normal(4)
-
-    def values(self, raw, points):
-        return raw / np.linalg.norm(raw, axis=-1, keepdims=True)
+    def values(self, u, points):
+        z = special.ndtri(u)
+        return z / np.linalg.norm(z, axis=-1, keepdims=True)
 
     def __repr__(self):
         return "UniformAttitude()"
@@ -273,15 +269,12 @@ class Inertia(Dispersion):
     def shape(self):
         return (3, 3)
 
-    def raw(self, rng):
-        return np.concatenate([rng.random(3), rng.standard_normal(3)])
-
-    def values(self, raw, points):
+    def values(self, u, points):
         std = np.where(self.std > 0, self.std, 1.0)  # a fixed moment (std 0): any unit, the box is a point
         box = self.truncation * std
-        moments = TruncatedNormal(self.moments, std, self.moments - box, self.moments + box).values(raw[:, :3], points)
+        moments = TruncatedNormal(self.moments, std, self.moments - box, self.moments + box).values(u[:, :3], points)
         moments = np.where(self.std > 0, moments, self.moments)
-        rotation = attitude.to_matrix(attitude.from_rotvec(self.angle * raw[:, 3:])) @ self.axes
+        rotation = attitude.to_matrix(attitude.from_rotvec(self.angle * special.ndtri(u[:, 3:]))) @ self.axes
         inertia = np.einsum("mij,mj,mkj->mik", rotation, moments, rotation)
         return 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
 
@@ -320,17 +313,14 @@ class Misalignment(Dispersion):
     def shape(self):
         return self.axes.shape
 
-    def raw(self, rng):
-        return rng.standard_normal(self.n_raw)
-
-    def values(self, raw, points):
+    def values(self, u, points):
         # two unit vectors across each axis: e1 ⟂ a from the coordinate axis least along a, e2 = a × e1
         a = self.axes
         helper = np.eye(3)[np.abs(a).argmin(axis=-1)]
         e1 = np.cross(a, helper)
         e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
         e2 = np.cross(a, e1)
-        z = raw.reshape(-1, a.shape[0], 2) * self.angle
+        z = special.ndtri(u).reshape(-1, a.shape[0], 2) * self.angle
         rotvec = z[..., :1] * e1 + z[..., 1:] * e2
         return attitude.rotate(attitude.from_rotvec(rotvec), np.broadcast_to(a, rotvec.shape))
 
@@ -340,8 +330,9 @@ class Misalignment(Dispersion):
 
 @dataclass(frozen=True)
 class NoiseSeed(Dispersion):
-    """An integer seed in [0, 2⁵³) per sample (for a sensor-noise or disturbance model that takes one):
-    different for every sample and, like every input, fixed by ``(seed, i)``. Given as an int64."""
+    """An integer seed ``⌊2⁵³ u⌋`` in [0, 2⁵³) per sample, ``u`` the sample's uniform variate (for a
+    sensor-noise or disturbance model that takes one): like every input fixed by ``(seed, i)``; two of N
+    samples share a seed with probability about N²/2⁵⁴. Given as an int64."""
 
     n_raw: int = field(default=1, init=False, repr=False)
 
@@ -349,11 +340,8 @@ class NoiseSeed(Dispersion):
     def shape(self):
         return ()
 
-    def raw(self, rng):
-        return rng.integers(0, 2**53, size=1).astype(np.float64)  # exact in float64
-
-    def values(self, raw, points):
-        return raw[:, 0].astype(np.int64)
+    def values(self, u, points):
+        return np.floor(u[:, 0] * 2.0**53).astype(np.int64)  # ⌊2⁵³ u⌋
 
     def __repr__(self):
         return "NoiseSeed()"

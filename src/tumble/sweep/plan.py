@@ -4,7 +4,7 @@ A :class:`Plan` is a plain, picklable value: the model (or a function that
 builds one from dispersed parameters), the dispersions, the seed, the output
 times and solver options, and the outcome and series functions. A Dask task
 calls :meth:`Plan.run` on a chunk ``[lo, hi)`` of samples; it draws the
-samples' inputs from their own streams (:func:`tumble.sweep.dispersions.sample_stream`),
+samples' inputs from their own part of the random stream (:func:`tumble.sweep.dispersions.sample_uniforms`),
 simulates the chunk as **one batch** where the model allows it, and reduces
 the batched trajectory to per-sample outcomes and series. Nothing in a chunk's
 result depends on the chunk's bounds: sample ``i`` is a function of ``(seed,
@@ -39,7 +39,7 @@ from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.rigid import RigidBodies
 from tumble.simulate import Model, as_model, simulate
-from tumble.sweep.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_stream
+from tumble.sweep.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_uniforms
 from tumble.sweep.outcomes import describe
 from tumble.trajectory import Extra, Trajectory
 
@@ -107,19 +107,14 @@ class Plan:
     def inputs(self, lo: int, hi: int) -> dict[str, np.ndarray]:
         """The dispersed inputs of samples ``lo`` to ``hi − 1`` (name → (m, *shape)), each a function of
         ``(seed, i)`` only."""
-        randoms = [(name, d) for name, d in self.dispersions.items() if d.n_raw]
-        raw = {name: np.empty((hi - lo, d.n_raw)) for name, d in randoms}
-        if randoms:
-            for j, i in enumerate(range(lo, hi)):
-                rng = sample_stream(self.seed, i)
-                for name, d in randoms:
-                    raw[name][j] = d.raw(rng)
+        u = sample_uniforms(self.seed, lo, hi, sum(d.n_raw for d in self.dispersions.values()))
+        columns = np.cumsum([0] + [d.n_raw for d in self.dispersions.values()])
         index = np.arange(lo, hi) % math.prod(self.grid)
         points = iter(np.unravel_index(index, self.grid)) if self.grid else iter(())
         out = {}
-        for name, d in self.dispersions.items():
+        for (name, d), start, stop in zip(self.dispersions.items(), columns[:-1], columns[1:]):
             p = next(points) if isinstance(d, Grid) else index
-            out[name] = d.values(raw.get(name, np.empty((hi - lo, 0))), p)
+            out[name] = d.values(u[:, start:stop], p)
         return out
 
     # -- one chunk --------------------------------------------------------------------
@@ -246,7 +241,7 @@ def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, t
         raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
     builder = _is_builder(model)
     parameters = _parameters(model, dispersions)
-    probe = model(**{n: d.values(np.zeros((1, d.n_raw)), np.zeros(1, dtype=int))[0]
+    probe = model(**{n: d.values(np.full((1, d.n_raw), 0.5), np.zeros(1, dtype=int))[0]
                      for n, d in dispersions.items() if n in parameters}) if builder else model
     fields = {f.name: f for f in as_model(probe).state_fields()}
     for name in list(dispersions) + list(fixed):
