@@ -1,6 +1,5 @@
 """Results written atomically under signals, stale temporary files, concurrent writers (issue 18)."""
 
-import fcntl
 import os
 import signal
 import subprocess
@@ -27,15 +26,21 @@ def test_stale_temporary_siblings_of_killed_runs_are_removed(tmp_path):
 def test_a_second_writer_to_the_same_path_is_refused_and_the_first_wins(tmp_path):
     out = tmp_path / "out.txt"
     out.write_text("old")
-    fd = os.open(tmp_path / ".out.txt.lock", os.O_RDWR | os.O_CREAT)  # a writer at work holds the lock
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    first = subprocess.Popen([sys.executable, "-c", WRITER, str(out)], stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, text=True, env=env)  # a writer at work, holding the lock
     try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
+        assert first.stdout.readline() == "writing\n"
         with pytest.raises(FileExistsError, match=r"out.txt: another process is writing it now"):
             write_atomic(out, lambda tmp: Path(tmp).write_text("second"))
+        assert out.read_text() == "old"
+        first.stdin.write("done\n")  # the first writer finishes
+        first.stdin.close()
+        assert first.wait(timeout=30) == 0
     finally:
-        os.close(fd)
-    assert out.read_text() == "old"
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".out.txt.lock", "out.txt"]  # the holder's, untouched
+        first.kill()
+        first.wait()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"] and out.read_text() == "first"
 
 
 WRITER = """
@@ -46,7 +51,9 @@ from tumble.trajectory import write_atomic
 def write(tmp):
     Path(tmp).write_text("partial")
     print("writing", flush=True)
-    time.sleep(60)
+    if sys.stdin.readline() != "done\\n":  # until told (an interrupt test signals it first)
+        time.sleep(60)
+    Path(tmp).write_text("first")
 
 write_atomic(sys.argv[1], write)
 """
@@ -57,7 +64,8 @@ def test_a_run_interrupted_while_writing_leaves_no_temporary_file(tmp_path, sig,
     out = tmp_path / "out.txt"
     out.write_text("old")
     env = {**os.environ, "PYTHONPATH": str(SRC)}
-    child = subprocess.Popen([sys.executable, "-c", WRITER, str(out)], stdout=subprocess.PIPE, text=True, env=env)
+    child = subprocess.Popen([sys.executable, "-c", WRITER, str(out)], stdin=subprocess.DEVNULL,
+                             stdout=subprocess.PIPE, text=True, env=env)
     try:
         assert child.stdout.readline() == "writing\n"
         child.send_signal(sig)

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import contextlib
 import datetime
-import fcntl
 import glob
 import operator
 import os
@@ -47,6 +46,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, NamedTuple
 
+import filelock
 import numpy as np
 
 from ._validate import ValidationError, as_array
@@ -655,9 +655,10 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
     new file gets the permissions of the file it replaces, or the default
     ``0o666 & ~umask``.
 
-    One writer at a time: a writer holds an exclusive :func:`fcntl.flock` on the
-    sibling ``.NAME.lock`` (removed when it is done; the kernel releases the
-    lock of a killed process), and a second writer to the same path is refused
+    One writer at a time: a writer holds an exclusive lock on the sibling
+    ``.NAME.lock`` (:class:`filelock.FileLock`: ``flock`` on POSIX,
+    ``msvcrt.locking`` on Windows; removed when it is done; the operating system
+    releases the lock of a killed process), and a second writer to the same path is refused
     at once with :class:`FileExistsError` naming it (it neither waits nor
     silently wins). Holding the lock, a writer removes the ``.NAME.*.tmp``
     siblings left by killed runs (``kill -9``): no live writer owns them.
@@ -695,21 +696,19 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
 
 @contextlib.contextmanager
 def _exclusive(lock_path: str, path: str):
-    """Hold an exclusive flock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
-    fd = os.open(lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+    """Hold an exclusive lock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
+    lock = filelock.FileLock(lock_path, timeout=0, is_singleton=False)
     try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise FileExistsError(f"{path}: another process is writing it now (it holds {lock_path}); wait for it "
-                                  "to finish, or write elsewhere") from None
-        try:
-            yield
-        finally:
-            with contextlib.suppress(FileNotFoundError):
-                os.remove(lock_path)
+        lock.acquire()
+    except filelock.Timeout:
+        raise FileExistsError(f"{path}: another process is writing it now (it holds {lock_path}); wait for it "
+                              "to finish, or write elsewhere") from None
+    try:
+        yield
     finally:
-        os.close(fd)
+        with contextlib.suppress(FileNotFoundError, PermissionError):  # Windows: a new holder has it open
+            os.remove(lock_path)
+        lock.release()
 
 
 @contextlib.contextmanager
