@@ -21,6 +21,8 @@ from tumble._validate import ValidationError
 from tumble.integrate import SolverError
 from tumble.scenario import parse
 
+from test_models import CASES
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -147,6 +149,54 @@ def test_simulate_on_any_rates_is_finite_or_a_clean_error(omega0, dt):
         assert str(error).startswith("simulation diverged at t = "), str(error)
         return
     assert np.all(np.isfinite(traj.q)) and np.all(np.isfinite(traj.omega))
+
+
+# -- every model through the front door (8 examples each) ---------------------------------------------------
+
+# Each model of the model x method matrix (tests/test_models.py: the same models, so the same compiled types),
+# run with rk4 at its step over a fifth of its span, from its generic initial state with every vector scaled by
+# a factor in [-2, 2] and, in one of four examples, one component replaced by any float (nan, inf, 1e308, ...).
+# Either a clean error (a ValidationError naming the field, or a divergence), or a finite run whose unit
+# quaternions stay unit and whose invariants stay within 300 x the matrix's rk4 tolerance: rk4's error grows
+# as (h|ω|)^4, 16 x at twice the rates, and the matrix's tolerances leave a factor >= 10 over what it measured.
+MODELS = sorted(CASES)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_every_model_is_finite_and_keeps_its_invariants_or_refuses_naming_the_field(name):
+    make, state, span, dt, tolerances = CASES[name]
+    model = make()
+    quaternions = {f.name for f in model.state_fields() if f.quaternion}
+
+    @fixed(8)
+    @given(st.floats(-2.0, 2.0).filter(lambda s: abs(s) >= 0.05), st.sampled_from(sorted(state)),
+           st.one_of(st.none(), st.none(), st.none(), ANY_FLOAT), st.integers(0, 7))
+    def check(scale, replaced, value, index):
+        values = {key: np.array(v, dtype=float) * (1.0 if key in quaternions else scale) for key, v in state.items()}
+        if value is not None:
+            flat = values[replaced].reshape(-1)
+            flat[index % flat.size] = value
+        try:
+            with np.errstate(all="ignore"):  # |x|² of values near 1e308 (the CLI silences NumPy's warnings)
+                traj = tumble.simulate(model, t=np.linspace(0.0, span / 5, 6), method="rk4", dt=dt, **values)
+        except ValidationError as error:
+            assert_names_a_field(error)
+            return
+        except SolverError as error:
+            assert str(error).startswith("simulation diverged at t = "), str(error)
+            return
+        for field_name in ("q", "omega"):
+            data = getattr(traj, field_name)
+            assert data is None or np.all(np.isfinite(data)), field_name
+        if traj.q is not None:
+            assert np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0).max() <= 1e-13
+        if value is None:
+            for what, kept in model.invariants(traj).items():
+                start = np.linalg.norm(np.atleast_1d(kept[0]))
+                change = np.linalg.norm((kept - kept[0]).reshape(len(traj), -1), axis=-1).max()
+                assert change <= 300 * tolerances["rk4"] * start + 1e-300, (what, change / start)
+
+    check()
 
 
 # -- scenario files: mutations of every example (40 examples) -------------------------------------------
