@@ -38,10 +38,11 @@ from tumble.robot.kinematics import (
     frame_poses,
 )
 from tumble.robot.link import Frame, Link
+from tumble.robot.space import space_manipulator
 from tumble.robot.tree import RobotTree
 
 __all__ = [
-    "Link", "Frame", "RobotTree", "SerialChain", "load",
+    "Link", "Frame", "RobotTree", "SerialChain", "load", "space_manipulator",
     "frame_poses", "frame_pose", "frame_jacobian", "center_of_mass", "centroidal_momentum_matrix",
     "centroidal_momentum",
     "rnea", "gravity_torques", "coriolis", "mass_matrix", "forward_dynamics",
