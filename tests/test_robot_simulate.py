@@ -189,7 +189,7 @@ def test_a_robot_trajectory_saves_loads_and_plots(puma, tmp_path):
     assert run.q is None and run.omega is None and run.inertia is None
     units = {name: (e.dims, e.units) for name, e in run.extras.items()}
     assert units == {"joint_position": (("joint",), "rad or m"), "joint_velocity": (("joint",), "rad/s or m/s"),
-                     "joint_torque": (("joint",), "N m or N"), "work": ((), "J")}
+                     "joint_torque": (("joint",), "N m or N"), "work": ((), "J"), "beyond_limits": ((), "1")}
     assert run.info["robot"] == "PUMA 560" and run.info["gravity_z"] == -9.81
     path = tmp_path / "puma.nc"
     run.save(path)
