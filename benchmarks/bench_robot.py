@@ -133,8 +133,9 @@ def main():
                 PQ, PV, PA = (np.asfortranarray(np.tile(x, (args.batch, 1)).T) for x in (pq, pv, pa))
                 out = np.zeros((model.nv, args.batch), order="F")
                 threads = numba.get_num_threads()
+                pool = pin.ModelPool(model, threads)
                 peer[1] = tuple(x / args.batch for x in timed(
-                    lambda: pin.rneaInParallel(threads, model, data, PQ, PV, PA, out), 1, r))
+                    lambda: pin.rneaInParallel(threads, pool, PQ, PV, PA, out), 1, r))
             peer_crba = timed(lambda: pin.crba(model, data, pq), args.calls, r)
             peer_aba = timed(lambda: pin.aba(model, data, pq, pv, ptau), args.calls, r)
         cells = [row[0], row[1], peer[0], peer[1], crba[0], peer_crba, fd[0], fd[1], peer_aba]
