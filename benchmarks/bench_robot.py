@@ -1,31 +1,33 @@
-"""Speed of tumble.robot's RNEA and forward dynamics (ABA) beside Pinocchio, in one run.
+"""Speed of tumble.robot's RNEA, CRBA and forward dynamics beside Pinocchio, in one run, from the same URDFs.
 
-    PYTHONPATH=src python benchmarks/bench_robot.py [--batch 20000]
+    PYTHONPATH=src python benchmarks/bench_robot.py [--batch 20000] [--repeats 7]
 
-For the planar 2-link arm, the PUMA 560, the Franka Panda (examples/robots/)
-and a random 30-joint chain: microseconds per call of ``tumble.robot.rnea``
-and ``tumble.robot.forward_dynamics`` on one state from Python, per sample on
-a batch (parallel over the cores), and ``pinocchio.rnea`` / ``pinocchio.aba``
-called from Python on the same model (built here joint by joint from the
-chain; the torques are compared first). Best of several repeats. Takes about
-half a minute with a warm Numba cache. Pinocchio is optional: without it,
-its columns are empty.
+Robots: the 6-axis examples/robots/industrial6.urdf, UR5 and Panda (fixed base) and the Talos humanoid and
+Solo12 quadruped (floating base) from example-robot-data. Pinocchio builds its model from the same file with
+its own URDF parser (``buildModelFromUrdf``: axis-aligned RX/RY/RZ joints where the URDF has them), and the
+torques are compared first. Per row: µs per call of ``tumble.robot.rnea`` / ``mass_matrix`` /
+``forward_dynamics`` on one state from Python, per sample of a batched call (parallel over the cores),
+and Pinocchio's ``rnea`` / ``crba`` / ``aba`` called from Python, and its ``rneaInParallel`` per sample
+where this build has it. Each figure: min and median over ``--repeats`` repeats (≥ 5). Prints the CPU,
+the cores and the load average first: on a shared machine the medians move with the load.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import platform
 import sys
 import time
+from importlib import metadata
 from pathlib import Path
 
+import numba
 import numpy as np
 
 from tumble import robot
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _timing import best_of  # noqa: E402
 
 try:
     import pinocchio as pin
@@ -33,83 +35,114 @@ except ImportError:  # the comparison is optional
     pin = None
 
 
-def random_chain(n: int, seed: int = 0) -> robot.SerialChain:
-    """n revolute joints with random DH parameters and random, physically consistent links."""
-    rng = np.random.default_rng(seed)
-    rows = []
-    for _ in range(n):
-        r, _ = np.linalg.qr(rng.standard_normal((3, 3)))
-        rows.append(dict(a=rng.uniform(0.0, 0.3), d=rng.uniform(0.0, 0.3), alpha=rng.uniform(-np.pi, np.pi),
-                         mass=rng.uniform(0.5, 3.0), com=rng.uniform(-0.1, 0.1, 3),
-                         inertia=r @ np.diag(rng.uniform(0.01, 0.02, 3)) @ r.T))
-    return robot.SerialChain.from_dh(rows, name=f"random {n}-DOF")
+def robots() -> dict[str, tuple[Path, bool]]:
+    cases = {"industrial6": (ROOT / "examples" / "robots" / "industrial6.urdf", False)}
+    try:
+        erd = Path(metadata.distribution("example-robot-data").locate_file(
+            "cmeel.prefix/share/example-robot-data/robots"))
+    except metadata.PackageNotFoundError:
+        return cases
+    cases.update({"ur5": (erd / "ur_description/urdf/ur5_robot.urdf", False),
+                  "panda": (erd / "panda_description/urdf/panda.urdf", False),
+                  "talos": (erd / "talos_data/robots/talos_full_v2.urdf", True),
+                  "solo12": (erd / "solo_description/robots/solo12.urdf", True)})
+    return cases
 
 
-def pinocchio_model(chain: robot.SerialChain):
-    """The same chain as a pinocchio.Model, from its canonical frames (tumble.kernels.featherstone layout)."""
-    P = chain.params
-    model = pin.Model()
-    parent = 0
-    for i in range(chain.dof):
-        placement = pin.SE3(P[i, 0:9].reshape(3, 3), P[i, 9:12].copy())
-        joint = pin.JointModelRevoluteUnaligned(P[i, 12:15].copy())
-        parent = model.addJoint(parent, joint, placement, f"j{i}")
-        m, h, inertia_o = P[i, 17], P[i, 18:21], P[i, 21:30].reshape(3, 3)
-        com = h / m if m > 0 else np.zeros(3)
-        inertia_c = inertia_o - m * (com @ com * np.eye(3) - np.outer(com, com))
-        model.appendBodyToJoint(parent, pin.Inertia(m, com, inertia_c), pin.SE3.Identity())
-    model.gravity.linear[:] = chain.gravity
-    return model
+def machine() -> str:
+    cpu = platform.processor() or "?"
+    try:
+        with open("/proc/cpuinfo") as fh:
+            cpu = next(line.split(":", 1)[1].strip() for line in fh if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    return (f"{cpu}; {os.cpu_count()} cores, {numba.get_num_threads()} Numba threads; load average "
+            f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}; Python {platform.python_version()}")
 
 
-def per_call(fn, calls: int, repeats: int = 5) -> float:
-    """Best over ``repeats`` of the mean time of ``calls`` calls of ``fn`` (µs)."""
-    def loop():
+def timed(fn, calls: int, repeats: int) -> tuple[float, float]:
+    """(min, median) over ``repeats`` of the mean time of ``calls`` calls of ``fn``, µs."""
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
         for _ in range(calls):
             fn()
-    return best_of(repeats, loop)[0] / calls * 1e6
+        times.append((time.perf_counter() - start) / calls * 1e6)
+    return float(np.min(times)), float(np.median(times))
+
+
+def pin_state(model, tree, q, v):
+    """Tumble's (q, v) in Pinocchio's coordinates (quaternion xyzw; base (v, ω)); joints matched by name."""
+    index = {model.names[j]: model.joints[j].idx_v for j in range(1, model.njoints) if model.joints[j].nv == 1}
+    of = np.array([index[n] for n in tree.joint_names])
+    fl = int(tree.floating_base)
+    pq, pv = np.zeros(model.nq), np.zeros(model.nv)
+    if fl:
+        pq[0:3], pq[3:6], pq[6] = q[0:3], q[4:7], q[3]
+        pv[0:3], pv[3:6] = v[3:6], v[0:3]
+    pq[of + fl] = q[7 * fl:]
+    pv[of] = v[6 * fl:]
+    return pq, pv, of
+
+
+def fmt(pair) -> str:
+    return f"{pair[0]:7.2f}/{pair[1]:<7.2f}"
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--batch", type=int, default=20000, help="samples per batched call")
-    parser.add_argument("--calls", type=int, default=2000, help="single calls per timing")
+    parser.add_argument("--calls", type=int, default=2000, help="single calls per repeat")
+    parser.add_argument("--repeats", type=int, default=7, help="repeats (min and median are printed), >= 5")
     args = parser.parse_args()
-    chains = [robot.load(ROOT / "examples" / "robots" / name)
-              for name in ("planar_2link.toml", "puma560.toml", "panda.urdf")] + [random_chain(30)]
-    import numba
-
-    print(f"tumble.robot vs {'Pinocchio ' + pin.__version__ if pin else 'no Pinocchio'}; "
-          f"{numba.get_num_threads()} threads; batch of {args.batch}; µs per call or per sample")
-    header = (f"{'chain':<22} {'n':>3} | {'RNEA 1':>8} {'RNEA B':>8} {'pin.rnea':>8} | "
-              f"{'FD 1':>8} {'FD B':>8} {'pin.aba':>8} | {'max |Δτ|':>8}")
-    print(header)
-    print("-" * len(header))
+    print(machine())
+    print(f"tumble.robot vs {'Pinocchio ' + pin.__version__ if pin else 'no Pinocchio'}; batch of {args.batch}; "
+          "µs per call (one state) or per sample (batch B); each cell min/median")
+    cols = ["RNEA 1", "RNEA B", "pin.rnea", "pin.rneaPar", "CRBA 1", "pin.crba", "FD 1", "FD B", "pin.aba"]
+    print(f"{'robot':<12} {'nv':>3} | " + " ".join(f"{c:>15}" for c in cols) + " | max|Δτ|")
     rng = np.random.default_rng(1)
-    for chain in chains:
-        n = chain.dof
-        q, qd, qdd = rng.uniform(-1.0, 1.0, (3, n))
-        Q, QD, QDD = rng.uniform(-1.0, 1.0, (3, args.batch, n))
-        tau = robot.rnea(chain, q, qd, qdd)
-        TAU = robot.rnea(chain, Q, QD, QDD)
-        robot.forward_dynamics(chain, Q, QD, TAU)
-        row = [per_call(lambda: robot.rnea(chain, q, qd, qdd), args.calls),
-               best_of(5, lambda: robot.rnea(chain, Q, QD, QDD))[0] / args.batch * 1e6]
-        fd = [per_call(lambda: robot.forward_dynamics(chain, q, qd, tau), args.calls),
-              best_of(5, lambda: robot.forward_dynamics(chain, Q, QD, TAU))[0] / args.batch * 1e6]
-        peer_rnea = peer_aba = delta = float("nan")
+    r = args.repeats
+    for name, (path, floating) in robots().items():
+        tree = robot.RobotTree.from_urdf(path, floating_base=floating, mimic=False, check_triangle=False)
+        q = tree.neutral()
+        q[tree.nq - tree.dof:] = rng.uniform(-1.0, 1.0, tree.dof)
+        qd, qdd = rng.uniform(-1.0, 1.0, (2, tree.nv))
+        Q, QD, QDD = np.tile(q, (args.batch, 1)), *rng.uniform(-1.0, 1.0, (2, args.batch, tree.nv))
+        tau = robot.rnea(tree, q, qd, qdd)
+        TAU = robot.rnea(tree, Q, QD, QDD)
+        robot.mass_matrix(tree, q), robot.forward_dynamics(tree, Q, QD, TAU)
+        row = [timed(lambda: robot.rnea(tree, q, qd, qdd), args.calls, r),
+               tuple(x / args.batch for x in timed(lambda: robot.rnea(tree, Q, QD, QDD), 1, r))]
+        peer = [(float("nan"),) * 2] * 2
+        crba = [timed(lambda: robot.mass_matrix(tree, q), args.calls, r)]
+        fd = [timed(lambda: robot.forward_dynamics(tree, q, qd, tau), args.calls, r),
+              tuple(x / args.batch for x in timed(lambda: robot.forward_dynamics(tree, Q, QD, TAU), 1, r))]
+        peer_crba = peer_aba = (float("nan"),) * 2
+        delta = float("nan")
         if pin is not None:
-            model = pinocchio_model(chain)
+            root = (pin.JointModelFreeFlyer(),) if floating else ()
+            model = pin.buildModelFromUrdf(str(path), *root)
             data = model.createData()
-            delta = np.abs(pin.rnea(model, data, q, qd, qdd) - tau).max()
-            peer_rnea = per_call(lambda: pin.rnea(model, data, q, qd, qdd), args.calls)
-            peer_aba = per_call(lambda: pin.aba(model, data, q, qd, tau), args.calls)
-        print(f"{chain.name:<22} {n:>3} | {row[0]:8.2f} {row[1]:8.3f} {peer_rnea:8.2f} | "
-              f"{fd[0]:8.2f} {fd[1]:8.3f} {peer_aba:8.2f} | {delta:8.1e}")
-    print("RNEA 1 / FD 1: one state from Python; RNEA B / FD B: per sample of a batched call.")
+            pq, pv, of = pin_state(model, tree, q, qd)
+            pa = pin_state(model, tree, q, qdd)[1]
+            ptau = pin_state(model, tree, q, tau)[1]
+            expected = pin.rnea(model, data, pq, pv, pa)
+            delta = float(np.abs(expected[of] - tau[tree.nv - tree.dof:]).max())
+            peer[0] = timed(lambda: pin.rnea(model, data, pq, pv, pa), args.calls, r)
+            if hasattr(pin, "rneaInParallel"):
+                PQ, PV, PA = (np.asfortranarray(np.tile(x, (args.batch, 1)).T) for x in (pq, pv, pa))
+                out = np.zeros((model.nv, args.batch), order="F")
+                threads = numba.get_num_threads()
+                pool = pin.ModelPool(model, threads)
+                peer[1] = tuple(x / args.batch for x in timed(
+                    lambda: pin.rneaInParallel(threads, pool, PQ, PV, PA, out), 1, r))
+            peer_crba = timed(lambda: pin.crba(model, data, pq), args.calls, r)
+            peer_aba = timed(lambda: pin.aba(model, data, pq, pv, ptau), args.calls, r)
+        cells = [row[0], row[1], peer[0], peer[1], crba[0], peer_crba, fd[0], fd[1], peer_aba]
+        print(f"{name:<12} {tree.nv:>3} | " + " ".join(fmt(c) for c in cells) + f" | {delta:.1e}")
 
 
 if __name__ == "__main__":
     start = time.perf_counter()
     main()
-    print(f"({time.perf_counter() - start:.0f} s)")
+    print(f"({time.perf_counter() - start:.0f} s)", file=sys.stderr)

@@ -189,7 +189,7 @@ def test_a_robot_trajectory_saves_loads_and_plots(puma, tmp_path):
     assert run.q is None and run.omega is None and run.inertia is None
     units = {name: (e.dims, e.units) for name, e in run.extras.items()}
     assert units == {"joint_position": (("joint",), "rad or m"), "joint_velocity": (("joint",), "rad/s or m/s"),
-                     "joint_torque": (("joint",), "N m or N"), "work": ((), "J")}
+                     "joint_torque": (("joint",), "N m or N"), "work": ((), "J"), "beyond_limits": ((), "1")}
     assert run.info["robot"] == "PUMA 560" and run.info["gravity_z"] == -9.81
     path = tmp_path / "puma.nc"
     run.save(path)
@@ -247,13 +247,16 @@ def test_docs_python_blocks_run_as_scripts(tmp_path, monkeypatch):
     (tmp_path / "examples").symlink_to(ROBOTS.parent)
     monkeypatch.chdir(tmp_path)
     blocks = re.findall(r"```python\n(.*?)```", DOCS.read_text(encoding="utf-8"), re.S)
-    assert len(blocks) == 3
+    assert len(blocks) == 4
+    spaces = []
     for k, code in enumerate(blocks):
         assert "…" not in code
         namespace: dict = {}
         exec(compile(code, f"{DOCS}, Python block {k}", "exec"), namespace)  # the project's own text
-    # the last block's claim: the power balance holds below 1e-13 J (measured 2.5e-14 J)
-    assert np.abs(namespace["balance"] - namespace["balance"][0]).max() < 1e-13
+        spaces.append(namespace)
+    # the simulation block's claim: the power balance holds below 1e-13 J (measured 2.5e-14 J)
+    balance = spaces[2]["balance"]
+    assert np.abs(balance - balance[0]).max() < 1e-13
 
 
 # -- the CLI ------------------------------------------------------------------------------

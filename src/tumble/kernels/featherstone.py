@@ -1,37 +1,52 @@
-"""Compiled rigid-body algorithms for serial chains: RNEA, CRBA, ABA, energies, link poses.
+"""Compiled rigid-body algorithms for kinematic trees: RNEA, CRBA, ABA, energies, body poses.
 
 Spatial vector algebra (Featherstone, *Rigid Body Dynamics Algorithms*,
 Springer 2008, ch. 2), written with 3-vectors so that every quantity lives in
 registers: a motion vector is ``(ω, v)`` (angular velocity, velocity of the
 body point at the frame origin), a force vector ``(n, f)`` (moment about the
-frame origin, force), both in link axes.
+frame origin, force), both in body axes.
 
-The chain is one float64 array ``P`` of shape (n, PARAMS), built once by
-:class:`tumble.robot.SerialChain`; row ``i`` describes joint ``i`` and the link
+A robot is a kinematic tree in Featherstone's form (2008, §4.1.2): bodies
+numbered so that every parent comes before its children, ``λ(i) < i``. It is
+one float64 array ``P`` of shape (nb, PARAMS), built once by
+:class:`tumble.robot.RobotTree`; row ``i`` describes joint ``i`` and body ``i``
 it moves, in *canonical* frames whose origin lies on the joint axis:
 
 =========  ==============================================================
 columns    meaning
 =========  ==============================================================
-0–8        ``R``: axes of joint frame i (before motion) in link frame i−1, row-major
-9–11       ``p``: origin of joint frame i in link frame i−1 (m)
-12–14      ``s``: unit joint axis (same in the joint and link frames)
-15         joint type: 0 revolute, 1 prismatic
-16         offset: the joint variable is ``q + offset`` (rad or m)
-17         ``m``: link mass (kg)
-18–20      ``h = m c``: first mass moment about the link origin (kg·m)
-21–29      ``I_O``: rotational inertia about the link origin, row-major (kg·m²)
-30–38      ``R_f``: axes of the user's link frame in the canonical link frame
-39–41      ``p_f``: origin of the user's link frame in the canonical link frame (m)
+0–8        ``R``: axes of joint frame i (before motion) in body frame λ(i), row-major
+9–11       ``p``: origin of joint frame i in body frame λ(i) (m)
+12–14      ``s``: unit joint axis (same in the joint and body frames)
+15         joint type: 0 revolute, 1 prismatic, 2 free (the floating base)
+16         offset: the joint variable is ``k q[c] + offset`` (rad or m)
+17         ``m``: body mass (kg)
+18–20      ``h = m c``: first mass moment about the body origin (kg·m)
+21–29      ``I_O``: rotational inertia about the body origin, row-major (kg·m²)
+30–38      ``R_f``: axes of the user's body frame in the canonical frame
+39–41      ``p_f``: origin of the user's body frame in the canonical frame (m)
+42         ``λ(i)``: the parent body, −1 for the fixed base (or the world, for the free body)
+43         ``c``: index of the joint's velocity coordinate in ``q̇``
+44         ``k``: multiplier; a mimic joint shares the coordinate ``c`` of the joint it copies
 =========  ==============================================================
 
-Motion of joint i: revolute ``R_J = exp(θ [s]×)``, ``θ = q + offset``; prismatic
-``p_J = (q + offset) s``. Link frame i = joint frame i moved by the joint.
+Motion of joint i: revolute ``R_J = exp(θ [s]×)``; prismatic ``p_J = θ s``,
+``θ = k q[c] + offset``, ``θ̇ = k q̇[c]``. A *floating base* is body 0 with a
+free joint (type 2) to the world: its configuration ``q[0:7] = (r, quat)``,
+the origin of body 0 in the world frame (m) and the unit quaternion
+``[w, x, y, z]`` of body 0 → world, its velocity ``q̇[0:6] = (ω, v)`` in body
+0 axes; the joint coordinates follow, so the configuration index of
+coordinate ``c`` is ``c + 1``. Gravity ``g`` is given in the world (base)
+frame and enters as a base acceleration ``−g`` (Featherstone 2008, §5.3).
 
-The single-sample functions ``*_one`` take a scratch array ``W`` (allocated
-once per call, or once per chunk of a batch). ``rnea_batch``, ``crba_batch``
-and ``aba_batch`` run a batch of samples in parallel: ``prange`` over ``nc``
-chunks of consecutive samples, one scratch allocation per chunk.
+Mimic joints (several bodies on one coordinate) are constrained coordinates
+``θ = G q + offset``: RNEA returns ``Gᵀ τ`` and CRBA ``Gᵀ M G``; the
+articulated-body algorithm does not apply and :func:`forward_one` solves
+``M q̈ = τ − h`` by Cholesky instead.
+
+The single-sample functions ``*_one`` take a scratch array ``W`` (nb,
+_WIDTH), allocated once per call or once per chunk of a batch; ``*_batch``
+run a batch in parallel: ``prange`` over ``nc`` chunks of consecutive samples.
 """
 
 from __future__ import annotations
@@ -43,8 +58,9 @@ from numba import njit, prange
 
 from tumble._vec import cross
 
-PARAMS = 42
-REVOLUTE, PRISMATIC = 0, 1
+PARAMS = 45
+REVOLUTE, PRISMATIC, FREE = 0, 1, 2
+PARENT, COORDINATE, MULTIPLIER = 42, 43, 44
 # Compiler options: fused multiply-adds allowed (contraction only: no reassociation,
 # NaN and inf keep their meaning, so the finiteness checks stay valid); a division
 # by zero gives inf or NaN (found by those checks) rather than an exception; the
@@ -52,18 +68,34 @@ REVOLUTE, PRISMATIC = 0, 1
 # 7-DOF RNEA).
 _JIT = {"cache": True, "fastmath": {"contract"}, "error_model": "numpy"}
 _INLINE = {**_JIT, "inline": "always"}
-# Scratch columns per link.
-_W_RNEA = 18   # transform (12), force (6)
-_W_CRBA = 25   # transform (12), composite inertia m, h, I_O (13)
-_W_ABA = 80    # transform (12), v (6), c (6), I^A (36), p^A (6), U (6), D, u, p^a (6)
-_W_POSE = 12   # transform (12)
+# Scratch columns per body: transform (0–11), v (12–17), a or c (18–23), f or I^A (24–59),
+# p^A (60–65), U (66–71), D, u (72, 73), p^a (74–79), ABA's a (80–85); CRBA's composite inertia
+# (m, h, I_O) at 12–24; world poses at 12–23.
+_WIDTH = 86
+
+
+@njit(**_JIT)
+def floating(P):
+    """1 when body 0 is a floating base (free joint), else 0 (also the configuration index shift)."""
+    return 1 if P[0, 15] == FREE else 0
 
 
 @njit(**_INLINE)
-def _transform(P, i, qi, W):
-    """Pose of link frame i in link frame i−1 into ``W[i, 0:12]`` (R row-major, then p)."""
+def _free_transform(q, W):
+    """Pose of the floating body 0 in the world, from ``q[0:7] = (r, quat)``, into ``W[0, 0:12]``."""
+    qw, qx, qy, qz = q[3], q[4], q[5], q[6]
+    xx, yy, zz, xy, xz, yz = qx * qx, qy * qy, qz * qz, qx * qy, qx * qz, qy * qz
+    wx, wy, wz = qw * qx, qw * qy, qw * qz
+    W[0, 0], W[0, 1], W[0, 2] = 1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy)
+    W[0, 3], W[0, 4], W[0, 5] = 2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx)
+    W[0, 6], W[0, 7], W[0, 8] = 2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy)
+    W[0, 9], W[0, 10], W[0, 11] = q[0], q[1], q[2]
+
+
+@njit(**_INLINE)
+def _transform(P, i, x, W):
+    """Pose of body frame i in body frame λ(i), joint variable ``x``, into ``W[i, 0:12]`` (R row-major, p)."""
     sx, sy, sz = P[i, 12], P[i, 13], P[i, 14]
-    x = qi + P[i, 16]
     if P[i, 15] == REVOLUTE:
         # Rodrigues: R_J = cos θ E + (1 − cos θ) s sᵀ + sin θ [s]×
         c, s = math.cos(x), math.sin(x)
@@ -85,6 +117,14 @@ def _transform(P, i, qi, W):
 
 
 @njit(**_INLINE)
+def _joint(P, i, q, fl):
+    """``(c, k, θ)``: coordinate index, multiplier and joint variable of joint i (not the free joint)."""
+    c = int(P[i, COORDINATE])
+    k = P[i, MULTIPLIER]
+    return c, k, k * q[c + fl] + P[i, 16]
+
+
+@njit(**_INLINE)
 def _rot_t(A, i, o, x, y, z):
     """``Rᵀ (x, y, z)`` with R row-major at ``A[i, o:o+9]`` (parent components → child)."""
     return (A[i, o] * x + A[i, o + 3] * y + A[i, o + 6] * z,
@@ -102,7 +142,7 @@ def _rot(A, i, o, x, y, z):
 
 @njit(**_INLINE)
 def _motion_to_child(W, i, wx, wy, wz, vx, vy, vz):
-    """``X_i m``: motion vector (ω, v) of frame i−1 in frame i: ``(Rᵀ ω, Rᵀ (v − p × ω))``."""
+    """``X_i m``: motion vector (ω, v) of frame λ(i) in frame i: ``(Rᵀ ω, Rᵀ (v − p × ω))``."""
     cx, cy, cz = cross(W[i, 9], W[i, 10], W[i, 11], wx, wy, wz)
     a = _rot_t(W, i, 0, wx, wy, wz)
     b = _rot_t(W, i, 0, vx - cx, vy - cy, vz - cz)
@@ -123,7 +163,7 @@ def _force_to_parent(A, i, o, nx, ny, nz, fx, fy, fz):
 
 @njit(**_INLINE)
 def _inertia_times(P, i, wx, wy, wz, vx, vy, vz):
-    """Rigid-body inertia of link i times a motion vector: ``(I_O ω + h × v, m v − h × ω)``."""
+    """Rigid-body inertia of body i times a motion vector: ``(I_O ω + h × v, m v − h × ω)``."""
     hx, hy, hz = P[i, 18], P[i, 19], P[i, 20]
     a = cross(hx, hy, hz, vx, vy, vz)
     b = cross(hx, hy, hz, wx, wy, wz)
@@ -135,10 +175,26 @@ def _inertia_times(P, i, wx, wy, wz, vx, vy, vz):
 
 
 @njit(**_INLINE)
+def _bias_force(P, i, wx, wy, wz, vx, vy, vz):
+    """``v ×* (I v)``, with ``v ×* (n, f) = (ω × n + v × f, ω × f)``."""
+    h = _inertia_times(P, i, wx, wy, wz, vx, vy, vz)
+    c1 = cross(wx, wy, wz, h[0], h[1], h[2])
+    c2 = cross(vx, vy, vz, h[3], h[4], h[5])
+    c3 = cross(wx, wy, wz, h[3], h[4], h[5])
+    return c1[0] + c2[0], c1[1] + c2[1], c1[2] + c2[2], c3[0], c3[1], c3[2]
+
+
+@njit(**_INLINE)
 def _external(P, fext):
-    """The end-link wrench ``fext = (f, n)`` (user frame n, moment about its origin) in the canonical frame."""
+    """The last body's wrench ``fext = (f, n)`` (user frame, moment about its origin) in its canonical frame."""
     n = P.shape[0] - 1
     return _force_to_parent(P, n, 30, fext[3], fext[4], fext[5], fext[0], fext[1], fext[2])
+
+
+@njit(**_INLINE)
+def _gravity_in_body0(W, g):
+    """``R₀ᵀ g``: gravity (world axes) in the axes of the floating body 0 (transform at ``W[0]``)."""
+    return _rot_t(W, 0, 0, g[0], g[1], g[2])
 
 
 # -- inverse dynamics: RNEA ----------------------------------------------------
@@ -146,65 +202,94 @@ def _external(P, fext):
 
 @njit(**_JIT)
 def rnea_one(P, q, qd, qdd, g, fext, W, tau):
-    """``τ = ID(q, q̇, q̈)`` into ``tau``: Featherstone (2008) Table 5.1, the base accelerating at −g.
+    """``τ = ID(q, q̇, q̈)`` into ``tau``: Featherstone (2008) Table 5.1 on a tree, the base accelerating at −g.
 
-    Returns False when a torque is not finite (the caller then finds the bad input).
+    With a floating base, ``qdd[0:6]`` is the base's spatial acceleration and
+    ``tau[0:6]`` the wrench ``(n, f)`` on it (body 0 axes) that this motion
+    needs (Featherstone 2008, §9.3). Returns False when a torque is not finite.
     """
-    n = P.shape[0]
-    wx = wy = wz = vx = vy = vz = 0.0
-    ax = ay = az = 0.0
-    lx, ly, lz = -g[0], -g[1], -g[2]
-    for i in range(n):
-        _transform(P, i, q[i], W)
-        wx, wy, wz, vx, vy, vz = _motion_to_child(W, i, wx, wy, wz, vx, vy, vz)
-        ax, ay, az, lx, ly, lz = _motion_to_child(W, i, ax, ay, az, lx, ly, lz)
-        sx, sy, sz = P[i, 12], P[i, 13], P[i, 14]
-        if P[i, 15] == REVOLUTE:
-            wx, wy, wz = wx + sx * qd[i], wy + sy * qd[i], wz + sz * qd[i]
-            c = cross(wx, wy, wz, sx * qd[i], sy * qd[i], sz * qd[i])
-            d = cross(vx, vy, vz, sx * qd[i], sy * qd[i], sz * qd[i])
-            ax, ay, az = ax + sx * qdd[i] + c[0], ay + sy * qdd[i] + c[1], az + sz * qdd[i] + c[2]
-            lx, ly, lz = lx + d[0], ly + d[1], lz + d[2]
+    nb = P.shape[0]
+    fl = floating(P)
+    for k in range(tau.shape[0]):
+        tau[k] = 0.0
+    for i in range(nb):
+        par = int(P[i, PARENT])
+        if fl == 1 and i == 0:
+            _free_transform(q, W)
+            gx, gy, gz = _gravity_in_body0(W, g)
+            wx, wy, wz, vx, vy, vz = qd[0], qd[1], qd[2], qd[3], qd[4], qd[5]
+            ax, ay, az, lx, ly, lz = qdd[0], qdd[1], qdd[2], qdd[3] - gx, qdd[4] - gy, qdd[5] - gz
         else:
-            vx, vy, vz = vx + sx * qd[i], vy + sy * qd[i], vz + sz * qd[i]
-            c = cross(wx, wy, wz, sx * qd[i], sy * qd[i], sz * qd[i])
-            lx, ly, lz = lx + sx * qdd[i] + c[0], ly + sy * qdd[i] + c[1], lz + sz * qdd[i] + c[2]
-        # f = I a + v ×* (I v),  v ×* (n, f) = (ω × n + v × f, ω × f)
+            c, k, x = _joint(P, i, q, fl)
+            _transform(P, i, x, W)
+            if par < 0:
+                wx = wy = wz = vx = vy = vz = 0.0
+                ax, ay, az, lx, ly, lz = _motion_to_child(W, i, 0.0, 0.0, 0.0, -g[0], -g[1], -g[2])
+            else:
+                wx, wy, wz, vx, vy, vz = _motion_to_child(W, i, W[par, 12], W[par, 13], W[par, 14],
+                                                          W[par, 15], W[par, 16], W[par, 17])
+                ax, ay, az, lx, ly, lz = _motion_to_child(W, i, W[par, 18], W[par, 19], W[par, 20],
+                                                          W[par, 21], W[par, 22], W[par, 23])
+            xd, xdd = k * qd[c], k * qdd[c]
+            sx, sy, sz = P[i, 12], P[i, 13], P[i, 14]
+            if P[i, 15] == REVOLUTE:
+                wx, wy, wz = wx + sx * xd, wy + sy * xd, wz + sz * xd
+                e = cross(wx, wy, wz, sx * xd, sy * xd, sz * xd)
+                d = cross(vx, vy, vz, sx * xd, sy * xd, sz * xd)
+                ax, ay, az = ax + sx * xdd + e[0], ay + sy * xdd + e[1], az + sz * xdd + e[2]
+                lx, ly, lz = lx + d[0], ly + d[1], lz + d[2]
+            else:
+                vx, vy, vz = vx + sx * xd, vy + sy * xd, vz + sz * xd
+                e = cross(wx, wy, wz, sx * xd, sy * xd, sz * xd)
+                lx, ly, lz = lx + sx * xdd + e[0], ly + sy * xdd + e[1], lz + sz * xdd + e[2]
+        W[i, 12], W[i, 13], W[i, 14], W[i, 15], W[i, 16], W[i, 17] = wx, wy, wz, vx, vy, vz
+        W[i, 18], W[i, 19], W[i, 20], W[i, 21], W[i, 22], W[i, 23] = ax, ay, az, lx, ly, lz
+        # f = I a + v ×* (I v)
         f = _inertia_times(P, i, ax, ay, az, lx, ly, lz)
-        h = _inertia_times(P, i, wx, wy, wz, vx, vy, vz)
-        c1 = cross(wx, wy, wz, h[0], h[1], h[2])
-        c2 = cross(vx, vy, vz, h[3], h[4], h[5])
-        c3 = cross(wx, wy, wz, h[3], h[4], h[5])
-        W[i, 12], W[i, 13], W[i, 14] = f[0] + c1[0] + c2[0], f[1] + c1[1] + c2[1], f[2] + c1[2] + c2[2]
-        W[i, 15], W[i, 16], W[i, 17] = f[3] + c3[0], f[4] + c3[1], f[5] + c3[2]
+        b = _bias_force(P, i, wx, wy, wz, vx, vy, vz)
+        for k in range(6):
+            W[i, 24 + k] = f[k] + b[k]
     e = _external(P, fext)
     for k in range(6):
-        W[n - 1, 12 + k] -= e[k]
-    ok = True
-    for i in range(n - 1, -1, -1):
-        o = 12 if P[i, 15] == REVOLUTE else 15
-        tau[i] = P[i, 12] * W[i, o] + P[i, 13] * W[i, o + 1] + P[i, 14] * W[i, o + 2]
-        ok = ok and math.isfinite(tau[i])
-        if i > 0:
-            r = _force_to_parent(W, i, 0, W[i, 12], W[i, 13], W[i, 14], W[i, 15], W[i, 16], W[i, 17])
+        W[nb - 1, 24 + k] -= e[k]
+    for i in range(nb - 1, -1, -1):
+        if fl == 1 and i == 0:
             for k in range(6):
-                W[i - 1, 12 + k] += r[k]
+                tau[k] = W[0, 24 + k]
+            break
+        o = 24 if P[i, 15] == REVOLUTE else 27
+        c = int(P[i, COORDINATE])
+        tau[c] += P[i, MULTIPLIER] * (P[i, 12] * W[i, o] + P[i, 13] * W[i, o + 1] + P[i, 14] * W[i, o + 2])
+        par = int(P[i, PARENT])
+        if par >= 0:
+            r = _force_to_parent(W, i, 0, W[i, 24], W[i, 25], W[i, 26], W[i, 27], W[i, 28], W[i, 29])
+            for k in range(6):
+                W[par, 24 + k] += r[k]
+    ok = True
+    for k in range(tau.shape[0]):
+        ok = ok and math.isfinite(tau[k])
     return ok
 
 
 @njit(**_JIT)
+def scratch(nb):
+    """The scratch array of the ``*_one`` functions for a tree of nb bodies."""
+    return np.empty((nb, _WIDTH))
+
+
+@njit(**_JIT)
 def rnea(P, q, qd, qdd, g, fext, tau):
-    """One sample: ``tau`` (n,) from ``q``, ``qd``, ``qdd`` (n,), ``g`` (3,), ``fext`` (6,)."""
-    return rnea_one(P, q, qd, qdd, g, fext, np.empty((P.shape[0], _W_RNEA)), tau)
+    """One sample: ``tau`` (nv,) from ``q`` (nq,), ``qd``, ``qdd`` (nv,), ``g`` (3,), ``fext`` (6,)."""
+    return rnea_one(P, q, qd, qdd, g, fext, scratch(P.shape[0]), tau)
 
 
 @njit(parallel=True, **_JIT)
 def rnea_batch(P, Q, QD, QDD, g, F, TAU, nc):
-    """A batch: ``TAU[b] = ID(Q[b], QD[b], QDD[b])``; ``F`` (1 or B, 6) the end-link wrenches."""
+    """A batch: ``TAU[b] = ID(Q[b], QD[b], QDD[b])``; ``F`` (1 or B, 6) the last body's wrenches."""
     B = Q.shape[0]
     wide = F.shape[0] > 1
     for c in prange(nc):
-        W = np.empty((P.shape[0], _W_RNEA))
+        W = scratch(P.shape[0])
         for b in range(c * B // nc, (c + 1) * B // nc):
             rnea_one(P, Q[b], QD[b], QDD[b], g, F[b * wide], W, TAU[b])
 
@@ -213,14 +298,14 @@ def rnea_batch(P, Q, QD, QDD, g, F, TAU, nc):
 
 
 @njit(**_INLINE)
-def _motion_subspace_force(W, i, o, s_rev, sx, sy, sz):
-    """``F = I S`` for a composite rigid inertia (m, h, I_O) at ``W[i, o:o+13]`` and joint axis s."""
-    m, hx, hy, hz = W[i, o], W[i, o + 1], W[i, o + 2], W[i, o + 3]
+def _motion_subspace_force(W, i, s_rev, sx, sy, sz):
+    """``F = I S`` for the composite rigid inertia (m, h, I_O) at ``W[i, 12:25]`` and joint axis s."""
+    m, hx, hy, hz = W[i, 12], W[i, 13], W[i, 14], W[i, 15]
     if s_rev:  # S = (s, 0): (I_O s, s × h)
         c = cross(sx, sy, sz, hx, hy, hz)
-        return (W[i, o + 4] * sx + W[i, o + 5] * sy + W[i, o + 6] * sz,
-                W[i, o + 7] * sx + W[i, o + 8] * sy + W[i, o + 9] * sz,
-                W[i, o + 10] * sx + W[i, o + 11] * sy + W[i, o + 12] * sz, c[0], c[1], c[2])
+        return (W[i, 16] * sx + W[i, 17] * sy + W[i, 18] * sz,
+                W[i, 19] * sx + W[i, 20] * sy + W[i, 21] * sz,
+                W[i, 22] * sx + W[i, 23] * sy + W[i, 24] * sz, c[0], c[1], c[2])
     c = cross(hx, hy, hz, sx, sy, sz)  # S = (0, s): (h × s, m s)
     return c[0], c[1], c[2], m * sx, m * sy, m * sz
 
@@ -233,61 +318,92 @@ def _project(P, j, F):
 
 
 @njit(**_JIT)
-def crba_one(P, q, W, M):
-    """Joint-space inertia matrix ``M(q)`` into ``M`` (n, n): Featherstone (2008) Table 6.2.
+def _add_composite_to_parent(W, i, par):
+    """``I^c_λ += X_iᵀ I^c_i X_i`` for rigid inertias (m, h, I_O): ``h' = R h + m p``,
+    ``I_O' = R I_O Rᵀ + (2 h'' · p + m|p|²) E − (h'' pᵀ + p h''ᵀ + m p pᵀ)``, ``h'' = R h``."""
+    m = W[i, 12]
+    hx, hy, hz = _rot(W, i, 0, W[i, 13], W[i, 14], W[i, 15])
+    px, py, pz = W[i, 9], W[i, 10], W[i, 11]
+    W[par, 12] += m
+    W[par, 13] += hx + m * px
+    W[par, 14] += hy + m * py
+    W[par, 15] += hz + m * pz
+    for r in range(3):  # R I_O Rᵀ
+        for c in range(3):
+            acc = 0.0
+            for a in range(3):
+                for b in range(3):
+                    acc += W[i, 3 * r + a] * W[i, 16 + 3 * a + b] * W[i, 3 * c + b]
+            W[par, 16 + 3 * r + c] += acc
+    diag = 2.0 * (hx * px + hy * py + hz * pz) + m * (px * px + py * py + pz * pz)
+    h = (hx, hy, hz)
+    p = (px, py, pz)
+    for r in range(3):
+        for c in range(3):
+            W[par, 16 + 3 * r + c] -= h[r] * p[c] + p[r] * h[c] + m * p[r] * p[c]
+        W[par, 16 + 4 * r] += diag
 
-    The composite inertias stay rigid-body inertias (m, h, I_O), moved to the
-    parent by ``h' = R h + m p``,
-    ``I_O' = R I_O Rᵀ + (2 h'' · p + m|p|²) E − (h'' pᵀ + p h''ᵀ + m p pᵀ)``, ``h'' = R h``.
+
+@njit(**_JIT)
+def crba_one(P, q, W, M):
+    """Joint-space inertia matrix ``M(q)`` into ``M`` (nv, nv): Featherstone (2008) Table 6.2 on a tree.
+
+    With a floating base, ``M[0:6, 0:6]`` is the composite inertia of the
+    whole robot in body 0 axes (Featherstone 2008, §9.3); with mimic joints
+    the result is ``Gᵀ M G`` in the independent coordinates.
     """
-    n = P.shape[0]
-    for i in range(n):
-        _transform(P, i, q[i], W)
+    nb = P.shape[0]
+    fl = floating(P)
+    M[:, :] = 0.0
+    for i in range(nb):
+        if fl == 1 and i == 0:
+            _free_transform(q, W)
+        else:
+            _transform(P, i, _joint(P, i, q, fl)[2], W)
         for k in range(13):
             W[i, 12 + k] = P[i, 17 + k]
-    for i in range(n - 1, -1, -1):
-        F = _motion_subspace_force(W, i, 12, P[i, 15] == REVOLUTE, P[i, 12], P[i, 13], P[i, 14])
-        M[i, i] = _project(P, i, F)
+    for i in range(nb - 1, -1, -1):
+        par = int(P[i, PARENT])
+        if fl == 1 and i == 0:  # S = E: the composite inertia as a 6×6 [[I_O, [h]×], [−[h]×, m E]]
+            m, hx, hy, hz = W[0, 12], W[0, 13], W[0, 14], W[0, 15]
+            hxm = ((0.0, -hz, hy), (hz, 0.0, -hx), (-hy, hx, 0.0))
+            for r in range(3):
+                for c in range(3):
+                    M[r, c] += W[0, 16 + 3 * r + c]
+                    M[r, 3 + c] += hxm[r][c]
+                    M[3 + r, c] -= hxm[r][c]
+                M[3 + r, 3 + r] += m
+            break
+        F = _motion_subspace_force(W, i, P[i, 15] == REVOLUTE, P[i, 12], P[i, 13], P[i, 14])
+        ci, ki = int(P[i, COORDINATE]), P[i, MULTIPLIER]
+        M[ci, ci] += ki * ki * _project(P, i, F)
         j = i
-        while j > 0:
+        while int(P[j, PARENT]) >= 0:
             F = _force_to_parent(W, j, 0, F[0], F[1], F[2], F[3], F[4], F[5])
-            j -= 1
-            M[i, j] = M[j, i] = _project(P, j, F)
-        if i > 0:
-            m = W[i, 12]
-            hx, hy, hz = _rot(W, i, 0, W[i, 13], W[i, 14], W[i, 15])
-            px, py, pz = W[i, 9], W[i, 10], W[i, 11]
-            W[i - 1, 12] += m
-            W[i - 1, 13] += hx + m * px
-            W[i - 1, 14] += hy + m * py
-            W[i - 1, 15] += hz + m * pz
-            # R I_O Rᵀ
-            for r in range(3):
-                for c in range(3):
-                    acc = 0.0
-                    for a in range(3):
-                        for b in range(3):
-                            acc += W[i, 3 * r + a] * W[i, 16 + 3 * a + b] * W[i, 3 * c + b]
-                    W[i - 1, 16 + 3 * r + c] += acc
-            diag = 2.0 * (hx * px + hy * py + hz * pz) + m * (px * px + py * py + pz * pz)
-            h = (hx, hy, hz)
-            p = (px, py, pz)
-            for r in range(3):
-                for c in range(3):
-                    W[i - 1, 16 + 3 * r + c] -= h[r] * p[c] + p[r] * h[c] + m * p[r] * p[c]
-                W[i - 1, 16 + 4 * r] += diag
+            j = int(P[j, PARENT])
+            if fl == 1 and j == 0:
+                for r in range(6):
+                    M[r, ci] += ki * F[r]
+                    M[ci, r] += ki * F[r]
+            else:
+                cj = int(P[j, COORDINATE])
+                x = ki * P[j, MULTIPLIER] * _project(P, j, F)
+                M[ci, cj] += x
+                M[cj, ci] += x
+        if par >= 0:
+            _add_composite_to_parent(W, i, par)
 
 
 @njit(**_JIT)
 def crba(P, q, M):
-    crba_one(P, q, np.empty((P.shape[0], _W_CRBA)), M)
+    crba_one(P, q, scratch(P.shape[0]), M)
 
 
 @njit(parallel=True, **_JIT)
 def crba_batch(P, Q, M, nc):
     B = Q.shape[0]
     for c in prange(nc):
-        W = np.empty((P.shape[0], _W_CRBA))
+        W = scratch(P.shape[0])
         for b in range(c * B // nc, (c + 1) * B // nc):
             crba_one(P, Q[b], W, M[b])
 
@@ -296,8 +412,8 @@ def crba_batch(P, Q, M, nc):
 
 
 @njit(**_JIT)
-def _add_articulated_to_parent(W, i, X, T):
-    """``I^A_{i−1} += X_iᵀ I^a X_i`` with I^a at ``W[i, 24:60]``; X, T are (6, 6) scratch."""
+def _add_articulated_to_parent(W, i, par, X, T):
+    """``I^A_λ += X_iᵀ I^a X_i`` with I^a at ``W[i, 24:60]``; X, T are (6, 6) scratch."""
     # X = [[E, 0], [−E [p]×, E]], E = Rᵀ
     for r in range(3):
         for c in range(3):
@@ -316,34 +432,73 @@ def _add_articulated_to_parent(W, i, X, T):
             for k in range(6):
                 acc += W[i, 24 + 6 * r + k] * X[k, c]
             T[r, c] = acc
-    for r in range(6):  # I^A_{i−1} += Xᵀ T
+    for r in range(6):  # I^A_λ += Xᵀ T
         for c in range(6):
             acc = 0.0
             for k in range(6):
                 acc += X[k, r] * T[k, c]
-            W[i - 1, 24 + 6 * r + c] += acc
+            W[par, 24 + 6 * r + c] += acc
+
+
+@njit(**_JIT)
+def cholesky_solve(A, b):
+    """Solve ``A x = b`` in place (``x`` into ``b``) for a symmetric positive-definite ``A`` (n, n), overwritten
+    by its Cholesky factor L (``A = L Lᵀ``, lower triangle). A non-positive pivot gives NaN."""
+    n = A.shape[0]
+    for j in range(n):
+        d = A[j, j]
+        for k in range(j):
+            d -= A[j, k] * A[j, k]
+        d = math.sqrt(d) if d > 0.0 else math.nan
+        A[j, j] = d
+        for i in range(j + 1, n):
+            s = A[i, j]
+            for k in range(j):
+                s -= A[i, k] * A[j, k]
+            A[i, j] = s / d
+    for i in range(n):
+        s = b[i]
+        for k in range(i):
+            s -= A[i, k] * b[k]
+        b[i] = s / A[i, i]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for k in range(i + 1, n):
+            s -= A[k, i] * b[k]
+        b[i] = s / A[i, i]
 
 
 @njit(**_JIT)
 def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
-    """``q̈ = FD(q, q̇, τ)`` into ``qdd``: the articulated-body algorithm, Featherstone (2008) Table 7.1.
-
-    Returns False when an acceleration is not finite.
+    """``q̈ = FD(q, q̇, τ)`` into ``qdd``: the articulated-body algorithm on a tree, Featherstone (2008)
+    Table 7.1; with a floating base, Table 9.6 (the base acceleration from ``I^A_0 a₀ = τ₀ − p^A_0``,
+    gravity as a fictitious acceleration). No mimic joints. Returns False when an acceleration is not finite.
     """
-    n = P.shape[0]
-    wx = wy = wz = vx = vy = vz = 0.0
-    for i in range(n):  # pass 1: velocities, bias accelerations c, rigid inertias, bias forces
-        _transform(P, i, q[i], W)
-        wx, wy, wz, vx, vy, vz = _motion_to_child(W, i, wx, wy, wz, vx, vy, vz)
-        sx, sy, sz = P[i, 12] * qd[i], P[i, 13] * qd[i], P[i, 14] * qd[i]
-        if P[i, 15] == REVOLUTE:
-            wx, wy, wz = wx + sx, wy + sy, wz + sz
-            c1 = cross(wx, wy, wz, sx, sy, sz)
-            c2 = cross(vx, vy, vz, sx, sy, sz)
+    nb = P.shape[0]
+    fl = floating(P)
+    for i in range(nb):  # pass 1: velocities, bias accelerations c, rigid inertias, bias forces
+        par = int(P[i, PARENT])
+        if fl == 1 and i == 0:
+            _free_transform(q, W)
+            wx, wy, wz, vx, vy, vz = qd[0], qd[1], qd[2], qd[3], qd[4], qd[5]
+            c1 = c2 = (0.0, 0.0, 0.0)
         else:
-            vx, vy, vz = vx + sx, vy + sy, vz + sz
-            c1 = (0.0, 0.0, 0.0)
-            c2 = cross(wx, wy, wz, sx, sy, sz)
+            c, k, x = _joint(P, i, q, fl)
+            _transform(P, i, x, W)
+            if par < 0:
+                wx = wy = wz = vx = vy = vz = 0.0
+            else:
+                wx, wy, wz, vx, vy, vz = _motion_to_child(W, i, W[par, 12], W[par, 13], W[par, 14],
+                                                          W[par, 15], W[par, 16], W[par, 17])
+            sx, sy, sz = P[i, 12] * qd[c], P[i, 13] * qd[c], P[i, 14] * qd[c]
+            if P[i, 15] == REVOLUTE:
+                wx, wy, wz = wx + sx, wy + sy, wz + sz
+                c1 = cross(wx, wy, wz, sx, sy, sz)
+                c2 = cross(vx, vy, vz, sx, sy, sz)
+            else:
+                vx, vy, vz = vx + sx, vy + sy, vz + sz
+                c1 = (0.0, 0.0, 0.0)
+                c2 = cross(wx, wy, wz, sx, sy, sz)
         W[i, 12], W[i, 13], W[i, 14], W[i, 15], W[i, 16], W[i, 17] = wx, wy, wz, vx, vy, vz
         W[i, 18], W[i, 19], W[i, 20], W[i, 21], W[i, 22], W[i, 23] = c1[0], c1[1], c1[2], c2[0], c2[1], c2[2]
         # I^A = [[I_O, [h]×], [−[h]×, m E]]
@@ -357,66 +512,106 @@ def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
             for c in range(3):
                 W[i, 24 + 6 * r + 3 + c] = hxm[r][c]
                 W[i, 24 + 6 * (3 + r) + c] = -hxm[r][c]
-        h = _inertia_times(P, i, wx, wy, wz, vx, vy, vz)
-        d1 = cross(wx, wy, wz, h[0], h[1], h[2])
-        d2 = cross(vx, vy, vz, h[3], h[4], h[5])
-        d3 = cross(wx, wy, wz, h[3], h[4], h[5])
-        W[i, 60], W[i, 61], W[i, 62] = d1[0] + d2[0], d1[1] + d2[1], d1[2] + d2[2]
-        W[i, 63], W[i, 64], W[i, 65] = d3[0], d3[1], d3[2]
+        b = _bias_force(P, i, wx, wy, wz, vx, vy, vz)
+        for k in range(6):
+            W[i, 60 + k] = b[k]
     e = _external(P, fext)
     for k in range(6):
-        W[n - 1, 60 + k] -= e[k]
-    for i in range(n - 1, -1, -1):  # pass 2: articulated inertias and bias forces
+        W[nb - 1, 60 + k] -= e[k]
+    for i in range(nb - 1, fl - 1, -1):  # pass 2: articulated inertias and bias forces
+        c = int(P[i, COORDINATE])
         o = 0 if P[i, 15] == REVOLUTE else 3
         sx, sy, sz = P[i, 12], P[i, 13], P[i, 14]
         for r in range(6):  # U = I^A S
             W[i, 66 + r] = (W[i, 24 + 6 * r + o] * sx + W[i, 24 + 6 * r + o + 1] * sy
                             + W[i, 24 + 6 * r + o + 2] * sz)
         D = W[i, 66 + o] * sx + W[i, 67 + o] * sy + W[i, 68 + o] * sz
-        u = tau[i] - (W[i, 60 + o] * sx + W[i, 61 + o] * sy + W[i, 62 + o] * sz)
+        u = tau[c] - (W[i, 60 + o] * sx + W[i, 61 + o] * sy + W[i, 62 + o] * sz)
         W[i, 72], W[i, 73] = D, u
-        if i > 0:
+        par = int(P[i, PARENT])
+        if par >= 0:
             # I^a = I^A − U Uᵀ/D (in place), p^a = p^A + I^a c + U u/D
             for r in range(6):
-                for c in range(6):
-                    W[i, 24 + 6 * r + c] -= W[i, 66 + r] * W[i, 66 + c] / D
+                for k in range(6):
+                    W[i, 24 + 6 * r + k] -= W[i, 66 + r] * W[i, 66 + k] / D
             for r in range(6):
                 acc = W[i, 60 + r] + W[i, 66 + r] * u / D
-                for c in range(6):
-                    acc += W[i, 24 + 6 * r + c] * W[i, 18 + c]
+                for k in range(6):
+                    acc += W[i, 24 + 6 * r + k] * W[i, 18 + k]
                 W[i, 74 + r] = acc
-            _add_articulated_to_parent(W, i, X, T)
+            _add_articulated_to_parent(W, i, par, X, T)
             f = _force_to_parent(W, i, 0, W[i, 74], W[i, 75], W[i, 76], W[i, 77], W[i, 78], W[i, 79])
             for k in range(6):
-                W[i - 1, 60 + k] += f[k]
-    ax = ay = az = 0.0
-    lx, ly, lz = -g[0], -g[1], -g[2]
+                W[par, 60 + k] += f[k]
     ok = True
-    for i in range(n):  # pass 3: accelerations
-        ax, ay, az, lx, ly, lz = _motion_to_child(W, i, ax, ay, az, lx, ly, lz)
+    for i in range(nb):  # pass 3: accelerations (a' = a − a_g, a_g = (0, g): gravity as a fictitious acceleration)
+        par = int(P[i, PARENT])
+        if fl == 1 and i == 0:
+            for r in range(6):
+                for k in range(6):
+                    X[r, k] = W[0, 24 + 6 * r + k]
+                W[0, 80 + r] = tau[r] - W[0, 60 + r]
+            cholesky_solve(X, W[0, 80:86])
+            gx, gy, gz = _gravity_in_body0(W, g)
+            qdd[0], qdd[1], qdd[2] = W[0, 80], W[0, 81], W[0, 82]
+            qdd[3], qdd[4], qdd[5] = W[0, 83] + gx, W[0, 84] + gy, W[0, 85] + gz
+            for r in range(6):
+                ok = ok and math.isfinite(qdd[r])
+            continue
+        if par < 0:
+            ax, ay, az, lx, ly, lz = _motion_to_child(W, i, 0.0, 0.0, 0.0, -g[0], -g[1], -g[2])
+        else:
+            ax, ay, az, lx, ly, lz = _motion_to_child(W, i, W[par, 80], W[par, 81], W[par, 82],
+                                                      W[par, 83], W[par, 84], W[par, 85])
         ax, ay, az = ax + W[i, 18], ay + W[i, 19], az + W[i, 20]
         lx, ly, lz = lx + W[i, 21], ly + W[i, 22], lz + W[i, 23]
         Ua = (W[i, 66] * ax + W[i, 67] * ay + W[i, 68] * az + W[i, 69] * lx + W[i, 70] * ly + W[i, 71] * lz)
-        qdd[i] = (W[i, 73] - Ua) / W[i, 72]
-        ok = ok and math.isfinite(qdd[i])
-        sx, sy, sz = P[i, 12] * qdd[i], P[i, 13] * qdd[i], P[i, 14] * qdd[i]
+        c = int(P[i, COORDINATE])
+        x = (W[i, 73] - Ua) / W[i, 72]
+        qdd[c] = x
+        ok = ok and math.isfinite(x)
+        sx, sy, sz = P[i, 12] * x, P[i, 13] * x, P[i, 14] * x
         if P[i, 15] == REVOLUTE:
             ax, ay, az = ax + sx, ay + sy, az + sz
         else:
             lx, ly, lz = lx + sx, ly + sy, lz + sz
+        W[i, 80], W[i, 81], W[i, 82], W[i, 83], W[i, 84], W[i, 85] = ax, ay, az, lx, ly, lz
     return ok
 
 
 @njit(**_JIT)
-def aba_scratch(n):
-    """Scratch arrays of :func:`aba_one` for a chain of n joints."""
-    return np.empty((n, _W_ABA)), np.empty((6, 6)), np.empty((6, 6))
+def mimic(P, nv):
+    """True when some joints share a coordinate (mimic joints): then the ABA does not apply."""
+    return nv < P.shape[0] + 5 * floating(P)
+
+
+@njit(**_JIT)
+def fd_scratch(nb, nv):
+    """Scratch arrays of :func:`forward_one` for a tree of nb bodies and nv velocity coordinates."""
+    return np.empty((nb, _WIDTH)), np.empty((6, 6)), np.empty((6, 6)), np.empty((nv, nv)), np.zeros(nv)
+
+
+@njit(**_JIT)
+def forward_one(P, q, qd, tau, g, fext, W, X, T, M, zero, qdd):
+    """``q̈ = FD(q, q̇, τ)``: the ABA (:func:`aba_one`), or with mimic joints ``M q̈ = τ − RNEA(q, q̇, 0)`` by CRBA
+    and Cholesky (``zero``: nv zeros). Returns False when an acceleration is not finite."""
+    if not mimic(P, qd.shape[0]):
+        return aba_one(P, q, qd, tau, g, fext, W, X, T, qdd)
+    rnea_one(P, q, qd, zero, g, fext, W, qdd)
+    for k in range(qdd.shape[0]):
+        qdd[k] = tau[k] - qdd[k]
+    crba_one(P, q, W, M)
+    cholesky_solve(M, qdd)
+    ok = True
+    for k in range(qdd.shape[0]):
+        ok = ok and math.isfinite(qdd[k])
+    return ok
 
 
 @njit(**_JIT)
 def aba(P, q, qd, tau, g, fext, qdd):
-    W, X, T = aba_scratch(P.shape[0])
-    return aba_one(P, q, qd, tau, g, fext, W, X, T, qdd)
+    W, X, T, M, zero = fd_scratch(P.shape[0], qd.shape[0])
+    return forward_one(P, q, qd, tau, g, fext, W, X, T, M, zero, qdd)
 
 
 @njit(parallel=True, **_JIT)
@@ -424,32 +619,43 @@ def aba_batch(P, Q, QD, TAU, g, F, QDD, nc):
     B = Q.shape[0]
     wide = F.shape[0] > 1
     for c in prange(nc):
-        W, X, T = aba_scratch(P.shape[0])
+        W, X, T, M, zero = fd_scratch(P.shape[0], QD.shape[1])
         for b in range(c * B // nc, (c + 1) * B // nc):
-            aba_one(P, Q[b], QD[b], TAU[b], g, F[b * wide], W, X, T, QDD[b])
+            forward_one(P, Q[b], QD[b], TAU[b], g, F[b * wide], W, X, T, M, zero, QDD[b])
 
 
 # -- kinematics and energy -----------------------------------------------------
 
 
 @njit(**_JIT)
-def poses_one(P, q, W, T):
-    """World poses of the user's link frames into ``T`` (n, 4, 4) (homogeneous, base frame)."""
-    n = P.shape[0]
-    Rw = np.eye(3)
-    pw = np.zeros(3)
-    Rn = np.empty((3, 3))
-    for i in range(n):
-        _transform(P, i, q[i], W)
+def world_poses(P, q, W):
+    """World poses of the canonical body frames into ``W[i, 12:24]`` (R row-major, then p), transforms at 0–11."""
+    fl = floating(P)
+    for i in range(P.shape[0]):
+        par = int(P[i, PARENT])
+        if fl == 1 and i == 0:
+            _free_transform(q, W)
+        else:
+            _transform(P, i, _joint(P, i, q, fl)[2], W)
+        if par < 0:
+            for k in range(12):
+                W[i, 12 + k] = W[i, k]
+            continue
         for r in range(3):
-            x, y, z = Rw[r, 0], Rw[r, 1], Rw[r, 2]
-            pw[r] += x * W[i, 9] + y * W[i, 10] + z * W[i, 11]
+            x, y, z = W[par, 12 + 3 * r], W[par, 13 + 3 * r], W[par, 14 + 3 * r]
+            W[i, 21 + r] = W[par, 21 + r] + x * W[i, 9] + y * W[i, 10] + z * W[i, 11]
             for c in range(3):
-                Rn[r, c] = x * W[i, c] + y * W[i, 3 + c] + z * W[i, 6 + c]
-        Rw[:, :] = Rn
+                W[i, 12 + 3 * r + c] = x * W[i, c] + y * W[i, 3 + c] + z * W[i, 6 + c]
+
+
+@njit(**_JIT)
+def poses_one(P, q, W, T):
+    """World poses of the user's body frames into ``T`` (nb, 4, 4) (homogeneous, base/world frame)."""
+    world_poses(P, q, W)
+    for i in range(P.shape[0]):
         for r in range(3):  # user frame = canonical frame ∘ (R_f, p_f)
-            x, y, z = Rw[r, 0], Rw[r, 1], Rw[r, 2]
-            T[i, r, 3] = pw[r] + x * P[i, 39] + y * P[i, 40] + z * P[i, 41]
+            x, y, z = W[i, 12 + 3 * r], W[i, 13 + 3 * r], W[i, 14 + 3 * r]
+            T[i, r, 3] = W[i, 21 + r] + x * P[i, 39] + y * P[i, 40] + z * P[i, 41]
             for c in range(3):
                 T[i, r, c] = x * P[i, 30 + c] + y * P[i, 33 + c] + z * P[i, 36 + c]
             T[i, 3, r] = 0.0
@@ -460,32 +666,21 @@ def poses_one(P, q, W, T):
 def energy_one(P, q, qd, g, W):
     """``(T, V)``: kinetic energy ``Σ ½ vᵢᵀ Iᵢ vᵢ`` and potential ``−Σ g · (mᵢ pᵢ + R_i hᵢ)`` (J).
 
-    ``pᵢ``, ``R_i``: pose of link frame i in the base frame, whose origin is the zero of V.
+    ``pᵢ``, ``R_i``: pose of body frame i in the world (base) frame, whose origin is the zero of V.
     """
-    n = P.shape[0]
-    wx = wy = wz = vx = vy = vz = 0.0
-    Rw = np.eye(3)
-    Rn = np.empty((3, 3))
-    pw = np.zeros(3)
-    kinetic = potential = 0.0
-    for i in range(n):
-        _transform(P, i, q[i], W)
-        wx, wy, wz, vx, vy, vz = _motion_to_child(W, i, wx, wy, wz, vx, vy, vz)
-        sx, sy, sz = P[i, 12] * qd[i], P[i, 13] * qd[i], P[i, 14] * qd[i]
-        if P[i, 15] == REVOLUTE:
-            wx, wy, wz = wx + sx, wy + sy, wz + sz
-        else:
-            vx, vy, vz = vx + sx, vy + sy, vz + sz
-        h = _inertia_times(P, i, wx, wy, wz, vx, vy, vz)
-        kinetic += 0.5 * (wx * h[0] + wy * h[1] + wz * h[2] + vx * h[3] + vy * h[4] + vz * h[5])
+    rnea_one(P, q, qd, np.zeros(qd.shape[0]), np.zeros(3), np.zeros(6), W, np.empty(qd.shape[0]))
+    # the body velocities are now at W[:, 12:18]
+    kinetic = 0.0
+    for i in range(P.shape[0]):
+        h = _inertia_times(P, i, W[i, 12], W[i, 13], W[i, 14], W[i, 15], W[i, 16], W[i, 17])
+        for k in range(6):
+            kinetic += 0.5 * W[i, 12 + k] * h[k]
+    world_poses(P, q, W)
+    potential = 0.0
+    for i in range(P.shape[0]):
         for r in range(3):
-            x, y, z = Rw[r, 0], Rw[r, 1], Rw[r, 2]
-            pw[r] += x * W[i, 9] + y * W[i, 10] + z * W[i, 11]
-            for c in range(3):
-                Rn[r, c] = x * W[i, c] + y * W[i, 3 + c] + z * W[i, 6 + c]
-        Rw[:, :] = Rn
-        for r in range(3):
-            first = P[i, 17] * pw[r] + Rw[r, 0] * P[i, 18] + Rw[r, 1] * P[i, 19] + Rw[r, 2] * P[i, 20]
+            first = (P[i, 17] * W[i, 21 + r] + W[i, 12 + 3 * r] * P[i, 18] + W[i, 13 + 3 * r] * P[i, 19]
+                     + W[i, 14 + 3 * r] * P[i, 20])
             potential -= g[r] * first
     return kinetic, potential
 
@@ -493,14 +688,23 @@ def energy_one(P, q, qd, g, W):
 @njit(**_JIT)
 def energy_batch(P, Q, QD, g, OUT):
     """``OUT[b] = (T, V)`` of sample b (serial: energies are for checks and plots, not hot loops)."""
-    W = np.empty((P.shape[0], _W_POSE))
+    W = scratch(P.shape[0])
     for b in range(Q.shape[0]):
         OUT[b, 0], OUT[b, 1] = energy_one(P, Q[b], QD[b], g, W)
 
 
 @njit(**_JIT)
 def poses_batch(P, Q, T):
-    """``T[b]`` = the link poses of sample b (serial)."""
-    W = np.empty((P.shape[0], _W_POSE))
+    """``T[b]`` = the body poses of sample b (serial)."""
+    W = scratch(P.shape[0])
     for b in range(Q.shape[0]):
         poses_one(P, Q[b], W, T[b])
+
+
+@njit(**_JIT)
+def body_poses_batch(P, Q, OUT):
+    """``OUT[b, i] = (R, p)`` (12,) of canonical body frame i in the world, sample b (serial; for Jacobians)."""
+    W = scratch(P.shape[0])
+    for b in range(Q.shape[0]):
+        world_poses(P, Q[b], W)
+        OUT[b] = W[:, 12:24]

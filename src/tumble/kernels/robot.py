@@ -1,24 +1,27 @@
-"""A serial chain (robot arm on a fixed base) as a model for the integrators (see :mod:`tumble._protocol`).
+"""A robot (kinematic tree on a fixed or floating base) as a model for the integrators (see :mod:`tumble._protocol`).
 
-State of a chain of n joints, ``y = [q, q̇, W]`` (2n + 1): the joint
-coordinates ``q`` (rad for a revolute joint, m for a prismatic one, base to
-tip), their rates ``q̇`` (rad/s or m/s), and the work ``W`` done on the chain by
-the joint torques since the start (J). Right-hand side::
+State of a robot with nq configuration and nv velocity coordinates,
+``y = [q, q̇, W]`` (nq + nv + 1): the configuration ``q`` (joint coordinates,
+rad or m; with a floating base first ``r`` (m, world) and the unit quaternion
+``[w, x, y, z]`` base → world), the velocities ``q̇`` (joint rates; with a
+floating base first ``ω`` and ``v`` of the base, base axes), and the work
+``W`` done by the joint torques since the start (J). Right-hand side::
 
-    q̇ = q̇,    q̈ = FD(q, q̇, τ),    Ẇ = τ · q̇,    τ = τ(t, q, q̇)
+    q̇_joints = q̇_joints,   ṙ = R(quat) v,   quaṫ = ½ quat ⊗ [0, ω],
+    q̈ = FD(q, q̇, τ),    Ẇ = τ · q̇,    τ = τ(t, q, q̇)
 
 with ``FD`` the articulated-body algorithm (Featherstone, *Rigid Body Dynamics
-Algorithms*, Springer 2008, Table 7.1; :mod:`tumble.kernels.featherstone`),
-which solves ``M(q) q̈ + C(q, q̇) q̇ + g(q) = τ``. Gravity is conservative and
-the joints frictionless, so the energy ``E = T + V`` changes only by the
-work of the joint torques, ``dE/dt = τ · q̇``: along the exact motion
-``E(t) − W(t) = E(0)``, a power balance every run can be checked against
-(:meth:`tumble.robot.SerialChain.invariants`).
+Algorithms*, Springer 2008, Tables 7.1 and 9.6; with mimic joints a CRBA
+solve; :mod:`tumble.kernels.featherstone`), which solves ``M(q) q̈ + C(q, q̇)
+q̇ + g(q) = τ``. Gravity is conservative and the joints frictionless, so the
+energy ``E = T + V`` changes only by the work of the joint torques, ``dE/dt
+= τ · q̇``: along the exact motion ``E(t) − W(t) = E(0)``, a power balance
+every run can be checked against (:meth:`tumble.robot.RobotTree.invariants`).
+The joint torques act on the joints only (none on a floating base).
 
-The joint coordinates live in a vector space (no quaternion), so
-``project`` does nothing and the chain provides a right-hand side only:
-``rk4`` and ``dop853`` apply. The torque law is zero, a constant, or a Python
-function ``f(t, q, q̇)`` called through the one registry of Python callbacks,
+``project`` renormalises the base quaternion (a fixed base has nothing to
+project). The torque law is zero, a constant, or a Python function ``f(t, q,
+q̇)`` called through the one registry of Python callbacks,
 :mod:`tumble._callback` (then ``calls_python``: the batch runs on one core).
 """
 
@@ -30,6 +33,7 @@ import numpy as np
 from numba import njit, objmode
 
 from tumble import _callback, _protocol
+from tumble._quat import qmul, qnorm, qrotate
 from tumble.kernels import featherstone as _featherstone
 
 # Torque laws (the first entry of RobotModel.law).
@@ -37,23 +41,25 @@ ZERO, CONSTANT, PYTHON = 0, 1, 2
 
 
 class RobotModel(NamedTuple):
-    """Compiled parameters of a serial chain under a joint-torque law.
+    """Compiled parameters of a robot under a joint-torque law.
 
-    params  : (n, 42) the chain (layout in :mod:`tumble.kernels.featherstone`)
+    params  : (nb, 45) the tree (layout in :mod:`tumble.kernels.featherstone`)
+    sizes   : (2,) int64: nq and nv
     gravity : (3,) gravitational acceleration, m/s², base frame
     law     : (2,) int64: the torque law (``ZERO``, ``CONSTANT`` or ``PYTHON``) and,
               for ``PYTHON``, the function's slot in :mod:`tumble._callback`
-    torque  : (n,) the constant joint torques of ``CONSTANT`` (N·m or N)
+    torque  : (dof,) the constant joint torques of ``CONSTANT`` (N·m or N)
     """
 
     params: np.ndarray
+    sizes: np.ndarray
     gravity: np.ndarray
     law: np.ndarray
     torque: np.ndarray
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side (joint coordinates, no attitude)."""
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side (and a projection)."""
         return frozenset({"rhs"})
 
     @property
@@ -63,13 +69,13 @@ class RobotModel(NamedTuple):
 
 
 def initial_states(q0: np.ndarray, qd0: np.ndarray) -> np.ndarray:
-    """The states ``[q, q̇, W = 0]`` (N, 2n + 1) from joint coordinates and rates (N, n)."""
+    """The states ``[q, q̇, W = 0]`` (N, nq + nv + 1) from configurations (N, nq) and velocities (N, nv)."""
     return np.concatenate([q0, qd0, np.zeros((q0.shape[0], 1))], axis=1)
 
 
-def split(states: np.ndarray, dof: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(q, q̇, W)`` of states (..., 2n + 1): views (..., n), (..., n) and (...)."""
-    return states[..., :dof], states[..., dof:2 * dof], states[..., 2 * dof]
+def split(states: np.ndarray, nq: int, nv: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(q, q̇, W)`` of states (..., nq + nv + 1): views (..., nq), (..., nv) and (...)."""
+    return states[..., :nq], states[..., nq:nq + nv], states[..., nq + nv]
 
 
 @njit(cache=True)
@@ -96,25 +102,41 @@ def sample_torques(model, t, Q, QD, TAU):
 
 @njit(cache=True)
 def _derivative(model, t, y, ydot):
-    """``ẏ = [q̇, FD(q, q̇, τ), τ · q̇]`` of one state vector ``y = [q, q̇, W]``.
+    """``ẏ = [q̇ (configuration rates), FD(q, q̇, τ), τ · q̇]`` of one state vector ``y = [q, q̇, W]``.
 
     ``q`` and ``q̇`` are copied out of ``y`` (which may be a lane of a block)
-    so that the articulated-body algorithm always sees contiguous arrays: one
-    compiled version of it serves every call.
+    so that the forward dynamics always sees contiguous arrays: one compiled
+    version of it serves every call.
     """
-    n = model.params.shape[0]
-    W, X, T = _featherstone.aba_scratch(n)
-    q, qd = y[:n].copy(), y[n:2 * n].copy()
-    tau, qdd = np.empty(n), np.empty(n)
-    joint_torque(model, t, q, qd, tau)
-    _featherstone.aba_one(model.params, q, qd, tau, model.gravity, np.zeros(6), W, X, T, qdd)
+    nq, nv = model.sizes[0], model.sizes[1]
+    fl = nq - nv
+    P = model.params
+    W, X, T, M, zero = _featherstone.fd_scratch(P.shape[0], nv)
+    q, qd = y[:nq].copy(), y[nq:nq + nv].copy()
+    tau, qdd = np.zeros(nv), np.empty(nv)
+    joint_torque(model, t, q, qd, tau[6 * fl:])
+    _featherstone.forward_one(P, q, qd, tau, model.gravity, np.zeros(6), W, X, T, M, zero, qdd)
     power = 0.0
-    for i in range(n):
-        ydot[i] = qd[i]
-        ydot[n + i] = qdd[i]
+    for i in range(nv):
+        ydot[nq + i] = qdd[i]
         power += tau[i] * qd[i]
-    ydot[2 * n] = power
+    for i in range(6 * fl, nv):
+        ydot[i + fl] = qd[i]
+    if fl == 1:  # ṙ = R(quat) v, quaṫ = ½ quat ⊗ [0, ω]
+        vx, vy, vz = qrotate(q[3], q[4], q[5], q[6], qd[3], qd[4], qd[5])
+        ydot[0], ydot[1], ydot[2] = vx, vy, vz
+        dw, dx, dy, dz = qmul(q[3], q[4], q[5], q[6], 0.0, qd[0], qd[1], qd[2])
+        ydot[3], ydot[4], ydot[5], ydot[6] = 0.5 * dw, 0.5 * dx, 0.5 * dy, 0.5 * dz
+    ydot[nq + nv] = power
 
+
+@njit(cache=True)
+def _normalise_base(model, y):
+    """Renormalise the floating base's quaternion ``y[3:7]`` (nothing on a fixed base)."""
+    if model.sizes[0] > model.sizes[1]:
+        n = qnorm(y[3], y[4], y[5], y[6])
+        for k in range(3, 7):
+            y[k] /= n
 
 
 @_protocol.implements(_protocol.rhs, RobotModel)
@@ -124,9 +146,16 @@ def _robot_rhs(model, b0, t, Y, OUT):
 
 @_protocol.implements(_protocol.project, RobotModel)
 def _robot_project(model, b0, t, Y):
-    return lambda model, b0, t, Y: None  # joint coordinates and work live in a vector space
+    if Y.ndim == 1:
+        return lambda model, b0, t, Y: _normalise_base(model, Y)
+
+    def impl(model, b0, t, Y):
+        for j in range(Y.shape[1]):
+            _normalise_base(model, Y[:, j])
+
+    return impl
 
 
 @_protocol.implements(_protocol.state_size, RobotModel)
 def _robot_state_size(model):
-    return lambda model: 2 * model.params.shape[0] + 1
+    return lambda model: model.sizes[0] + model.sizes[1] + 1

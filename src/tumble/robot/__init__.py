@@ -1,7 +1,9 @@
-"""Robot manipulators: serial chains from DH tables and URDF, inverse and forward dynamics, simulation.
+"""Robots: serial chains and kinematic trees from DH tables and URDF, fixed or floating base, dynamics, simulation.
 
-A :class:`SerialChain` is an immutable, validated model (built with
-:meth:`SerialChain.from_dh`, :meth:`SerialChain.from_urdf` or :func:`load`);
+A :class:`RobotTree` (kinematic tree, Featherstone's parent array; optional
+floating base, mimic joints and named frames) and its special case
+:class:`SerialChain` are immutable, validated models (built with
+:meth:`SerialChain.from_dh`, :meth:`RobotTree.from_urdf` or :func:`load`);
 joint states are plain arrays of shape (n,) or (B, n). The algorithms are
 compiled and batched::
 
@@ -27,10 +29,22 @@ from tumble.robot.dynamics import (
     potential_energy,
     rnea,
 )
-from tumble.robot.link import Link
+from tumble.robot.kinematics import (
+    center_of_mass,
+    centroidal_momentum,
+    centroidal_momentum_matrix,
+    frame_jacobian,
+    frame_pose,
+    frame_poses,
+)
+from tumble.robot.link import Frame, Link
+from tumble.robot.space import space_manipulator
+from tumble.robot.tree import RobotTree
 
 __all__ = [
-    "Link", "SerialChain", "load",
+    "Link", "Frame", "RobotTree", "SerialChain", "load", "space_manipulator",
+    "frame_poses", "frame_pose", "frame_jacobian", "center_of_mass", "centroidal_momentum_matrix",
+    "centroidal_momentum",
     "rnea", "gravity_torques", "coriolis", "mass_matrix", "forward_dynamics",
     "link_poses", "kinetic_energy", "potential_energy",
     "simulate",

@@ -26,16 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from tumble._inertia import as_shape, frozen, parallel_axis
+from tumble._inertia import as_shape
 from tumble._validate import ValidationError, as_array
-from tumble.kernels import featherstone as _kernels
-from tumble.robot.link import Link
-from tumble.robot.motion import ChainMotion
-from tumble.robot.urdf import links_from_urdf
+from tumble.robot.link import Frame, Link
+from tumble.robot.tree import DEFAULT_GRAVITY, RobotTree
+from tumble.robot.urdf import read_urdf
 
 __all__ = ["SerialChain", "load"]
-
-DEFAULT_GRAVITY = (0.0, 0.0, -9.81)
 
 
 def _rx(angle):
@@ -86,10 +83,11 @@ def _dh_link(row: Mapping, k: int, modified: bool, check_triangle: bool) -> Link
                 name=row.get("name", f"joint{k + 1}"), check_triangle=check_triangle)
 
 
-class SerialChain(ChainMotion):
-    """An immutable, validated serial chain of rigid links on a fixed base.
+class SerialChain(RobotTree):
+    """An immutable, validated serial chain of rigid links on a fixed base: the tree whose parents are
+    ``λ(i) = i − 1`` (:class:`~tumble.robot.RobotTree`).
 
-    ``SerialChain(links, *, gravity=(0, 0, -9.81), name=None)``
+    ``SerialChain(links, *, gravity=(0, 0, -9.81), name=None, frames=())``
 
     ``links`` is a sequence of :class:`Link` (base to tip); ``gravity`` is the
     gravitational acceleration in the base frame (m/s²), part of the model as
@@ -107,26 +105,16 @@ class SerialChain(ChainMotion):
     ``qd0`` the joint rates (rad/s or m/s, default 0).
     """
 
-    __slots__ = ("_links", "_gravity", "_name", "_params", "_lower", "_upper", "_no_wrench", "_no_wrenches",
-                 "_one_state")
+    __slots__ = ()
 
-    def __init__(self, links: Sequence[Link], *, gravity=DEFAULT_GRAVITY, name: str | None = None):
+    def __init__(self, links: Sequence[Link], *, gravity=DEFAULT_GRAVITY, name: str | None = None,
+                 frames: Sequence[Frame] = ()):
         links = tuple(links)
-        if not links:
-            raise ValidationError("links: a serial chain needs at least one link")
         for k, link in enumerate(links):
-            if not isinstance(link, Link):
-                raise ValidationError(f"links[{k}]: must be a tumble.robot.Link, got {type(link).__name__}")
-        set_ = object.__setattr__
-        set_(self, "_links", links)
-        set_(self, "_gravity", np.array(as_shape(gravity, "gravity", (3,))))
-        set_(self, "_name", name)
-        set_(self, "_params", _pack(links))
-        set_(self, "_lower", frozen([link.lower for link in links]))
-        set_(self, "_upper", frozen([link.upper for link in links]))
-        set_(self, "_no_wrench", np.zeros(6))
-        set_(self, "_no_wrenches", np.zeros((1, 6)))
-        set_(self, "_one_state", (len(links),))  # the shape of one joint array, for the fast path of a call
+            if isinstance(link, Link) and link.joint == "floating":
+                raise ValidationError(f"links[{k}].joint: a SerialChain has a fixed base; a floating base is a "
+                                      "RobotTree")
+        super().__init__(links, range(-1, len(links) - 1), gravity=gravity, name=name, frames=frames)
 
     # -- constructors ---------------------------------------------------------
 
@@ -154,34 +142,12 @@ class SerialChain(ChainMotion):
 
     @classmethod
     def from_urdf(cls, source, *, check_triangle: bool = True, gravity=DEFAULT_GRAVITY) -> SerialChain:
-        """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`."""
-        name, links = links_from_urdf(source, check_triangle=check_triangle)
-        return cls(links, gravity=gravity, name=name)
+        """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
-    # -- data -----------------------------------------------------------------
-
-    @property
-    def links(self) -> tuple[Link, ...]:
-        """The links, base to tip."""
-        return self._links
-
-    @property
-    def dof(self) -> int:
-        """Number of joints n."""
-        return len(self._links)
-
-    @property
-    def joint_names(self) -> tuple[str | None, ...]:
-        return tuple(link.name for link in self._links)
-
-    @property
-    def joint_types(self) -> tuple[str, ...]:
-        return tuple(link.joint for link in self._links)
-
-    @property
-    def gravity(self) -> np.ndarray:
-        """(3,) gravitational acceleration in the base frame, m/s² (a copy)."""
-        return self._gravity.copy()
+        Refused when the URDF describes a tree or has mimic joints (use :meth:`RobotTree.from_urdf`)."""
+        description = read_urdf(source, check_triangle=check_triangle)
+        description.require_serial()
+        return cls(description.links, gravity=gravity, name=description.name, frames=description.frames)
 
     def with_gravity(self, gravity) -> SerialChain:
         """The same chain under the gravitational acceleration ``gravity`` (3,), m/s², base frame.
@@ -189,74 +155,23 @@ class SerialChain(ChainMotion):
         E.g. ``chain.with_gravity((0, 0, -1.62))`` on the Moon, or ``(0, 0, 0)`` to see the
         arm's motion without gravity.
         """
-        return SerialChain(self._links, gravity=gravity, name=self._name)
-
-    @property
-    def name(self) -> str | None:
-        return self._name
-
-    @property
-    def lower(self) -> np.ndarray:
-        """(n,) lower joint limits (rad or m; -inf when unlimited), read-only."""
-        return self._lower
-
-    @property
-    def upper(self) -> np.ndarray:
-        """(n,) upper joint limits (rad or m; +inf when unlimited), read-only."""
-        return self._upper
-
-    @property
-    def params(self) -> np.ndarray:
-        """(n, 42) array the compiled algorithms read (layout in :mod:`tumble.kernels.featherstone`), a copy."""
-        return self._params.copy()
-
-    def within_limits(self, q) -> np.ndarray | bool:
-        """True where ``lower ≤ q ≤ upper`` for every joint; ``q`` of shape (…, n)."""
-        q = as_array(q, "q", tail=(self.dof,))
-        ok = ((q >= self._lower) & (q <= self._upper)).all(axis=-1)
-        return bool(ok) if ok.ndim == 0 else ok
-
-    def __setattr__(self, name, value):
-        raise AttributeError(f"SerialChain is immutable: cannot set {name!r}")
+        return SerialChain(self._links, gravity=gravity, name=self._name, frames=self._frames)
 
     def __repr__(self):
         joints = "".join("R" if j == "revolute" else "P" for j in self.joint_types)
         name = "" if self._name is None else f"{self._name!r}, "
-        return f"SerialChain({name}{self.dof} joints {joints}, mass={sum(l.mass for l in self._links):.6g} kg)"
-
-
-def _pack(links: tuple[Link, ...]) -> np.ndarray:
-    """The (n, 42) parameter array of :mod:`._kernels`, in canonical frames.
-
-    The link frame's offset (R_f, p_f) of link i−1 is folded into the joint
-    origin of joint i, and link i's mass properties are moved from its link
-    frame to the canonical frame (origin on joint i's axis):
-    ``c' = R_f c + p_f``, ``I_c' = R_f I_c R_fᵀ``, ``I_O = I_c' + m(|c'|² E − c'c'ᵀ)``.
-    """
-    P = np.zeros((len(links), _kernels.PARAMS))
-    prev_R, prev_p = np.eye(3), np.zeros(3)
-    for i, link in enumerate(links):
-        P[i, 0:9] = (prev_R @ link.origin_rotation).ravel()
-        P[i, 9:12] = prev_p + prev_R @ link.origin_position
-        P[i, 12:15] = link.axis
-        P[i, 15] = _kernels.REVOLUTE if link.joint == "revolute" else _kernels.PRISMATIC
-        P[i, 16] = link.offset
-        Rf, pf = link.frame_rotation, link.frame_position
-        com = Rf @ link.com + pf
-        P[i, 17] = link.mass
-        P[i, 18:21] = link.mass * com
-        P[i, 21:30] = (Rf @ link.inertia @ Rf.T + parallel_axis(link.mass, com)).ravel()
-        P[i, 30:39] = Rf.ravel()
-        P[i, 39:42] = pf
-        prev_R, prev_p = Rf, pf
-    return P
+        return f"SerialChain({name}{self.dof} joints {joints}, mass={self.mass:.6g} kg)"
 
 
 _TOML_KEYS = {"name", "convention", "gravity", "check_triangle", "source", "link"}
 
 
-def load(path) -> SerialChain:
-    """A chain from a robot file: a DH table in TOML (``.toml``) or a URDF (``.urdf``, ``.xml``).
+def load(path) -> RobotTree:
+    """A robot from a robot file: a DH table in TOML (``.toml``) or a URDF (``.urdf``, ``.xml``).
+
+    A URDF gives a :class:`SerialChain` when it describes a serial chain
+    without mimic joints, else a :class:`~tumble.robot.RobotTree`
+    (:func:`tumble.robot.urdf.read_urdf`).
 
     The TOML file holds ``convention`` (``"standard"`` or ``"modified"``),
     optional ``name``, ``gravity``, ``check_triangle`` and ``source`` (a
@@ -265,7 +180,10 @@ def load(path) -> SerialChain:
     """
     path = Path(path)
     if path.suffix.lower() in (".urdf", ".xml"):
-        return SerialChain.from_urdf(path)
+        d = read_urdf(path)
+        if d.serial:
+            return SerialChain(d.links, name=d.name, frames=d.frames)
+        return RobotTree(d.links, d.parents, name=d.name, frames=d.frames, mimic=d.mimic)
     if path.suffix.lower() != ".toml":
         raise ValidationError(f"robot file: must end in .toml (DH table) or .urdf/.xml, got {path.name!r}")
     try:

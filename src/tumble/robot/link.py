@@ -26,17 +26,28 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from tumble._inertia import as_rotation, as_shape, frozen, principal_axes
 from tumble._validate import ValidationError
 
-__all__ = ["JOINT_TYPES", "Link"]
+__all__ = ["JOINT_TYPES", "Frame", "Link"]
 
-JOINT_TYPES = ("revolute", "prismatic")
+JOINT_TYPES = ("revolute", "prismatic", "floating")  # "floating": the free base of a RobotTree only
 # A joint axis is normalised; one shorter than this (m or 1) is refused as undefined.
 _MIN_AXIS_NORM = 1e-9
+
+
+class Frame(NamedTuple):
+    """A named frame fixed to body ``body`` (−1: the base): ``rotation`` (3, 3) maps frame axes to the body's link
+    axes, ``position`` (3,) is its origin in the link frame (m)."""
+
+    name: str
+    body: int
+    rotation: np.ndarray
+    position: np.ndarray
 
 
 @dataclass(frozen=True, slots=True, eq=False, kw_only=True)

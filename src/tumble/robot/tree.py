@@ -1,0 +1,302 @@
+"""Kinematic trees: bodies joined by revolute and prismatic joints, on a fixed or a floating base.
+
+Conventions (``docs/robot.md``): SI units (m, rad, kg, kg·m²). A tree is
+given in Featherstone's form (*Rigid Body Dynamics Algorithms*, Springer
+2008, §4.1.2): a list of :class:`~tumble.robot.Link` (one joint and the body
+it moves) and a parent array ``parents[i] < i`` (−1: the fixed base). The
+frames of link i are those of :mod:`tumble.robot.link` with "previous link"
+read as "parent link": link frame i = link frame λ(i) · (R_o, p_o) · joint(q_i)
+· (R_f, p_f).
+
+*Floating base*: ``links[0]`` with ``joint="floating"`` is a body free in
+space (a legged robot in flight, a spacecraft hub). The configuration is
+``q = [r (3), quat (4), joints]``: ``r`` the base origin in the world frame
+(m), ``quat`` the unit quaternion ``[w, x, y, z]`` of base → world (tumble's
+convention); the velocity ``q̇ = [ω (3), v (3), joint rates]``: the base's
+angular velocity and the velocity of its origin, both in *base* axes (the
+spatial velocity of Featherstone, angular part first). ``τ[0:6]`` is the
+wrench ``(n, f)`` on the base, base axes, moment about its origin.
+
+*Mimic joints* (``mimic={i: (j, multiplier, offset)}``) copy the coordinate of
+joint j: ``θ_i = multiplier · q_j + offset``. They have no coordinate of their
+own, so ``q`` holds the independent coordinates only; the algorithms return
+``Gᵀ τ`` and ``Gᵀ M G`` (``θ = G q + offset``), as Pinocchio does.
+
+*Frames*: named frames fixed to a body (URDF links merged by fixed joints,
+massless ``base``/``flange``/``tool0``/sensor links): ``Frame(name, body,
+rotation, position)``, the pose in the body's link frame (``body = −1``: the
+base/world frame). :func:`tumble.robot.frame_poses` and
+:func:`tumble.robot.frame_jacobian` use them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+import numpy as np
+
+from tumble._inertia import as_rotation, as_shape, frozen, parallel_axis
+from tumble._validate import ValidationError, as_array
+from tumble.kernels import featherstone as _kernels
+from tumble.robot.link import Frame, Link
+from tumble.robot.motion import ChainMotion
+from tumble.robot.urdf import read_urdf
+
+__all__ = ["Frame", "RobotTree", "DEFAULT_GRAVITY"]
+
+DEFAULT_GRAVITY = (0.0, 0.0, -9.81)
+
+
+class RobotTree(ChainMotion):
+    """An immutable, validated kinematic tree of rigid links on a fixed or a floating base.
+
+    ``RobotTree(links, parents, *, gravity=(0, 0, -9.81), name=None, frames=(), mimic=None)``
+
+    ``links``: :class:`Link` in topological order (parents first); ``parents``:
+    ``parents[i] < i`` the parent link of link i, −1 for the fixed base; a
+    ``links[0]`` with ``joint="floating"`` is a floating base (then every other
+    link descends from it). ``gravity``: m/s², world (base) frame. ``frames``:
+    :class:`Frame` values; ``mimic``: ``{link index: (copied link index,
+    multiplier, offset)}``. Sizes: ``nq`` configuration coordinates, ``nv``
+    velocity coordinates (``nq = nv + 1`` with a floating base).
+    A tree is a model of :func:`tumble.simulate` (:mod:`tumble.robot.motion`).
+    """
+
+    __slots__ = ("_links", "_parents", "_gravity", "_name", "_frames", "_mimic", "_params", "_lower", "_upper",
+                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links")
+
+    def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity=DEFAULT_GRAVITY,
+                 name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None):
+        links = tuple(links)
+        if not links:
+            raise ValidationError("links: a robot needs at least one link")
+        for k, link in enumerate(links):
+            if not isinstance(link, Link):
+                raise ValidationError(f"links[{k}]: must be a tumble.robot.Link, got {type(link).__name__}")
+        parents = tuple(int(p) for p in parents)
+        if len(parents) != len(links):
+            raise ValidationError(f"parents: must give one parent per link ({len(links)}), got {len(parents)}")
+        floating = links[0].joint == "floating"
+        for i, p in enumerate(parents):
+            if not -1 <= p < i:
+                raise ValidationError(f"parents[{i}]: must be -1 (the base) or a link before it (< {i}), got {p}")
+            if i > 0 and links[i].joint == "floating":
+                raise ValidationError(f"links[{i}].joint: only links[0] may be 'floating' (the floating base)")
+            if floating and i > 0 and p < 0:
+                raise ValidationError(f"parents[{i}]: with a floating base every link descends from links[0]")
+        mimic = dict(mimic or {})
+        coordinate, multiplier, offset = _coordinates(links, mimic, floating)
+        set_ = object.__setattr__
+        set_(self, "_links", links)
+        set_(self, "_parents", parents)
+        set_(self, "_gravity", np.array(as_shape(gravity, "gravity", (3,))))
+        set_(self, "_name", name)
+        set_(self, "_frames", tuple(_frame(f, len(links)) for f in frames))
+        set_(self, "_mimic", mimic)
+        set_(self, "_floating", floating)
+        set_(self, "_params", _pack(links, parents, coordinate, multiplier, offset))
+        independent = [i for i in range(len(links)) if i not in mimic and not (floating and i == 0)]
+        set_(self, "_coordinate_links", tuple(independent))
+        set_(self, "_lower", frozen([links[i].lower for i in independent]))
+        set_(self, "_upper", frozen([links[i].upper for i in independent]))
+        set_(self, "_no_wrench", np.zeros(6))
+        set_(self, "_no_wrenches", np.zeros((1, 6)))
+        nv = len(independent) + 6 * floating
+        set_(self, "_nv", nv)
+        set_(self, "_nq", nv + floating)
+
+    @classmethod
+    def from_urdf(cls, source, *, floating_base: bool = False, mimic: bool = True, check_triangle: bool = True,
+                  gravity=DEFAULT_GRAVITY) -> RobotTree:
+        """A tree from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
+
+        ``floating_base=True`` makes the root link a free body (configuration ``[r, quat, joints]``);
+        ``mimic=False`` reads ``<mimic>`` joints as independent joints."""
+        d = read_urdf(source, check_triangle=check_triangle, floating_base=floating_base, mimic=mimic)
+        return cls(d.links, d.parents, gravity=gravity, name=d.name, frames=d.frames, mimic=d.mimic)
+
+    # -- data -----------------------------------------------------------------
+
+    @property
+    def links(self) -> tuple[Link, ...]:
+        """The links, parents first."""
+        return self._links
+
+    @property
+    def parents(self) -> tuple[int, ...]:
+        """``parents[i]``: the parent link of link i (−1: the fixed base or, for the floating base, the world)."""
+        return self._parents
+
+    @property
+    def floating_base(self) -> bool:
+        """True when ``links[0]`` is a floating base."""
+        return self._floating
+
+    @property
+    def nq(self) -> int:
+        """Number of configuration coordinates (7 + joints with a floating base)."""
+        return self._nq
+
+    @property
+    def nv(self) -> int:
+        """Number of velocity coordinates (6 + joints with a floating base)."""
+        return self._nv
+
+    @property
+    def dof(self) -> int:
+        """Number of independent joint coordinates (mimic joints and the floating base excluded)."""
+        return len(self._coordinate_links)
+
+    @property
+    def joint_names(self) -> tuple[str | None, ...]:
+        """Names of the independent joints (one per joint coordinate)."""
+        return tuple(self._links[i].name for i in self._coordinate_links)
+
+    @property
+    def joint_types(self) -> tuple[str, ...]:
+        return tuple(self._links[i].joint for i in self._coordinate_links)
+
+    @property
+    def frames(self) -> tuple[Frame, ...]:
+        """The named frames (URDF links, merged and massless ones included)."""
+        return self._frames
+
+    @property
+    def frame_names(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self._frames)
+
+    @property
+    def mimic(self) -> dict:
+        """``{link: (copied link, multiplier, offset)}`` (a copy)."""
+        return dict(self._mimic)
+
+    @property
+    def gravity(self) -> np.ndarray:
+        """(3,) gravitational acceleration in the world (base) frame, m/s² (a copy)."""
+        return self._gravity.copy()
+
+    @property
+    def name(self) -> str | None:
+        return self._name
+
+    @property
+    def mass(self) -> float:
+        """Total mass, kg."""
+        return float(sum(link.mass for link in self._links))
+
+    @property
+    def lower(self) -> np.ndarray:
+        """(dof,) lower joint limits (rad or m; -inf when unlimited), read-only."""
+        return self._lower
+
+    @property
+    def upper(self) -> np.ndarray:
+        """(dof,) upper joint limits (rad or m; +inf when unlimited), read-only."""
+        return self._upper
+
+    @property
+    def params(self) -> np.ndarray:
+        """(nb, 45) array the compiled algorithms read (layout in :mod:`tumble.kernels.featherstone`), a copy."""
+        return self._params.copy()
+
+    def joint_coordinates(self, q) -> np.ndarray:
+        """The joint part ``q[..., nq − dof:]`` of configurations (…, nq) (the floating base's 7 dropped)."""
+        q = as_array(q, "q", tail=(self._nq,))
+        return q[..., self._nq - self.dof:]
+
+    def within_limits(self, q) -> np.ndarray | bool:
+        """True where ``lower ≤ q ≤ upper`` for every joint; ``q`` of shape (…, nq)."""
+        joints = self.joint_coordinates(q)
+        ok = ((joints >= self._lower) & (joints <= self._upper)).all(axis=-1)
+        return bool(ok) if ok.ndim == 0 else ok
+
+    def with_gravity(self, gravity) -> RobotTree:
+        """The same robot under the gravitational acceleration ``gravity`` (3,), m/s², world frame."""
+        return RobotTree(self._links, self._parents, gravity=gravity, name=self._name, frames=self._frames,
+                         mimic=self._mimic)
+
+    def neutral(self) -> np.ndarray:
+        """(nq,) the zero configuration (identity quaternion for a floating base)."""
+        q = np.zeros(self._nq)
+        if self._floating:
+            q[3] = 1.0
+        return q
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"{type(self).__name__} is immutable: cannot set {name!r}")
+
+    def __repr__(self):
+        name = "" if self._name is None else f"{self._name!r}, "
+        base = "floating base, " if self._floating else ""
+        return (f"{type(self).__name__}({name}{base}{len(self._links)} links, {self.dof} joint coordinates, "
+                f"mass={self.mass:.6g} kg)")
+
+
+def _frame(frame, nb: int) -> Frame:
+    if not isinstance(frame, Frame):
+        raise ValidationError(f"frames: must be tumble.robot.Frame values, got {type(frame).__name__}")
+    if not -1 <= frame.body < nb:
+        raise ValidationError(f"frame {frame.name!r}: body must be -1 (the base) or a link index < {nb}, "
+                              f"got {frame.body}")
+    return Frame(str(frame.name), int(frame.body), frozen(as_rotation(frame.rotation, f"frame {frame.name!r}")),
+                 frozen(as_shape(frame.position, f"frame {frame.name!r}.position", (3,))))
+
+
+def _coordinates(links, mimic: dict, floating: bool):
+    """Velocity index, multiplier and offset of every link's joint variable ``θ_i = k q[c] + offset``."""
+    coordinate, multiplier, offset = [], [], []
+    index = 6 if floating else 0
+    for i, link in enumerate(links):
+        if floating and i == 0:
+            coordinate.append(0), multiplier.append(1.0), offset.append(0.0)
+        elif i in mimic:
+            coordinate.append(-1), multiplier.append(1.0), offset.append(link.offset)
+        else:
+            coordinate.append(index), multiplier.append(1.0), offset.append(link.offset)
+            index += 1
+    for i, spec in mimic.items():
+        where = f"mimic[{i}]"
+        try:
+            j, k, o = spec
+            j, k, o = int(j), float(k), float(o)
+        except (TypeError, ValueError):
+            raise ValidationError(f"{where}: must be (copied link index, multiplier, offset), got {spec!r}") from None
+        if not (0 <= i < len(links)) or not (0 <= j < len(links)) or j in mimic or (floating and 0 in (i, j)):
+            raise ValidationError(f"{where}: must copy an independent joint (a link index not itself a mimic "
+                                  f"joint nor the floating base), got link {i} copying {j}")
+        if not (math.isfinite(k) and math.isfinite(o)):
+            raise ValidationError(f"{where}: multiplier and offset must be finite, got {k} and {o}")
+        coordinate[i], multiplier[i], offset[i] = coordinate[j], k, offset[i] + o
+    return coordinate, multiplier, offset
+
+
+def _pack(links, parents, coordinate, multiplier, offset) -> np.ndarray:
+    """The (nb, 45) parameter array of :mod:`._kernels`, in canonical frames.
+
+    The link frame's offset (R_f, p_f) of link λ(i) is folded into the joint
+    origin of joint i, and link i's mass properties are moved from its link
+    frame to the canonical frame (origin on joint i's axis):
+    ``c' = R_f c + p_f``, ``I_c' = R_f I_c R_fᵀ``, ``I_O = I_c' + m(|c'|² E − c'c'ᵀ)``.
+    """
+    P = np.zeros((len(links), _kernels.PARAMS))
+    kinds = {"revolute": _kernels.REVOLUTE, "prismatic": _kernels.PRISMATIC, "floating": _kernels.FREE}
+    for i, link in enumerate(links):
+        par = parents[i]
+        prev_R, prev_p = (np.eye(3), np.zeros(3)) if par < 0 else (links[par].frame_rotation,
+                                                                  links[par].frame_position)
+        P[i, 0:9] = (prev_R @ link.origin_rotation).ravel()
+        P[i, 9:12] = prev_p + prev_R @ link.origin_position
+        P[i, 12:15] = link.axis
+        P[i, 15] = kinds[link.joint]
+        P[i, 16] = offset[i]
+        Rf, pf = link.frame_rotation, link.frame_position
+        com = Rf @ link.com + pf
+        P[i, 17] = link.mass
+        P[i, 18:21] = link.mass * com
+        P[i, 21:30] = (Rf @ link.inertia @ Rf.T + parallel_axis(link.mass, com)).ravel()
+        P[i, 30:39] = Rf.ravel()
+        P[i, 39:42] = pf
+        P[i, 42] = par
+        P[i, 43] = coordinate[i]
+        P[i, 44] = multiplier[i]
+    return P
