@@ -212,6 +212,20 @@ def test_settling_and_crossing_times():
     np.testing.assert_array_equal(Max(x, after=1.0)(traj), [2.0, 0.0, 4.0])
 
 
+def test_outcome_percentiles_are_over_the_samples_where_the_event_happened():
+    # omega_z crosses 1.0 rad/s only in the samples started above it (no torque: omega_z oscillates about its
+    # start by the small transverse rates): the others have no crossing time (NaN); the percentiles are
+    # those of the samples with a value, and the count says how many
+    crossing = tumble.sweep.CrossingTime(tumble.sweep.Component("omega", 2), above=1.0)
+    ds = tumble.sweep(BODY, DISPERSIONS, samples=N, seed=5, t=T, **RK4, workers=0,
+                      outcomes={"crossing": crossing})
+    values = ds.crossing.values
+    reached = ~np.isnan(values)
+    assert 0 < reached.sum() < N and int(ds.crossing_count) == reached.sum()
+    np.testing.assert_array_equal(ds.crossing_percentiles.values,
+                                  np.percentile(values[reached], ds.percentile.values))
+
+
 def test_a_model_built_per_sample_runs_member_by_member(tmp_path):
     # a spacecraft with a dispersed damper: no batched form, so one simulate per sample inside the chunk
     from tumble.spacecraft import Spacecraft, SphericalDamper

@@ -13,7 +13,8 @@ each series                 (sample, time)           one value per sample and ou
 ``done``                    (chunk,)                 True once the chunk's results are written
 ``NAME_mean`` ... ``_max``  (time,)                  per-time mean, std (ddof 0), min, max of a series
 ``NAME_percentiles``        (percentile, time)       per-time percentiles of a series
-``OUTCOME_percentiles``     (percentile, ...)        percentiles of an outcome over the samples
+``OUTCOME_percentiles``     (percentile, ...)        percentiles of an outcome over the samples with a value
+``OUTCOME_count``           (...)                    the samples with a value (not NaN)
 ==========================  =======================  ==========================================
 
 The store's arrays are chunked along ``sample`` exactly as the sweep is, so a
@@ -32,6 +33,11 @@ The per-time statistics merge the chunks' moments in chunk order with
 so they are the same bit for bit whatever the number of workers or the order
 in which chunks finished; the percentiles are exact (``numpy.percentile``,
 linear interpolation), read from the stored series in blocks of output times.
+An outcome is NaN where its event did not happen within the run (a
+:class:`~tumble.sweep.CrossingTime` never crossed, a
+:class:`~tumble.sweep.SettlingTime` not settled at the end): its percentiles
+are those of the samples with a value (``numpy.nanpercentile``; NaN when none
+has one), and ``OUTCOME_count`` says how many of the samples that is.
 """
 
 from __future__ import annotations
@@ -39,6 +45,7 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+import warnings
 
 import numpy as np
 
@@ -197,8 +204,11 @@ class SweepStore:
             data[f"{name}_percentiles"] = ("percentile", "time"), np.concatenate(bands, axis=1)
         for name in plan.outcomes:
             values = group[name][:]
-            dims = ("percentile",) + tuple(f"{name}_dim{k}" for k in range(values.ndim - 1))
-            data[f"{name}_percentiles"] = dims, np.percentile(values, p, axis=0)
+            dims = tuple(f"{name}_dim{k}" for k in range(values.ndim - 1))
+            with warnings.catch_warnings():  # an outcome no sample reached: NaN percentiles, said by its count
+                warnings.simplefilter("ignore", RuntimeWarning)
+                data[f"{name}_percentiles"] = ("percentile", *dims), np.nanpercentile(values, p, axis=0)
+            data[f"{name}_count"] = dims, np.count_nonzero(~np.isnan(values), axis=0)
         ds = xr.Dataset(data, coords={"percentile": p})
         ds.to_zarr(self._memory if self.path is None else self.path, mode="a", consolidated=False, zarr_format=3)
         group.attrs[COMPLETE_ATTR] = True
