@@ -125,3 +125,15 @@ def test_the_warning_states_the_size_of_the_neglected_correction():
     with pytest.warns(limits.RigidityWarning, match=r"energy by at least 7\.5e-05 and the angular momentum by "
                                                    r"at least 5e-05"):
         limits.check_rigid_motion(sphere.moments, [0.0, 0.0, rate], sphere.mass)
+
+
+def test_neutron_star_demo(tmp_path):
+    from tumble.lorentz import NEUTRON_STAR, demo_lorentz
+
+    summary = demo_lorentz(tmp_path)
+    omega = 2.0 * math.pi / 1.4e-3
+    assert summary["rim_speed"] == pytest.approx(omega * 12e3 / C, rel=1e-15)  # 0.1796 c
+    sphere = SpinningMatter("sphere", NEUTRON_STAR["mass"], 12e3)
+    assert summary["sphere"]["moment"] == pytest.approx(sphere.quadrature("moment", omega) / sphere.newtonian_moment
+                                                        - 1.0, rel=1e-10)  # a 0.94 % correction, to 1e-12 of I
+    assert (tmp_path / "lorentz.png").stat().st_size > 10_000
