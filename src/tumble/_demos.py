@@ -174,4 +174,18 @@ DEMOS: dict[str, Demo] = {
             ("libration", f"largest roll/pitch/yaw angle {s['max_angle_deg']:.3g} deg"),
         ],
     ),
+    "lorentz": Demo(
+        "tumble.lorentz:demo_lorentz",
+        """Lorentz-factor inertia of a neutron star (R = 12 km, M = 1.4 Msun, period 1.4 ms).
+
+        Incoherent matter in rigid rotation, special relativity only (not Born-rigid, no gravity:
+        docs/limits.md): the corrections to I, L and T that the Newtonian model neglects, for the star
+        as a uniform sphere, a shell and a ring. Writes lorentz.png (I/I0 against the rim speed).
+        """,
+        lambda s: [
+            ("rim", f"omega = {s['omega']:.6g} rad/s, rim speed {s['rim_speed']:.4f} c"),
+            *[(shape, f"I and L {s[shape]['moment']:+.3%}, kinetic energy {s[shape]['energy']:+.3%} "
+                      "against Newton") for shape in ("sphere", "shell", "ring")],
+        ],
+    ),
 }

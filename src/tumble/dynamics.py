@@ -18,6 +18,15 @@ Kinematics::
 
     q̇ = ½ q ⊗ [0, ω]
 
+Frame form for an axisymmetric body (transverse moment ``I_t``, axial moment
+``I_s`` about the symmetry axis ``e₃``), in principal axes F that turn at
+``ω_F = (ω₁, ω₂, Ω₃)``: the body rate and ω_F differ only about ``e₃``
+(:func:`euler_frame`)::
+
+    I_t ω̇₁ = N₁ − (I_s ω₃ − I_t Ω₃) ω₂
+    I_t ω̇₂ = N₂ + (I_s ω₃ − I_t Ω₃) ω₁
+    I_s ω̇₃ = N₃
+
 Invariants: kinetic energy ``T = ½ ω·(I ω)``, angular momentum ``L_B = I ω``
 (body axes) and ``L_N = R(q) I ω`` (inertial axes). Without torque, ``T``,
 ``|L|`` and ``L_N`` are constant.
@@ -39,6 +48,7 @@ from tumble.attitude import rotate
 __all__ = [
     "omega_dot",
     "omega_dot_principal",
+    "omega_dot_frame",
     "quaternion_rate",
     "kinetic_energy",
     "angular_momentum",
@@ -131,6 +141,59 @@ def omega_dot_principal(moments, omega, torque=None) -> np.ndarray:
         out.reshape(-1, 3),
     )
     return out
+
+
+@register_jitable
+def euler_frame(ratio, r_t, r_s, w1, w2, w3, frame3, n1, n2, n3):
+    """Euler's equations of an axisymmetric body in a principal frame F turning at ``(ω₁, ω₂, Ω₃)``.
+
+    The body rate is ``ω = ω₁e₁ + ω₂e₂ + ω₃e₃`` and the frame's rate
+    ``ω_F = ω₁e₁ + ω₂e₂ + Ω₃e₃`` (``Ω₃ = frame3``): they differ only about the
+    symmetry axis ``e₃``, so F stays principal. With ``L = I_t(ω₁e₁ + ω₂e₂) + I_s ω₃ e₃``,
+    ``dL/dt|_F + ω_F × L = N`` reads in components::
+
+        I_t ω̇₁ = N₁ − (I_s ω₃ − I_t Ω₃) ω₂
+        I_t ω̇₂ = N₂ + (I_s ω₃ − I_t Ω₃) ω₁
+        I_s ω̇₃ = N₃
+
+    ``Ω₃ = ω₃`` (F fixed in the body) gives the principal-axes Euler equations
+    with ``I₁ = I₂ = I_t``; ``Ω₃ = 0`` is the non-spinning (Resal) frame of
+    gyroscope and projectile analyses. Sources: the article "Euler's
+    equations (rigid body dynamics)" (Wikipedia: the equations hold in
+    principal axes not fixed to the body, with ω replaced by the axes' rate);
+    J. H. Ginsberg, *Advanced Engineering Dynamics*, 2nd ed., 1995, on the
+    equations of axisymmetric bodies in a non-body-fixed frame; R. L.
+    McCoy, *Modern Exterior Ballistics*, 1999, for the non-rolling frame of
+    spinning projectiles.
+
+    Arguments: ``ratio = I_s/I_t``, ``r_t = 1/I_t``, ``r_s = 1/I_s``
+    (1/(kg·m²)); rates in rad/s and torques ``N`` in N·m, all in F
+    components. Returns ``(ω̇₁, ω̇₂, ω̇₃)`` (rad/s², F components: the rates of
+    change of the components, i.e. ``dω/dt|_F``). Plain Python too (it works
+    on arrays), and compiled into callers.
+    """
+    gyro = ratio * w3 - frame3  # (I_s ω₃ − I_t Ω₃)/I_t, rad/s
+    return n1 * r_t - gyro * w2, n2 * r_t + gyro * w1, n3 * r_s
+
+
+def omega_dot_frame(moments, omega, frame_rate, torque=None) -> np.ndarray:
+    """Rates of change of the body-rate components in a principal frame F of an axisymmetric body (rad/s²).
+
+    ``moments`` (…, 2) are ``(I_t, I_s)``: the transverse and the axial
+    moment (kg·m²); ``omega`` (…, 3) the body rate in F components, with
+    ``e₃`` the symmetry axis (rad/s); ``frame_rate`` (…) the frame's rate
+    ``Ω₃`` about ``e₃`` (rad/s; the frame's transverse rate is the body's);
+    ``torque`` (…, 3) in F components (N·m). The equations are those of
+    :func:`euler_frame`.
+    """
+    moments = as_array(moments, "moments", tail=(2,))
+    omega = as_array(omega, "omega", tail=(3,))
+    frame_rate = as_array(frame_rate, "frame_rate")
+    torque = _torque(torque, omega)
+    i_t, i_s = moments[..., 0], moments[..., 1]
+    rates = euler_frame(i_s / i_t, 1.0 / i_t, 1.0 / i_s, omega[..., 0], omega[..., 1], omega[..., 2], frame_rate,
+                        torque[..., 0], torque[..., 1], torque[..., 2])
+    return np.stack(np.broadcast_arrays(*rates), axis=-1)
 
 
 @njit(cache=True)

@@ -14,7 +14,18 @@ stops describing a real body:
     order ``(v/c)²`` ≥ 1e-6, are ignored by the Newtonian model, and so is
     the finite speed at which stresses propagate. Special-relativistic rigid
     bodies do not exist (Born rigidity forbids setting a body spinning), so
-    the corrections are out of scope rather than an option.
+    the corrections are out of scope rather than an option. The warning
+    states their size (:func:`relativistic_corrections`): for incoherent
+    matter turning at ω, whatever its shape, the Newtonian kinetic energy
+    and angular momentum are low by at least
+
+        T/T₀ − 1 ≥ 2(γ − 1)/β² − 1 = (2γ + 1)(γ − 1)/(γ + 1) ≈ ¾ β²,    L·ω/(L₀·ω) − 1 ≥ γ − 1 ≈ ½ β²
+
+    with ``β = v_rms/c`` and ``γ = 1/√(1 − β²)``: Jensen's inequality for
+    ``(γ(v) − 1)c²`` and ``γ(v) v²``, convex functions of ``v²``, averaged
+    over the mass; equality for a thin ring, where every particle moves at
+    ``v_rms``. :mod:`tumble.lorentz` gives the exact figures of a ring, a
+    disk, a sphere and a spherical shell.
   - ``v_rms > 2 km/s``: no material holds together. The hoop stress of a
     spinning ring is ``σ = ρ v²``, and the best specific strengths
     ``σ/ρ`` (carbon-fibre composites, about 2–4 MJ/kg) give bursting speeds
@@ -38,7 +49,7 @@ import warnings
 
 import numpy as np
 
-__all__ = ["RigidityWarning", "check_rigid_motion", "SPEED_OF_LIGHT", "RELATIVISTIC_SPEED",
+__all__ = ["RigidityWarning", "check_rigid_motion", "relativistic_corrections", "SPEED_OF_LIGHT", "RELATIVISTIC_SPEED",
            "BURST_SPEED", "THIN_RATIO"]
 
 #: Speed of light in vacuum, m/s (exact, SI 2019).
@@ -53,6 +64,29 @@ THIN_RATIO = 1e-9
 
 class RigidityWarning(UserWarning):
     """The data are valid for a rigid body, but a real body would not behave like one (see :mod:`tumble.limits`)."""
+
+
+def relativistic_corrections(moments, omega, mass) -> dict[str, np.ndarray]:
+    """Lower bounds of the relative corrections the Newtonian model neglects, from the RMS particle speed.
+
+    moments : (..., 3) principal moments, kg·m²; omega : (..., 3) body rates in principal axes, rad/s;
+    mass : kg. With ``v_rms = √(ω·Iω/m)``, ``β = v_rms/c`` and ``γ = 1/√(1 − β²)`` (module docstring):
+
+    ``"speed"``    β (1); at or above 1 the bounds are ``inf``: no matter moves that fast
+    ``"energy"``   ``(2γ + 1)(γ − 1)/(γ + 1)``, at most ``T/T₀ − 1`` (kinetic energy, ≈ ¾ β²)
+    ``"momentum"`` ``γ − 1``, at most ``I(ω)/I₀ − 1`` along ω (angular momentum, ≈ ½ β²)
+
+    ``γ − 1 = β²γ²/(1 + γ)``: no cancellation at small speeds.
+    """
+    moments = np.asarray(moments, dtype=np.float64)
+    omega = np.asarray(omega, dtype=np.float64)
+    beta = np.sqrt(np.sum(moments * omega * omega, axis=-1) / mass) / SPEED_OF_LIGHT
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = np.minimum(beta * beta, 1.0)
+        gamma = 1.0 / np.sqrt(1.0 - k)
+        excess = np.where(k < 1.0, k * gamma * gamma / (1.0 + gamma), np.inf)
+        energy = np.where(k < 1.0, (2.0 * gamma + 1.0) * excess / (gamma + 1.0), np.inf)
+    return {"speed": beta, "energy": energy, "momentum": excess}
 
 
 def check_rigid_motion(moments, omega, mass=None, *, stacklevel: int = 2) -> None:
@@ -79,11 +113,15 @@ def check_rigid_motion(moments, omega, mass=None, *, stacklevel: int = 2) -> Non
         return
     speed = np.sqrt(np.sum(moments * omega * omega, axis=-1) / mass)  # √(ω·Iω/m), m/s
     if np.any(speed > RELATIVISTIC_SPEED):
+        worst = np.unravel_index(np.argmax(speed), speed.shape)
+        bounds = relativistic_corrections(moments, omega, mass)
         warnings.warn(RigidityWarning(
             f"omega: particles move at {speed.max():.3g} m/s or more (RMS about the centre of mass, "
             f"{speed.max() / SPEED_OF_LIGHT:.2g} c){_count(speed > RELATIVISTIC_SPEED)}: the rigid "
-            "model is Newtonian and ignores relativistic corrections of order (v/c)^2, and no material "
-            "holds together at such speeds (see tumble.limits)"), stacklevel=stacklevel)
+            "model is Newtonian and ignores relativistic corrections: the Lorentz factor of its particles raises the kinetic "
+            f"energy by at least {bounds['energy'][worst]:.2g} and the angular momentum by at least "
+            f"{bounds['momentum'][worst]:.2g} (relative; exact for a thin ring, tumble.lorentz for other shapes), "
+            "and no material holds together at such speeds (see tumble.limits)"), stacklevel=stacklevel)
     elif np.any(speed > BURST_SPEED):
         warnings.warn(RigidityWarning(
             f"omega: particles move at {speed.max():.3g} m/s or more (RMS about the centre of mass)"
