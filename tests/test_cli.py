@@ -314,3 +314,27 @@ def test_cli_does_not_import_back():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "False"
+
+
+# -- tumble warmup ------------------------------------------------------------------------------------
+
+
+def test_warmup_compiles_what_a_new_process_then_loads_from_the_cache():
+    env = {**os.environ, "PYTHONPATH": str(Path(tumble.__file__).parents[1])}
+    done = subprocess.run([sys.executable, "-m", "tumble", "warmup", "one body, rk4", "--quiet"], env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert re.match(r"compiled\s+1 paths in [\d.]+ s\ncache\s+", done.stdout), done.stdout
+    # a new process making the same call compiles nothing: Numba's cache log shows loads and no save
+    child = "from tumble._warmup import PATHS; PATHS['one body, rk4']()"
+    log = subprocess.run([sys.executable, "-c", child], env={**env, "NUMBA_DEBUG_CACHE": "1"},
+                         capture_output=True, text=True, timeout=600, check=True).stdout
+    assert "[cache] data loaded" in log and "[cache] data saved" not in log, log
+
+
+def test_warmup_refuses_an_unknown_path_and_lists_them():
+    result = invoke("warmup", "one body, rk5")
+    assert result.exit_code == 2
+    assert result.stderr.startswith("error: PATH: unknown 'one body, rk5'; the paths are 'demo racket', ")
+    listed = invoke("warmup", "--list").stdout.splitlines()
+    assert listed[0] == "demo racket" and "one body, exact" in listed and len(listed) == 13

@@ -9,11 +9,13 @@
     tumble sweep SCENARIO.toml -o out.zarr [--samples N] [--scheduler ADDR] [--workers N] [--plot out.png]
     tumble info out.nc | out.zarr
     tumble view out.nc -o out.html [--scenario SCENARIO.toml] [--frames 600] [--axis x]
+    tumble warmup [PATH ...] [--list]
     tumble --version
 
-Exit codes: 0 success; 2 bad input (a one-line message per problem on
-stderr, naming the file, the key and the rule; nothing is written); 1 any
-other failure (the integrator gave up, a file could not be written, a bug).
+Exit codes: 0 success; 2 an error (a one-line message per problem on
+stderr, naming the file, the key and the rule; nothing is written): bad
+input, the integrator giving up, a file that cannot be read or written; 1 a
+bug.
 Results are written atomically (:func:`tumble.trajectory.write_atomic`).
 Documented in ``docs/cli.md``.
 """
@@ -385,6 +387,44 @@ def view(
         model = None if scenario is None else scenarios.load(scenario).model
         write_html(path, output, model=model, frames=frames, axis=axis)
     _print_rows([("trajectory", str(path)), ("wrote", str(output))])
+
+@app.command()
+def warmup(
+    paths: Annotated[list[str] | None, typer.Argument(
+        help="Paths to compile, by name (default: all of them; --list shows them).", show_default=False)] = None,
+    list_paths: Annotated[bool, typer.Option("--list", help="List the paths and exit.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+) -> None:
+    """Compile the common paths into Numba's on-disk cache, so that a session's first simulation starts at once.
+
+    Each path (the quick-start demo, one body under every method, a batch, a heavy top) runs a simulation of
+    a few steps; the compiled code is cached beside tumble's source (or in NUMBA_CACHE_DIR), where every later
+    process loads it in milliseconds. Run it once after installing (it takes a minute or two).
+    """
+    import time
+
+    from numba.core import config
+
+    from tumble._warmup import PATHS
+
+    if list_paths:
+        typer.echo("\n".join(PATHS))
+        return
+    with _exit_codes():
+        unknown = [name for name in paths or () if name not in PATHS]
+        if unknown:
+            raise ValidationError(f"PATH: unknown {', '.join(map(repr, unknown))}; the paths are "
+                                  f"{', '.join(map(repr, PATHS))}")
+        chosen = list(paths or PATHS)
+        start = time.perf_counter()
+        with _progress_bar("compiling", enabled=not quiet, unit="paths") as progress:
+            for done, name in enumerate(chosen):
+                PATHS[name]()
+                if progress is not None:
+                    progress(done + 1, len(chosen))
+    where = config.CACHE_DIR or "__pycache__ beside tumble's source"
+    _print_rows([("compiled", f"{len(chosen)} paths in {time.perf_counter() - start:.1f} s"), ("cache", where)])
+
 
 def _info_store(path: Path) -> None:
     """``tumble info`` of a Zarr store: a sweep's samples and outcomes, or a streamed run's dimensions."""
