@@ -1,12 +1,16 @@
-"""Foundation benchmark: tumble's RK4 and DOP853 beside scipy's solve_ivp, in one run.
+"""Foundation benchmark: tumble's RK4 and DOP853 beside their peers, in one run (issue 17, goals 1-3).
 
-Prints, side by side:
+Prints, side by side, with the machine (CPU model, cores, load average), min / median over at least
+5 repeats, wall and CPU-time-based rates (``_timing``):
 
-1. single-body RK4 cost per step in the compiled loop (tumble) and in a
-   hand-written NumPy RK4 loop (what one would write without tumble);
-2. batch throughput, body-steps per second, N = 100 000 bodies on all cores;
-3. the adaptive method at the same tolerance as scipy's solve_ivp(DOP853):
-   wall time and maximum error against a tight scipy reference, and the ratios.
+1. single-body RK4, cost per step: tumble's compiled loop, a naive Numba loop and a NumPy loop;
+2. batch RK4, body-steps per second on all cores, one shared inertia and one inertia per body,
+   beside a hand-written C kernel (``rk4_reference.c``, all four stages fused in registers) built
+   here with ``gcc -O3 -march=native -fopenmp -fno-math-errno`` when gcc is present;
+3. the cost per body of set-up and output at N = 1e6 (a run of one step, less the kernel's share);
+4. the adaptive method against scipy's ``solve_ivp(DOP853)`` at equal error, end to end, with scipy
+   given a fair right-hand side (one preallocated-free expression returning one array), and the
+   fixed cost of one ``simulate`` call.
 
 Run by hand (not a test; timings vary with the machine)::
 
@@ -17,36 +21,40 @@ Run by hand (not a test; timings vary with the machine)::
 from __future__ import annotations
 
 import argparse
+import ctypes
 import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
 
 import numpy as np
+from numba import njit
 from scipy.integrate import solve_ivp
 
 import tumble
-from _timing import best_of
-from tumble.kernels import rigid as _rigid
+from _timing import fmt, machine, measure
 from tumble.integrate import _fixed, _rk4
+from tumble.kernels import rigid as _rigid
+from tumble.rigid import RigidBodies
 
 MOMENTS = np.array([1.0, 2.0, 3.0])          # kg m², principal axes = body axes
+C1, C2, C3 = (MOMENTS[1] - MOMENTS[2]) / MOMENTS[0], (MOMENTS[2] - MOMENTS[0]) / MOMENTS[1], \
+    (MOMENTS[0] - MOMENTS[1]) / MOMENTS[2]
 OMEGA0 = np.array([1e-3, 1.0, 1e-3])          # rad/s: near the intermediate axis (flips)
 # For the accuracy comparison, a motion far from the separatrix: near it, rounding
 # differences of 1e-16 grow to 1e-9 in 100 s, and no reference can tell methods apart.
 OMEGA0_ACCURACY = np.array([1.0, 0.2, 0.5])
 Q0 = np.array([1.0, 0.0, 0.0, 0.0])
+CORES = len(os.sched_getaffinity(0))
 
 
 def euler_rhs(t, y):
-    """Euler's equations + quaternion kinematics in NumPy, as a solve_ivp user would write them."""
-    q, w = y[:4], y[4:]
-    i1, i2, i3 = MOMENTS
-    wdot = np.array([(i2 - i3) * w[1] * w[2] / i1, (i3 - i1) * w[2] * w[0] / i2, (i1 - i2) * w[0] * w[1] / i3])
-    qdot = 0.5 * np.array([
-        -q[1] * w[0] - q[2] * w[1] - q[3] * w[2],
-        q[0] * w[0] + q[2] * w[2] - q[3] * w[1],
-        q[0] * w[1] - q[1] * w[2] + q[3] * w[0],
-        q[0] * w[2] + q[1] * w[1] - q[2] * w[0],
-    ])
-    return np.concatenate([qdot, wdot])
+    """Euler's equations + quaternion kinematics for solve_ivp: one array built from scalars (fair to scipy)."""
+    qw, qx, qy, qz, w1, w2, w3 = y
+    return np.array([0.5 * (-qx * w1 - qy * w2 - qz * w3), 0.5 * (qw * w1 + qy * w3 - qz * w2),
+                     0.5 * (qw * w2 - qx * w3 + qz * w1), 0.5 * (qw * w3 + qx * w2 - qy * w1),
+                     C1 * w2 * w3, C2 * w3 * w1, C3 * w1 * w2])
 
 
 def numpy_rk4(y, dt, steps):
@@ -62,78 +70,139 @@ def numpy_rk4(y, dt, steps):
     return y
 
 
-def single_body_rk4(steps):
+naive_rhs = njit(euler_rhs)
+
+
+@njit
+def naive_numba_rk4(y, dt, steps):
+    """The NumPy loop above under @njit, as a user would write it (the issue's 'naive Numba loop')."""
+    for k in range(steps):
+        t = k * dt
+        k1 = naive_rhs(t, y)
+        k2 = naive_rhs(t + dt / 2, y + dt / 2 * k1)
+        k3 = naive_rhs(t + dt / 2, y + dt / 2 * k2)
+        k4 = naive_rhs(t + dt, y + dt * k3)
+        y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        y[:4] /= np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2 + y[3] ** 2)
+    return y
+
+
+def single_body(steps):
+    """ns per step (CPU, min / median): tumble's one-body path, the naive Numba loop, NumPy."""
     model = _rigid.build([tumble.RigidBody(np.diag(MOMENTS))], None)
     y = np.concatenate([Q0, OMEGA0])[None, :]
     t = np.array([0.0, steps * 1e-3])
+    m, h = _fixed.landing_steps(t, 1e-3, 10**9)
     out, stats = np.empty((2, 1, 7)), np.zeros((1, 5))
-    # the engine's entry point for one body (tumble.integrate runs a lone body on its state vector)
-    _fixed.run_one(_rk4.SCHEME, model, y.copy(), t, 1e-3, out, stats)  # compile / load from cache
-
-    def run():
-        stats[:] = 0.0
-        _fixed.run_one(_rk4.SCHEME, model, y.copy(), t, 1e-3, out, stats)
-        return stats[0, 0]
-
-    seconds, n = best_of(5, run)
-    return seconds / n
+    run = lambda: _fixed.run_one(_rk4.SCHEME, model, y.copy(), t, m, h, out, stats)  # noqa: E731
+    run()  # compile / load from cache
+    naive_numba_rk4(y[0].copy(), 1e-3, 10)
+    ns = lambda timing, n: tuple(1e9 / r for r in timing.rates(n)["cpu"])  # noqa: E731
+    return {"tumble": ns(measure(run), steps),
+            "naive Numba": ns(measure(lambda: naive_numba_rk4(y[0].copy(), 1e-3, steps)), steps),
+            "NumPy": ns(measure(lambda: numpy_rk4(y[0].copy(), 1e-3, 2000)), 2000)}
 
 
-def batch_rk4(n_bodies, steps):
-    body = tumble.RigidBody(np.diag(MOMENTS))
+def c_reference():
+    """The C kernel's ``rk4_batch`` (ctypes), or None without gcc."""
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        return None
+    lib = Path(tempfile.mkdtemp()) / "rk4_reference.so"
+    subprocess.run([gcc, "-O3", "-march=native", "-fopenmp", "-fno-math-errno", "-shared", "-fPIC", "-o", str(lib),
+                    str(Path(__file__).with_name("rk4_reference.c"))], check=True)
+    f = ctypes.CDLL(str(lib)).rk4_batch
+    f.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_ssize_t, ctypes.c_double, ctypes.c_long]
+    return f
+
+
+def batch(n_bodies, steps, per_body, c_kernel):
+    """Body-steps per second (wall and CPU × cores, min / median): tumble.simulate and the C kernel."""
     rng = np.random.default_rng(1)
     omega0 = OMEGA0 + 1e-2 * rng.standard_normal((n_bodies, 3))
     t = np.array([0.0, steps * 1e-3])
-    tumble.simulate(body, omega0[:2], t=t, method="rk4", dt=1e-3)  # compile / load from cache
-    seconds, _ = best_of(3, lambda: tumble.simulate(body, omega0, t=t, method="rk4", dt=1e-3))
-    return n_bodies * steps / seconds
+    scale = 1.0 + 0.1 * rng.random(n_bodies) if per_body else np.ones(1)
+    model = RigidBodies.of(np.diag(MOMENTS) * scale[:, None, None]) if per_body else tumble.RigidBody(np.diag(MOMENTS))
+    tumble.simulate(model, omega0, t=t[:1].tolist() + [1e-3], method="rk4", dt=1e-3)  # compile / load from cache
+    work = n_bodies * steps
+    rows = {"tumble": measure(lambda: tumble.simulate(model, omega0, t=t, method="rk4", dt=1e-3)).rates(work, CORES)}
+    if c_kernel is not None:
+        y = np.zeros((7, n_bodies))
+        y[0], y[4:] = 1.0, omega0.T
+        # (3, N) one column per body (a scaled inertia has the same c₁, c₂, c₃: the memory traffic is the point)
+        c = np.ascontiguousarray(np.repeat([[C1], [C2], [C3]], n_bodies if per_body else 1, axis=1))
+        rows["C reference"] = measure(lambda: c_kernel(y.ctypes.data, c.ctypes.data, int(per_body), n_bodies,
+                                                       1e-3, steps)).rates(work, CORES)
+    return rows
 
 
-def adaptive_vs_scipy(t_end, rtol, atol):
+def big_batch_overhead(n_bodies):
+    """CPU ns per body of set-up and output at N = n_bodies: a one-step run less one step's kernel cost."""
+    rng = np.random.default_rng(2)
+    body = tumble.RigidBody(np.diag(MOMENTS))
+    omega0 = OMEGA0 + 1e-2 * rng.standard_normal((n_bodies, 3))
+    one = measure(lambda: tumble.simulate(body, omega0, t=[0.0, 1e-3], method="rk4", dt=1e-3), 3)
+    ten = measure(lambda: tumble.simulate(body, omega0, t=[0.0, 1e-2], method="rk4", dt=1e-3), 3)
+    per_step = (ten.cpu.min() - one.cpu.min()) / 9
+    return (one.cpu.min() - per_step) / n_bodies * 1e9, per_step / n_bodies * 1e9
+
+
+def adaptive_vs_scipy(t_end, rtol, atol, reference):
     t = np.linspace(0.0, t_end, 101)
     y0 = np.concatenate([Q0, OMEGA0_ACCURACY])
-    reference = solve_ivp(euler_rhs, (0.0, t_end), y0, method="DOP853", t_eval=t, rtol=2.3e-14, atol=1e-16)
-    ref_w = reference.y[4:].T
     body = tumble.RigidBody(np.diag(MOMENTS))
     tumble.simulate(body, OMEGA0_ACCURACY, t=t[:3], rtol=rtol, atol=atol)  # compile / load from cache
-    t_tumble, traj = best_of(5, lambda: tumble.simulate(body, OMEGA0_ACCURACY, t=t, rtol=rtol, atol=atol))
-    t_scipy, sol = best_of(2, lambda: solve_ivp(euler_rhs, (0.0, t_end), y0, method="DOP853", t_eval=t,
-                                                rtol=rtol, atol=atol))
-    return {
-        "tumble_s": t_tumble, "scipy_s": t_scipy,
-        "tumble_err": np.abs(traj.omega - ref_w).max(), "scipy_err": np.abs(sol.y[4:].T - ref_w).max(),
-        "tumble_steps": traj.info["n_steps"], "scipy_nfev": sol.nfev,
-    }
+    ours = measure(lambda: tumble.simulate(body, OMEGA0_ACCURACY, t=t, rtol=rtol, atol=atol))
+    theirs = measure(lambda: solve_ivp(euler_rhs, (0.0, t_end), y0, method="DOP853", t_eval=t, rtol=rtol, atol=atol))
+    return {"tumble": ours.seconds(), "scipy": theirs.seconds(),
+            "tumble_err": np.abs(ours.result.omega - reference).max(),
+            "scipy_err": np.abs(theirs.result.y[4:].T - reference).max()}
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="smaller sizes (about 20 s)")
+    parser.add_argument("--quick", action="store_true", help="smaller sizes")
     args = parser.parse_args()
-    n_bodies = 20_000 if args.quick else 100_000
-    cores = len(os.sched_getaffinity(0))
-    print(f"tumble {tumble.__version__}, {cores} cores; body I = diag{MOMENTS.tolist()} kg m², "
-          f"omega0 = {OMEGA0.tolist()} rad/s\n")
+    print(machine())
+    print(f"tumble {tumble.__version__}; body I = diag{MOMENTS.tolist()} kg m²; min / median of >= 5 repeats; "
+          f"'cpu' rates = work / CPU s × {CORES} cores\n")
 
-    ns_tumble = single_body_rk4(200_000) * 1e9
-    ns_numpy, _ = best_of(1, lambda: numpy_rk4(np.concatenate([Q0, OMEGA0]), 1e-3, 5_000))
-    ns_numpy = ns_numpy / 5_000 * 1e9
-    print("1. single-body RK4, cost per step")
-    print(f"   tumble (compiled loop)        {ns_tumble:10.1f} ns")
-    print(f"   hand-written NumPy RK4        {ns_numpy:10.1f} ns   ratio {ns_numpy / ns_tumble:8.0f}x\n")
+    r = single_body(20_000 if args.quick else 200_000)
+    print("1. single-body RK4, CPU ns per step (min / median)")
+    for name, v in r.items():
+        print(f"   {name:<14} {fmt(v, ' ns')}")
 
-    rate = batch_rk4(n_bodies, 200 if args.quick else 500)
-    print(f"2. batch RK4, N = {n_bodies} bodies, all {cores} cores")
-    print(f"   tumble                        {rate:10.3g} body-steps/s "
-          f"({rate / cores:.3g} per core)\n")
+    c_kernel = c_reference()
+    n_bodies, steps = (20_000, 200) if args.quick else (100_000, 500)
+    for per_body in (False, True):
+        print(f"\n2{'b' if per_body else 'a'}. batch RK4, N = {n_bodies}, {steps} steps, "
+              f"{'one inertia per body' if per_body else 'one shared inertia'}: body-steps/s (min-time / median)")
+        rows = batch(n_bodies, steps, per_body, c_kernel)
+        for name, v in rows.items():
+            print(f"   {name:<12} wall {fmt(v['wall'])}   cpu {fmt(v['cpu'])}")
+        if "C reference" in rows:
+            print(f"   tumble / C (cpu, best): {rows['tumble']['cpu'][0] / rows['C reference']['cpu'][0]:.0%}")
 
-    print(f"3. adaptive DOP853 at the same tolerance, omega0 = {OMEGA0_ACCURACY.tolist()} rad/s, t = 0..100 s, "
-          "101 outputs;\n   error = max |Δω| (rad/s) against scipy DOP853 at rtol = 2.3e-14, atol = 1e-16")
-    print(f"   {'rtol=atol':>10} {'tumble s':>10} {'scipy s':>10} {'speed-up':>9} {'tumble err':>11} {'scipy err':>11}")
+    n_big = 200_000 if args.quick else 1_000_000
+    setup, step = big_batch_overhead(n_big)
+    print(f"\n3. N = {n_big}: set-up and output {setup:.0f} CPU ns per body per call; one step {step:.1f} ns per body")
+
+    t = np.linspace(0.0, 100.0, 101)
+    y0 = np.concatenate([Q0, OMEGA0_ACCURACY])
+    reference = solve_ivp(euler_rhs, (0.0, 100.0), y0, method="DOP853", t_eval=t, rtol=2.3e-14, atol=1e-16).y[4:].T
+    print("\n4. adaptive DOP853 at the same tolerance, t = 0..100 s, 101 outputs; error = max |Δω| (rad/s) against "
+          "scipy DOP853 at rtol = 2.3e-14, atol = 1e-16; wall s (min / median)")
+    print(f"   {'rtol=atol':>10} {'tumble s':>20} {'scipy s':>20} {'speed-up':>9} {'tumble err':>11} {'scipy err':>11}")
     for tol in (1e-8, 1e-10, 1e-12):
-        r = adaptive_vs_scipy(100.0, tol, tol)
-        print(f"   {tol:10.0e} {r['tumble_s']:10.2e} {r['scipy_s']:10.2e} {r['scipy_s'] / r['tumble_s']:8.0f}x "
+        r = adaptive_vs_scipy(100.0, tol, tol, reference)
+        print(f"   {tol:10.0e} {fmt(r['tumble']):>20} {fmt(r['scipy']):>20} {r['scipy'][0] / r['tumble'][0]:8.0f}x "
               f"{r['tumble_err']:11.2e} {r['scipy_err']:11.2e}")
+    body = tumble.RigidBody(np.diag(MOMENTS))
+    for method, options in (("dop853", {}), ("rk4", {"dt": 1e-3})):
+        tumble.simulate(body, OMEGA0_ACCURACY, t=[0.0, 1e-3], method=method, **options)
+        c = measure(lambda: tumble.simulate(body, OMEGA0_ACCURACY, t=[0.0, 1e-3], method=method, **options), 200)
+        print(f"   fixed cost of one simulate call ({method}, one step): {c.cpu.min() * 1e6:.0f} / "
+              f"{np.median(c.cpu) * 1e6:.0f} µs CPU (min / median)")
 
 
 if __name__ == "__main__":

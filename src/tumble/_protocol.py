@@ -39,6 +39,18 @@ compiles::
     "cuda"         the kernel's fields are those that tumble.integrate._cuda reads (a rigid
                    body with a compiled torque program): rk4 on an NVIDIA GPU
 
+Two more are optional: a kernel whose state is ``[q_NP, ω_P]`` (7) and whose
+projection is ``q ← q/|q|`` may give its right-hand side on one body's state
+held in registers (a 7-tuple), which the fixed-step RK4 then runs fused, all
+four stages, the update and the projection of a lane in one pass::
+
+    point_rates(model, r, t, y) -> dy/dt    (7-tuples) with the parameters of row r
+    uniform(model) -> bool                  one row for all members (r = 0); otherwise member b has row b
+    members(model, b0, b1) -> model         the kernel of members b0 … b1−1 alone (its rows 0 … b1−b0−1),
+                                            contiguous copies, so that a block reads lane j's row j
+
+(:func:`implemented` tells an overload whether a kernel type gives one.)
+
 A kernel also tells Python whether it calls back into the interpreter
 (``calls_python``): the integrators then run its batch on one core.
 
@@ -68,6 +80,16 @@ def is_type(numba_type, cls) -> bool:
     return isinstance(numba_type, types.BaseNamedTuple) and numba_type.instance_class is cls
 
 
+#: (generic, kernel class) pairs registered by :func:`implements`.
+_IMPLEMENTED: set = set()
+
+
+def implemented(generic, numba_type) -> bool:
+    """True when the kernel type ``numba_type`` (seen by an overload) has an overload of ``generic``."""
+    return (isinstance(numba_type, types.BaseNamedTuple)
+            and (generic, numba_type.instance_class) in _IMPLEMENTED)
+
+
 def implements(generic, cls, *, inline: bool = False, **jit_options):
     """Decorator: register a typing function as the overload of ``generic`` for the NamedTuple type ``cls``.
 
@@ -85,6 +107,7 @@ def implements(generic, cls, *, inline: bool = False, **jit_options):
 
         overload(generic, inline="always" if inline else "never",
                  jit_options={"cache": True, **jit_options})(for_this_kernel)
+        _IMPLEMENTED.add((generic, cls))
         return typer
 
     return register
@@ -121,6 +144,24 @@ def body_rate(model, Y, j):  # pragma: no cover - replaced by overloads in compi
     quaternion ``Y[0:4]``, in the body axes that quaternion maps to inertial.
     """
     raise NotImplementedError(f"no compiled body rate for {type(model).__name__}")
+
+
+def point_rates(model, r, t, y):  # pragma: no cover - replaced by overloads in compiled code
+    """``dy/dt`` (a 7-tuple) at time ``t`` (s) and state ``y = (q_NP, ω_P)`` (a 7-tuple) with the parameters
+    of row ``r``: 0 for every member of a :func:`uniform` model, otherwise the member itself."""
+    raise NotImplementedError(f"no compiled pointwise right-hand side for {type(model).__name__}")
+
+
+def uniform(model):  # pragma: no cover - replaced by overloads in compiled code
+    """True when every batch member of ``model`` has the same parameters (one row shared by all);
+    otherwise every member has its own row."""
+    raise NotImplementedError(f"{type(model).__name__} does not say whether its members share parameters")
+
+
+def members(model, b0, b1):  # pragma: no cover - replaced by overloads in compiled code
+    """The kernel of batch members ``b0 … b1−1`` alone: member ``b0 + j`` has row ``j`` (a non-:func:`uniform`
+    model; its per-member arrays copied contiguous, so that the lanes of a block read them as vectors)."""
+    raise NotImplementedError(f"no compiled member selection for {type(model).__name__}")
 
 
 def inverse_moments(model, b):  # pragma: no cover - replaced by overloads in compiled code
@@ -165,14 +206,15 @@ def torque_free(model):  # pragma: no cover - replaced by overloads in compiled 
     raise NotImplementedError(f"{type(model).__name__} does not say whether it has a torque")
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def quaternion_scale(qw, qx, qy, qz):
     """``1/|q|``: the factor that projects a quaternion back onto the unit sphere.
 
     This is the projection every attitude model uses: the exact flow keeps
     ``|q| = 1``; a Runge–Kutta step leaves it off by about the local error.
     Projecting after every accepted step keeps it at 1 to rounding without
-    changing the order of the method.
+    changing the order of the method. (NumPy's error model: a zero quaternion gives inf, then nan
+    states, rather than a ZeroDivisionError check that would keep the lane loops scalar.)
     """
     return 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
 

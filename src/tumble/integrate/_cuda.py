@@ -42,12 +42,11 @@ import numpy as np
 from numba import cuda, types
 from numba.extending import overload, register_jitable
 
-from tumble import _quat, torques
-from tumble._protocol import quaternion_scale
+from tumble import torques
 from tumble._validate import ValidationError
-from tumble.dynamics import euler_principal
 from tumble.integrate._fixed import landing_steps
-from tumble.integrate._rk4 import weighted_sum
+from tumble.integrate._rk4 import axpy, update
+from tumble.kernels.rigid import rates
 
 #: Threads per block, a multiple of the warp (32). The kernel uses no shared
 #: memory, so what limits the warps resident on a multiprocessor is registers:
@@ -86,37 +85,23 @@ def _torque_by_type(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
 
 @register_jitable
 def _derivative(c, P, row, codes, t, y):
-    """``dy/dt`` of one body: ``½ q ⊗ [0, ω]`` and Euler's equations with coefficients ``c``."""
+    """``dy/dt`` of one body: the rigid body's one right-hand side (:func:`tumble.kernels.rigid.rates`)
+    with coefficients ``c`` and the torque of ``codes``."""
     qw, qx, qy, qz, w1, w2, w3 = y
     t1, t2, t3 = _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
-    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-    a1, a2, a3 = euler_principal(c[0], c[1], c[2], c[3], c[4], c[5], w1, w2, w3, t1, t2, t3)
-    return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
-
-
-@register_jitable
-def _axpy(y, a, k):
-    """``y + a k`` for 7-tuples."""
-    return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3],
-            y[4] + a * k[4], y[5] + a * k[5], y[6] + a * k[6])
+    return rates(c[0], c[1], c[2], c[3], c[4], c[5], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
 
 
 @register_jitable
 def _rk4_step(c, P, row, codes, t, h, y):
-    """One RK4 step of length ``h`` from ``(t, y)``, then ``q ← q/|q|``."""
+    """One RK4 step of length ``h`` from ``(t, y)``, then ``q ← q/|q|``: the stages of the CPU's
+    :func:`tumble.integrate._rk4.point_step`, with its :func:`~tumble.integrate._rk4.axpy` and
+    :func:`~tumble.integrate._rk4.update`."""
     k1 = _derivative(c, P, row, codes, t, y)
-    k2 = _derivative(c, P, row, codes, t + 0.5 * h, _axpy(y, 0.5 * h, k1))
-    k3 = _derivative(c, P, row, codes, t + 0.5 * h, _axpy(y, 0.5 * h, k2))
-    k4 = _derivative(c, P, row, codes, t + h, _axpy(y, h, k3))
-    qw, qx, qy, qz, w1, w2, w3 = (y[0] + weighted_sum(h, k1[0], k2[0], k3[0], k4[0]),
-                                  y[1] + weighted_sum(h, k1[1], k2[1], k3[1], k4[1]),
-                                  y[2] + weighted_sum(h, k1[2], k2[2], k3[2], k4[2]),
-                                  y[3] + weighted_sum(h, k1[3], k2[3], k3[3], k4[3]),
-                                  y[4] + weighted_sum(h, k1[4], k2[4], k3[4], k4[4]),
-                                  y[5] + weighted_sum(h, k1[5], k2[5], k3[5], k4[5]),
-                                  y[6] + weighted_sum(h, k1[6], k2[6], k3[6], k4[6]))
-    s = quaternion_scale(qw, qx, qy, qz)
-    return qw * s, qx * s, qy * s, qz * s, w1, w2, w3
+    k2 = _derivative(c, P, row, codes, t + 0.5 * h, axpy(y, 0.5 * h, k1))
+    k3 = _derivative(c, P, row, codes, t + 0.5 * h, axpy(y, 0.5 * h, k2))
+    k4 = _derivative(c, P, row, codes, t + h, axpy(y, h, k3))
+    return update(h, y, k1, k2, k3, k4)
 
 
 @cuda.jit(cache=True)
@@ -126,9 +111,9 @@ def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
     b = cuda.grid(1)
     if b >= y0.shape[0]:
         return
-    r = b if coefficients.shape[0] > 1 else 0
-    c = (coefficients[r, 0], coefficients[r, 1], coefficients[r, 2],
-         coefficients[r, 3], coefficients[r, 4], coefficients[r, 5])
+    r = b if coefficients.shape[1] > 1 else 0
+    c = (coefficients[0, r], coefficients[1, r], coefficients[2, r],
+         coefficients[3, r], coefficients[4, r], coefficients[5, r])
     row = b if P.shape[0] > 1 else 0
     y = (y0[b, 0], y0[b, 1], y0[b, 2], y0[b, 3], y0[b, 4], y0[b, 5], y0[b, 6])
     out[0, b, 0], out[0, b, 1], out[0, b, 2], out[0, b, 3], out[0, b, 4], out[0, b, 5], out[0, b, 6] = y
@@ -147,8 +132,8 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None) -> tuple[np.ndarray, int]:
     ``model`` is a :class:`tumble.kernels.rigid.RigidModel` (the ``"cuda"``
     capability), whose fields the kernel reads:
 
-    coefficients : (N or 1, 6) Euler coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``,
-                   one row per body or one shared
+    coefficients : (6, N or 1) Euler coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``,
+                   one column per body or one shared
     params : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes : int64 torque-program codes, or None for torque-free bodies
 

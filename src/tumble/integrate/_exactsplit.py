@@ -80,8 +80,8 @@ ORDERS = {"exact_split2": 2, "exact_split4": 4}
 
 
 @_protocol.implements(_fixed.workspace, ExactSplit)
-def _exact_split_workspace(scheme, model, Y):
-    return lambda scheme, model, Y: ()  # every lane runs on scalars
+def _exact_split_workspace(scheme, model, b0, Y):
+    return lambda scheme, model, b0, Y: ()  # every lane runs on scalars
 
 
 @_protocol.implements(_fixed.advance, ExactSplit)

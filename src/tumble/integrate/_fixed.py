@@ -6,7 +6,7 @@ runs through the drivers below; a method is a *scheme*, a
 generic functions, in the same way as models overload the protocol of
 :mod:`tumble._protocol`::
 
-    workspace(scheme, model, Y)                     # scratch arrays for Y (allocated once per run)
+    workspace(scheme, model, b0, Y)                 # scratch for Y, bodies b0, … (once per run)
     advance(scheme, model, b0, t0, h, m, Y, work)   # m steps of h from t0 (in place)
 
 ``Y`` is a block (state × lanes) of bodies ``b0, b0+1, …`` or the state vector
@@ -32,9 +32,13 @@ from tumble._validate import ValidationError
 #: Bodies advanced together in one structure-of-arrays block (SIMD lanes × unrolling).
 LANES = 64
 
+# The drivers compile with NumPy's error model: a float division by zero gives ±inf or nan (caught as
+# divergence by tumble.integrate) instead of a check that raises ZeroDivisionError, which would keep
+# every lane loop scalar (LLVM does not vectorise a loop that may raise).
 
-def workspace(scheme, model, Y):  # pragma: no cover - replaced by overloads in compiled code
-    """Scratch arrays ``scheme`` needs to advance ``Y`` (a tuple; allocated once per run)."""
+
+def workspace(scheme, model, b0, Y):  # pragma: no cover - replaced by overloads in compiled code
+    """Scratch ``scheme`` needs to advance ``Y``, bodies ``b0, b0+1, …`` (allocated once per run)."""
     raise NotImplementedError(f"no compiled workspace for {type(scheme).__name__}")
 
 
@@ -93,7 +97,7 @@ def landing_steps(t_out, dt: float, max_steps: int) -> tuple[np.ndarray, np.ndar
     return m, spans / m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def fixed_path(scheme, model, b0, Y, t_out, m, h, out):
     """Advance ``Y`` (in place) through ``t_out``, ``m[k]`` steps of ``h[k]`` from ``t_out[k]`` to
     ``t_out[k+1]`` (:func:`landing_steps`): a block (state × lanes) of bodies ``b0, b0+1, …``, or the
@@ -101,7 +105,7 @@ def fixed_path(scheme, model, b0, Y, t_out, m, h, out):
 
     ``out[k]`` receives ``Y.T`` at ``t_out[k]``. Returns the number of steps taken.
     """
-    work = workspace(scheme, model, Y)
+    work = workspace(scheme, model, b0, Y)
     store(out[0], Y)
     steps = 0
     for k in range(1, t_out.shape[0]):
@@ -111,7 +115,7 @@ def fixed_path(scheme, model, b0, Y, t_out, m, h, out):
     return steps
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_one(scheme, model, y, t_out, m, h, out, stats):
     """Integrate the lone body ``y[0]`` (a batch of one, updated in place) on its state vector.
 
@@ -121,7 +125,7 @@ def run_one(scheme, model, y, t_out, m, h, out, stats):
     stats[0, 0] += fixed_path(scheme, model, 0, y[0], t_out, m, h, out[:, 0])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_block(scheme, model, k, y, t_out, m, h, out, stats):
     """Integrate block ``k`` (bodies ``k·LANES …``) of the batch ``y`` (bodies × state, updated in place).
 
@@ -136,7 +140,7 @@ def run_block(scheme, model, k, y, t_out, m, h, out, stats):
         stats[b, 0] += steps
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, error_model="numpy")
 def run_batch(scheme, model, y, t_out, m, h, out, stats):
     """Integrate the bodies ``y[b]`` (updated in place), blocks in parallel over the cores.
 

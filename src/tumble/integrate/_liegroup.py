@@ -81,9 +81,9 @@ def times_unit(qw, qx, qy, qz, ew, ex, ey, ez):
 
 
 @_protocol.implements(_fixed.workspace, CF4)
-def _cf4_workspace(scheme, model, Y):
+def _cf4_workspace(scheme, model, b0, Y):
 
-    def impl(scheme, model, Y):
+    def impl(scheme, model, b0, Y):
         lanes = Y.size // Y.shape[0]  # 1 for one body's state vector
         n = Y.shape[0]
         # derivatives k₁…k₄ and the stage state (state × lanes), stage rates ω₁…ω₄, Q₂

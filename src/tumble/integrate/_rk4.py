@@ -9,6 +9,14 @@ Tableau (Kutta 1901)::
     k₁ = f(t, y)            k₂ = f(t + h/2, y + h k₁/2)
     k₃ = f(t + h/2, y + h k₂/2)   k₄ = f(t + h, y + h k₃)
     y ← y + h (k₁ + 2k₂ + 2k₃ + k₄)/6
+
+A kernel that gives its right-hand side on one body's state in registers
+(``point_rates``, :mod:`tumble._protocol`: the rigid body) runs *fused*: each
+lane's four stages, update and normalisation are one pass over its seven
+values, kept in registers, with the lanes of a block as SIMD lanes
+(:func:`point_step`). The stage arithmetic is that of the GPU kernel
+(:mod:`._cuda`), operation for operation, so both round alike. Other kernels
+run the stages as passes over the block (state × lanes).
 """
 
 from __future__ import annotations
@@ -16,10 +24,11 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 from numba.extending import register_jitable
 
 from tumble import _protocol
-from tumble._protocol import project, rhs, state_size
+from tumble._protocol import members, point_rates, project, quaternion_scale, rhs, state_size, uniform
 from tumble.integrate import _fixed
 
 ORDER = 4
@@ -37,6 +46,38 @@ def weighted_sum(h, k1, k2, k3, k4):
     return h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
+@register_jitable
+def axpy(y, a, k):
+    """``y + a k`` for 7-tuples (a stage state)."""
+    return (y[0] + a * k[0], y[1] + a * k[1], y[2] + a * k[2], y[3] + a * k[3],
+            y[4] + a * k[4], y[5] + a * k[5], y[6] + a * k[6])
+
+
+@register_jitable
+def update(h, y, k1, k2, k3, k4):
+    """``y + h (k₁ + 2k₂ + 2k₃ + k₄)/6`` for 7-tuples, then ``q ← q/|q|`` (the state ``[q, ω]``)."""
+    qw, qx, qy, qz, w1, w2, w3 = (y[0] + weighted_sum(h, k1[0], k2[0], k3[0], k4[0]),
+                                  y[1] + weighted_sum(h, k1[1], k2[1], k3[1], k4[1]),
+                                  y[2] + weighted_sum(h, k1[2], k2[2], k3[2], k4[2]),
+                                  y[3] + weighted_sum(h, k1[3], k2[3], k3[3], k4[3]),
+                                  y[4] + weighted_sum(h, k1[4], k2[4], k3[4], k4[4]),
+                                  y[5] + weighted_sum(h, k1[5], k2[5], k3[5], k4[5]),
+                                  y[6] + weighted_sum(h, k1[6], k2[6], k3[6], k4[6]))
+    s = quaternion_scale(qw, qx, qy, qz)
+    return qw * s, qx * s, qy * s, qz * s, w1, w2, w3
+
+
+@njit(inline="always")
+def point_step(model, r, t, h, y):
+    """One RK4 step of length ``h`` (s) from ``(t, y)`` with the parameters of row ``r``
+    (:func:`tumble._protocol.point_rates`), ``y = (q, ω)`` a 7-tuple in registers, then ``q ← q/|q|``."""
+    k1 = point_rates(model, r, t, y)
+    k2 = point_rates(model, r, t + 0.5 * h, axpy(y, 0.5 * h, k1))
+    k3 = point_rates(model, r, t + 0.5 * h, axpy(y, 0.5 * h, k2))
+    k4 = point_rates(model, r, t + h, axpy(y, h, k3))
+    return update(h, y, k1, k2, k3, k4)
+
+
 class RK4(NamedTuple):
     """The classical Runge–Kutta scheme (no parameters)."""
 
@@ -46,13 +87,21 @@ SCHEME = RK4()
 
 
 @_protocol.implements(_fixed.workspace, RK4)
-def _rk4_workspace(scheme, model, Y):
-    return lambda scheme, model, Y: (np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y),
+def _rk4_workspace(scheme, model, b0, Y):
+    if _protocol.implemented(point_rates, model):
+        if Y.ndim == 1:  # fused: registers only
+            return lambda scheme, model, b0, Y: ()
+        # the lanes at a fixed stride, and the block's own rows of a non-uniform model
+        return lambda scheme, model, b0, Y: (np.empty(7 * _fixed.LANES),
+                                             model if uniform(model) else members(model, b0, b0 + Y.shape[1]))
+    return lambda scheme, model, b0, Y: (np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y),
                                      np.empty_like(Y))
 
 
 @_protocol.implements(_fixed.advance, RK4, inline=True)
 def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
+    if _protocol.implemented(point_rates, model):
+        return _fused_advance(Y)
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         k1, k2, k3, k4, tmp = work
@@ -75,5 +124,55 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
             for i in range(size):
                 y_[i] += weighted_sum(h, k1_[i], k2_[i], k3_[i], k4_[i])
             project(model, b0, t + h, Y)
+
+    return impl
+
+
+def _fused_advance(Y):
+    """``advance`` of a kernel with ``point_rates``: the state vector, or each lane of the block, in
+    registers through all ``m`` steps (one body) or through one step per pass over the lanes (a block).
+
+    A block's lanes are copied into a buffer where component ``i`` of lane ``j`` is ``x[i·LANES + j]``:
+    with a stride known at compile time LLVM sees that the lanes of one pass are independent and
+    vectorises the pass (with the block's own run-time stride it does not). Lane ``j`` reads row ``j``
+    of the block's own kernel (:func:`tumble._protocol.members`), or row 0 of a uniform one: indices
+    from 0, which LLVM reads as contiguous vectors (from ``b0`` it did not).
+    """
+    if Y.ndim == 1:
+
+        def impl(scheme, model, b0, t0, h, m, Y, work):
+            r = 0 if uniform(model) else b0
+            y = (Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6])
+            for s in range(m):
+                y = point_step(model, r, t0 + s * h, h, y)
+            Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6] = y
+
+        return impl
+
+    W = _fixed.LANES
+
+    def impl(scheme, model, b0, t0, h, m, Y, work):
+        x, block = work
+        lanes = Y.shape[1]
+        for i in range(7):
+            for j in range(lanes):
+                x[i * W + j] = Y[i, j]
+        # two loops, so that shared parameters are a broadcast and per-member ones a contiguous load
+        shared = uniform(model)
+        for s in range(m):
+            t = t0 + s * h
+            if shared:
+                for j in range(lanes):
+                    (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
+                        point_step(model, 0, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
+                                                    x[5 * W + j], x[6 * W + j])))
+            else:
+                for j in range(lanes):
+                    (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
+                        point_step(block, j, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
+                                                    x[5 * W + j], x[6 * W + j])))
+        for i in range(7):
+            for j in range(lanes):
+                Y[i, j] = x[i * W + j]
 
     return impl

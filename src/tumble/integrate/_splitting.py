@@ -99,10 +99,10 @@ ORDERS = {"splitting2": 2, "splitting4": 4}
 
 
 @_protocol.implements(_fixed.workspace, Splitting)
-def _splitting_workspace(scheme, model, Y):
+def _splitting_workspace(scheme, model, b0, Y):
     # the rates of A, B and C of each lane (1/(kg·m²)), and |L|² at the start of the run
     # (negative: not yet known; set by the first advance)
-    return lambda scheme, model, Y: (np.full((4, Y.size // Y.shape[0]), -1.0),)
+    return lambda scheme, model, b0, Y: (np.full((4, Y.size // Y.shape[0]), -1.0),)
 
 
 # error_model="numpy": IEEE division without Python's zero check, which measured

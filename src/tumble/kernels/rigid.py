@@ -15,6 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
+from numba.extending import register_jitable
 
 from tumble import _free_flow, _protocol, _quat, torques
 from tumble.dynamics import euler_coefficients, euler_principal
@@ -25,8 +26,10 @@ STATE_SIZE = 7
 class RigidModel(NamedTuple):
     """Compiled parameters of a batch of rigid bodies.
 
-    coefficients : (N or 1, 6) Euler coefficients per body (``dynamics.euler_coefficients``
-                   of the principal moments): one row shared by all bodies, or one per body
+    coefficients : (6, N or 1) Euler coefficients (``dynamics.euler_coefficients`` of the
+                   principal moments), structure of arrays: coefficient ``k`` of body ``b`` is
+                   ``coefficients[k, b]`` (one column shared by all bodies, or one per body), so
+                   that a block of lanes reads each coefficient as one contiguous vector
     params  : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes   : int64 torque-program codes, or None for a torque-free body
     moments : (N or 1, 3) principal moments, kg·m² (for the exact flow, ``method="exact"``)
@@ -65,7 +68,7 @@ def from_principal(moments, axes, model) -> RigidModel:
     """
     # a writeable copy: RigidBody.moments is read-only, and Numba would compile every integrator once more
     moments = np.array(moments, dtype=np.float64, order="C")
-    coefficients = np.stack(euler_coefficients(moments[:, 0], moments[:, 1], moments[:, 2]), axis=-1)
+    coefficients = np.stack(euler_coefficients(moments[:, 0], moments[:, 1], moments[:, 2]))
     if model is None:
         codes, params = None, np.zeros((1, 0))
     else:
@@ -76,8 +79,23 @@ def from_principal(moments, axes, model) -> RigidModel:
 
 
 
-@_protocol.implements(_protocol.rhs, RigidModel, inline=True)
-def _rigid_rhs(model, b0, t, Y, OUT):
+@register_jitable
+def rates(c1, c2, c3, r1, r2, r3, qw, qx, qy, qz, w1, w2, w3, t1, t2, t3):
+    """``dy/dt`` of one body from its state ``(q, ω)`` and torque ``τ`` (N·m, principal axes):
+    ``(½ q ⊗ [0, ω], ω̇)`` with ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic
+    (:func:`tumble.dynamics.euler_principal`, coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``).
+
+    The one right-hand side of the rigid body, compiled into the CPU
+    integrators and the GPU kernel of :mod:`tumble.integrate._cuda` alike, so
+    that both round alike.
+    """
+    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
+    a1, a2, a3 = euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3)
+    return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
+
+
+@_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
+def _rigid_point_rates(model, b, t, y):
     if isinstance(model.types[2], types.NoneType):  # torque-free: no torque code at all
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
@@ -86,46 +104,56 @@ def _rigid_rhs(model, b0, t, Y, OUT):
     else:
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
-            row = b * (model.params.shape[0] > 1)
-            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, row, model.codes)
+            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
 
     torque = njit(inline="always")(torque)
 
-    @njit(inline="always")  # IR-level inlining: LLVM alone leaves a call in the RK4 loop (+25 %)
-    def derivative(model, b, r, t, qw, qx, qy, qz, w1, w2, w3):
-        # body b, coefficients in row r; scalar reads only: a row view would
-        # cost reference counting in the inner loop
+    def impl(model, b, t, y):
+        # b is the member's row, 0 for all of a uniform model (see _rigid_uniform): lanes b, b+1, ...
+        # read contiguous coefficients (structure of arrays), or one broadcast; scalar reads only (a
+        # column view would cost reference counting in the inner loop)
         c = model.coefficients
+        r = b
+        qw, qx, qy, qz, w1, w2, w3 = y
         t1, t2, t3 = torque(model, b, t, qw, qx, qy, qz, w1, w2, w3)
-        d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-        a1, a2, a3 = euler_principal(
-            c[r, 0], c[r, 1], c[r, 2], c[r, 3], c[r, 4], c[r, 5], w1, w2, w3, t1, t2, t3
-        )
-        return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
+        return rates(c[0, r], c[1, r], c[2, r], c[3, r], c[4, r], c[5, r], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
 
+    return impl
+
+
+@_protocol.implements(_protocol.uniform, RigidModel, inline=True)
+def _rigid_uniform(model):
+    # one body for all (from_principal gives the coefficients and a torque program's parameters
+    # the same number of rows: 1, or one per body; a torque-free model has one empty row)
+    return lambda model: model.coefficients.shape[1] == 1
+
+
+@_protocol.implements(_protocol.members, RigidModel)
+def _rigid_members(model, b0, b1):
+
+    def impl(model, b0, b1):
+        c = np.ascontiguousarray(model.coefficients[:, b0:b1])
+        params = np.ascontiguousarray(model.params[b0:b1]) if model.params.shape[0] > 1 else model.params
+        return RigidModel(c, params, model.codes, np.ascontiguousarray(model.moments[b0:b1]))
+
+    return impl
+
+
+@_protocol.implements(_protocol.rhs, RigidModel, inline=True)
+def _rigid_rhs(model, b0, t, Y, OUT):
     if Y.ndim == 1:  # one body: the state vector itself
 
         def impl(model, b0, t, Y, OUT):
-            r = b0 * (model.coefficients.shape[0] > 1)
-            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = derivative(
-                model, b0, r, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]
-            )
+            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = _protocol.point_rates(
+                model, b0 * (model.coefficients.shape[1] > 1), t, (Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]))
 
     else:  # a block: state × lanes
 
         def impl(model, b0, t, Y, OUT):
-            # one body's coefficients for all lanes, or one row per lane: two loops,
-            # so that the shared case is a broadcast the compiler can vectorise
-            if model.coefficients.shape[0] == 1:
-                for j in range(Y.shape[1]):
-                    (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = derivative(
-                        model, b0 + j, 0, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]
-                    )
-            else:
-                for j in range(Y.shape[1]):
-                    (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = derivative(
-                        model, b0 + j, b0 + j, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]
-                    )
+            per_body = model.coefficients.shape[1] > 1  # not uniform: row b0 + j (see _rigid_uniform)
+            for j in range(Y.shape[1]):
+                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = _protocol.point_rates(
+                    model, (b0 + j) * per_body, t, (Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]))
 
     return impl
 
@@ -155,9 +183,9 @@ def _rigid_inverse_moments(model, b):
         return None  # with a torque program, the body is not free: no splitting
 
     def impl(model, b):
-        r = b * (model.coefficients.shape[0] > 1)
         c = model.coefficients
-        return c[r, 3], c[r, 4], c[r, 5]
+        r = b * (c.shape[1] > 1)
+        return c[3, r], c[4, r], c[5, r]
 
     return impl
 
@@ -189,11 +217,11 @@ def _rigid_torque_acceleration(model, b, t, x, w1, w2, w3):
         return lambda model, b, t, x, w1, w2, w3: (0.0, 0.0, 0.0)
 
     def impl(model, b, t, x, w1, w2, w3):
-        r = b * (model.coefficients.shape[0] > 1)
         c = model.coefficients
+        r = b * (c.shape[1] > 1)
         t1, t2, t3 = torques.evaluate(t, x[0], x[1], x[2], x[3], w1, w2, w3, model.params,
                                       b * (model.params.shape[0] > 1), model.codes)
-        return c[r, 3] * t1, c[r, 4] * t2, c[r, 5] * t3
+        return c[3, r] * t1, c[4, r] * t2, c[5, r] * t3
 
     return impl
 
