@@ -10,5 +10,7 @@
 
 from tumble.analysis._flips import flip_times, intermediate_rate
 from tumble.analysis._lyapunov import LyapunovExponents, lyapunov_exponents
+from tumble.analysis._poincare import PoincareSection, poincare_section
 
-__all__ = ["LyapunovExponents", "flip_times", "intermediate_rate", "lyapunov_exponents"]
+__all__ = ["LyapunovExponents", "PoincareSection", "flip_times", "intermediate_rate", "lyapunov_exponents",
+           "poincare_section"]

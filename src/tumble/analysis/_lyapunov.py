@@ -22,16 +22,18 @@ The state and the tangents are integrated together by ``dop853`` (adaptive;
 its error control includes the tangents) or ``rk4`` (fixed step that lands on
 each ``tₙ``), the engine's own schemes, compiled once for the tangent kernel.
 A batch of initial states (a chaos map over a grid) runs in one call, in
-parallel over the cores.
+parallel over the cores (threads over shares of the batch).
 """
 
 from __future__ import annotations
 
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from tumble import attitude
 from tumble._inertia import principal_axes
@@ -111,8 +113,7 @@ def lyapunov_exponents(body, gravity=None, *, omega0, q0=None, t, count: int = 1
         m, h = np.zeros(t.size - 1, dtype=np.int64), np.zeros(t.size - 1)
     logs = np.zeros((t.size, y0.shape[0], count))
     status = np.zeros(y0.shape[0])
-    _spectra(model, y0, t, method == "dop853", m, h, float(rtol), float(atol), float(max_steps),
-             _dop853.tableau(), _rk4.SCHEME, logs, status)
+    _run(model, y0, t, method == "dop853", m, h, float(rtol), float(atol), float(max_steps), logs, status)
     bad = np.flatnonzero(status != _dop853.OK)
     if bad.size:
         raise SolverError(f"body {int(bad[0])}: dop853 stopped (status {int(status[bad[0]])}: step too small or "
@@ -155,11 +156,24 @@ def _initial(body, gravity, omega0, q0, count):
     return model, y0, single
 
 
-@njit(cache=True, parallel=True)
-def _spectra(model, y0, t, adaptive, m, h, rtol, atol, max_steps, tab, scheme, logs, status):
-    """``logs[n, b, j]``: the sums of ``ln R_jj`` up to ``t[n]`` of member ``b``; ``status[b]``: dop853's status."""
-    for i in prange(y0.shape[0]):
-        b = np.int64(i)
+def _run(model, y0, t, adaptive, m, h, rtol, atol, max_steps, logs, status):
+    """:func:`_spectra` on the members of the batch, in contiguous shares, one thread per core."""
+    args = (model, y0, t, adaptive, m, h, rtol, atol, max_steps, _dop853.tableau(), _rk4.SCHEME, logs, status)
+    shares = np.array_split(np.arange(y0.shape[0]), min(y0.shape[0], os.cpu_count() or 1))
+    if len(shares) == 1:
+        _spectra(0, y0.shape[0], *args)
+        return
+    with ThreadPoolExecutor(len(shares)) as pool:
+        for done in [pool.submit(_spectra, int(s[0]), int(s[-1]) + 1, *args) for s in shares]:
+            done.result()
+
+
+@njit(cache=True, nogil=True)
+def _spectra(first, last, model, y0, t, adaptive, m, h, rtol, atol, max_steps, tab, scheme, logs, status):
+    """``logs[n, b, j]``: the sums of ``ln R_jj`` up to ``t[n]`` of the members ``first ≤ b < last``;
+    ``status[b]``: dop853's status (compiled without the GIL, so that threads share the batch: a parallel
+    ``prange`` region would double the compile time of this kernel)."""
+    for b in range(first, last):
         status[b] = _path(model, b, y0[b].copy(), t, adaptive, m, h, rtol, atol, max_steps, tab, scheme,
                           logs[:, b, :])
 
