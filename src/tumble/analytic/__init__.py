@@ -13,7 +13,8 @@
 ``separatrix``, ``herpolhode``
 ``HeavyTop``                           the Lagrange top: nutation bounds, exact u(t), period, precession
 ``kovalevskaya_invariant``,            the extra invariants of the two other integrable heavy tops;
-``goryachev_chaplygin_invariant``      ``heavy_top_energy``, ``vertical_momentum``, ``upward_vertical``
+``goryachev_chaplygin_invariant``      ``heavy_top_energy``, ``vertical_momentum``, ``upward_vertical``,
+                                       ``omega_at_energy``
 ====================================  ==============================================================
 
 See ``docs/exact.md``, ``docs/stability.md``, ``docs/heavy_top.md`` and ``docs/chaos.md``.
@@ -33,6 +34,7 @@ from tumble.analytic._integrable import (
     goryachev_chaplygin_invariant,
     heavy_top_energy,
     kovalevskaya_invariant,
+    omega_at_energy,
     upward_vertical,
     vertical_momentum,
 )
@@ -67,6 +69,7 @@ __all__ = [
     "herpolhode",
     "kovalevskaya_invariant",
     "measure_nutation",
+    "omega_at_energy",
     "polhode",
     "polhode_family",
     "polhode_period",

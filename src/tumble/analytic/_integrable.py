@@ -52,7 +52,7 @@ from tumble._inertia import principal_axes
 from tumble._validate import ValidationError, as_array
 
 __all__ = ["CASE_RTOL", "goryachev_chaplygin_invariant", "heavy_top_energy", "kovalevskaya_invariant",
-           "upward_vertical", "vertical_momentum"]
+           "omega_at_energy", "upward_vertical", "vertical_momentum"]
 
 #: Relative tolerance of the conditions of an integrable case: ``|A − B|``, ``|A − k C|`` ≤ CASE_RTOL·A
 #: and the centre of mass off the equatorial plane by ≤ CASE_RTOL·|r|; on the Goryachev–Chaplygin
@@ -79,6 +79,21 @@ def heavy_top_energy(inertia, gravity, omega, q) -> np.ndarray:
     tensor, omega = _tensor(inertia), as_array(omega, "omega", tail=(3,))
     kinetic = 0.5 * np.einsum("...i,ij,...j->...", omega, tensor, omega)
     return kinetic + gravity.mass * _magnitude(gravity) * (upward_vertical(q, gravity) @ gravity.com)
+
+
+def omega_at_energy(inertia, gravity, energy, direction, q) -> np.ndarray:
+    """The body rate along ``direction`` (…, 3) that gives the top at attitude ``q`` (…, 4) the energy ``energy`` (J).
+
+    ``ω = s d`` with ``½ s² d·I d = H − m g r·γ`` and ``s ≥ 0``: initial states on one energy level (a Poincaré
+    section, a chaos map). Refused (``energy``) where the potential at ``q`` exceeds ``energy``.
+    """
+    tensor, direction = _tensor(inertia), as_array(direction, "direction", tail=(3,))
+    kinetic = float(as_array(energy, "energy")) - heavy_top_energy(tensor, gravity, np.zeros(3), q)
+    if np.any(kinetic < 0.0):
+        raise ValidationError(f"energy: must be at least the potential energy m g r.gamma at q, "
+                              f"short by {-float(np.min(kinetic)):.3g} J")
+    unit = np.einsum("...i,ij,...j->...", direction, tensor, direction)
+    return direction * np.sqrt(2.0 * kinetic / unit)[..., None]
 
 
 def vertical_momentum(inertia, gravity, omega, q) -> np.ndarray:
