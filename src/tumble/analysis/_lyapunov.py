@@ -86,7 +86,9 @@ def lyapunov_exponents(body, gravity=None, *, omega0, q0=None, t, count: int = 1
     q0      : (4,) or (N, 4) initial attitude, body → inertial (default identity)
     t       : (n + 1,) increasing times, s: ``t[0]`` the start, then the re-orthonormalisation times
     count   : the number of exponents, 1 (the largest) to 6 (the full spectrum)
-    method  : ``"dop853"`` (``rtol``, ``atol``) or ``"rk4"`` (``dt``)
+    method  : ``"dop853"`` (``rtol``, ``atol``: default 1e-10; the error control includes the tangents) or
+              ``"rk4"`` (``dt``, s)
+    max_steps : the most steps of one member over the whole run
 
     Returns :class:`LyapunovExponents`. The initial tangent vectors are the
     first ``count`` columns of a fixed random orthogonal 6×6 matrix (seed
