@@ -12,9 +12,12 @@
 ``polhode``, ``polhode_family``,       curves on the energy ellipsoid; the herpolhode of a motion
 ``separatrix``, ``herpolhode``
 ``HeavyTop``                           the Lagrange top: nutation bounds, exact u(t), period, precession
+``kovalevskaya_invariant``,            the extra invariants of the two other integrable heavy tops;
+``goryachev_chaplygin_invariant``      ``heavy_top_energy``, ``vertical_momentum``, ``upward_vertical``,
+                                       ``omega_at_energy``
 ====================================  ==============================================================
 
-See ``docs/exact.md``, ``docs/stability.md`` and ``docs/heavy_top.md``.
+See ``docs/exact.md``, ``docs/stability.md``, ``docs/heavy_top.md`` and ``docs/chaos.md``.
 """
 
 from tumble.analytic._free import REGIMES, FreeParameters, free_parameters, torque_free
@@ -26,6 +29,14 @@ from tumble.analytic._geometry import (
     polhode_family,
     polhode_through,
     separatrix,
+)
+from tumble.analytic._integrable import (
+    goryachev_chaplygin_invariant,
+    heavy_top_energy,
+    kovalevskaya_invariant,
+    omega_at_energy,
+    upward_vertical,
+    vertical_momentum,
 )
 from tumble.analytic._heavy_top import AxisMotion, HeavyTop, NutationMeasurement, axis_motion, measure_nutation
 from tumble.analytic._stability import (
@@ -52,9 +63,13 @@ __all__ = [
     "flip_interval",
     "flip_times",
     "free_parameters",
+    "goryachev_chaplygin_invariant",
     "growth_rate",
+    "heavy_top_energy",
     "herpolhode",
+    "kovalevskaya_invariant",
     "measure_nutation",
+    "omega_at_energy",
     "polhode",
     "polhode_family",
     "polhode_period",
@@ -62,4 +77,6 @@ __all__ = [
     "separatrix",
     "stability",
     "torque_free",
+    "upward_vertical",
+    "vertical_momentum",
 ]
