@@ -82,11 +82,11 @@ def figure(results):
 
     fig = Figure(figsize=(11, 4.5), layout="constrained")
     for ax, (name, rows) in zip(fig.subplots(1, len(results)), results.items()):
-        for label, style in (("frame", "-"), ("body", "--")):
+        for label, style, legend in (("frame", "-", "non-spinning frame"), ("body", "--", "body axes")):
             for method, marker in (("rk4", "o"), ("dop853", "s")):
                 pts = [(r[3], r[5]) for r in rows if r[0] == label and r[1] == method]
                 ax.loglog([p[0] for p in pts], [max(p[1], 1e-16) for p in pts], style, marker=marker,
-                          label=f"{label} frame, {method}")
+                          label=f"{legend}, {method}")
         ax.set_title(name)
         ax.set_xlabel("right-hand-side evaluations")
         ax.set_ylabel("error (rad + relative rate)")

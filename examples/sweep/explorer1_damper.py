@@ -71,8 +71,8 @@ def main(samples=500, figure=None):
     ratio = measured / expected
     print(f"{samples} samples, time to flat spin (nutation >= 80 deg), s: 1st percentile {p[1.0]:.1f}, "
           f"median {p[50.0]:.1f}, 99th percentile {p[99.0]:.1f}; never reached: {int(np.isnan(measured).sum())}")
-    print(f"measured / energy-sink estimate tau ln(theta_f/theta_0): median {np.median(ratio):.3f}, "
-          f"range {ratio.min():.3f} to {ratio.max():.3f}")
+    print(f"measured / energy-sink estimate tau ln(theta_f/theta_0), over the samples that reached it: median "
+          f"{np.nanmedian(ratio):.3f}, range {np.nanmin(ratio):.3f} to {np.nanmax(ratio):.3f}")
     if figure:
         from tumble.sweep.figure import sweep_figure
 
