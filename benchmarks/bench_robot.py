@@ -21,9 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
+import tumble
 from tumble import robot
 
-ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _timing import best_of  # noqa: E402
 
@@ -75,7 +75,7 @@ def main():
     parser.add_argument("--batch", type=int, default=20000, help="samples per batched call")
     parser.add_argument("--calls", type=int, default=2000, help="single calls per timing")
     args = parser.parse_args()
-    chains = [robot.load(ROOT / "examples" / "robots" / name)
+    chains = [robot.load(tumble.examples.path(name))
               for name in ("planar_2link.toml", "puma560.toml", "panda.urdf")] + [random_chain(30)]
     import numba
 

@@ -8,7 +8,6 @@ torque-free RigidBody the suite already compiles.
 
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,7 +20,7 @@ from tumble._validate import ValidationError
 from tumble.integrate import SolverError
 from tumble.scenario import parse
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = tumble.examples.directory()
 
 
 def fixed(examples):

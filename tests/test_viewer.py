@@ -5,8 +5,6 @@ free motion: ``q(t) = [cos(Ωt/2), sin(Ωt/2) e]``), so the module compiles noth
 helpers. tests/test_viewer_browser.py opens the pages in Chromium.
 """
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import xarray as xr
@@ -20,7 +18,7 @@ from tumble.viewer._frames import frame_indices
 from tumble.viewer._shapes import body_mesh, box_mesh, cylinder_mesh, ellipsoid_mesh, equivalent_box
 from tumble.viewer.scenes.spacecraft import spin_angles
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 INERTIA = np.diag([1.0, 2.0, 3.0])   # kg m²
 SPIN = 2.0                           # rad/s about body z, the major axis
 
