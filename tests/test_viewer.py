@@ -115,10 +115,13 @@ def test_the_page_is_one_file_with_the_scene_and_no_external_script(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["spin.html"]   # no temporary file left
 
 
-def test_repr_html_is_an_iframe_and_a_robot_without_its_chain_falls_back_to_text():
-    html = steady_spin(n=21)._repr_html_()
+def test_notebook_html_is_an_iframe_and_a_robot_without_its_chain_falls_back_to_the_table():
+    html = viewer.notebook_html(steady_spin(n=21))
     assert html.startswith("<iframe srcdoc=") and "&lt;!DOCTYPE html&gt;" in html
-    assert arm_trajectory()._repr_html_() is None
+    assert viewer.notebook_html(arm_trajectory()) is None
+    # a notebook shows the run's table, then the viewer where it can draw one; a robot arm's run, the table alone
+    assert steady_spin(n=21)._repr_html_().endswith(html)
+    assert arm_trajectory()._repr_html_().endswith("</table>")
 
 
 @pytest.mark.parametrize("frames", [1, 0, -3, 2.5, "600"])
