@@ -177,7 +177,7 @@ def test_wheel_and_sdist_carry_the_package_data(tmp_path):
     assert f"Version: {version}\n" in metadata and "License-Expression: MIT AND Apache-2.0\n" in metadata
     sdist = subprocess.run(["tar", "tzf", str(tmp_path / "dist" / f"tumble-{version}.tar.gz")],
                            capture_output=True, check=True, text=True).stdout.split()
-    assert {f"tumble-{version}/{n}" for n in ("LICENSE", "NOTICE", "CHANGELOG.md",
+    assert {f"tumble-{version}/{n}" for n in ("LICENSE", "NOTICE", "CHANGELOG.md", "mkdocs.yml",
                                               "docs/conventions.md", "src/tumble/examples/robots/panda.urdf")} \
         <= set(sdist)
     # the installed wheel runs from anywhere, with its example files beside it

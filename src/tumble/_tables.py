@@ -56,14 +56,11 @@ def summary_html(traj: Trajectory) -> str:
 
 def _columns(name: str, data: np.ndarray, lead: int, labels: tuple[str, ...] | None = None) -> dict:
     """The columns of one sampled quantity: one per trailing component, named ``NAME_LABEL`` or ``NAME[i]``."""
-    flat = data.reshape(data.shape[:lead] + (-1,))
-    if flat.shape[-1] == 1 and data.ndim == lead:
+    flat = np.reshape(data, (*np.shape(data)[:lead], -1))
+    if data.ndim == lead:
         return {name: flat[..., 0]}
-    if labels is None:
-        labels = tuple(f"[{i}]" for i in range(flat.shape[-1]))
-    else:
-        labels = tuple(f"_{label}" for label in labels)
-    return {f"{name}{label}": flat[..., i] for i, label in enumerate(labels)}
+    suffixes = [f"[{i}]" for i in range(flat.shape[-1])] if labels is None else [f"_{label}" for label in labels]
+    return {f"{name}{suffix}": flat[..., i] for i, suffix in enumerate(suffixes)}
 
 
 def to_dataframe(traj: Trajectory) -> pandas.DataFrame:
@@ -79,7 +76,7 @@ def to_dataframe(traj: Trajectory) -> pandas.DataFrame:
 
     lead = len(traj._lead)
     columns: dict = {}
-    if traj.q is not None:
+    if traj.q is not None and traj.omega is not None:
         columns |= _columns("q", traj.q, lead, _QUATERNION) | _columns("omega", traj.omega, lead, _AXES)
     columns |= _columns("energy", traj.energy, lead)
     if traj.q is not None or "momentum_body" in traj.totals:
