@@ -2,7 +2,7 @@
 
     PYTHONPATH=src python benchmarks/bench_robot.py [--batch 20000] [--repeats 7]
 
-Robots: the 6-axis examples/robots/industrial6.urdf, UR5 and Panda (fixed base) and the Talos humanoid and
+Robots: the 6-axis tumble.examples.path("industrial6.urdf"), UR5 and Panda (fixed base) and the Talos humanoid and
 Solo12 quadruped (floating base) from example-robot-data. Pinocchio builds its model from the same file with
 its own URDF parser (``buildModelFromUrdf``: axis-aligned RX/RY/RZ joints where the URDF has them), and the
 torques are compared first. Per row: µs per call of ``tumble.robot.rnea`` / ``mass_matrix`` /
@@ -25,9 +25,9 @@ from pathlib import Path
 import numba
 import numpy as np
 
+import tumble
 from tumble import robot
 
-ROOT = Path(__file__).resolve().parents[1]
 
 try:
     import pinocchio as pin
@@ -36,7 +36,7 @@ except ImportError:  # the comparison is optional
 
 
 def robots() -> dict[str, tuple[Path, bool]]:
-    cases = {"industrial6": (ROOT / "examples" / "robots" / "industrial6.urdf", False)}
+    cases = {"industrial6": (tumble.examples.path("industrial6.urdf"), False)}
     try:
         erd = Path(metadata.distribution("example-robot-data").locate_file(
             "cmeel.prefix/share/example-robot-data/robots"))

@@ -2,8 +2,8 @@
 
 Run from the repository root: ``python benchmarks/robot_pinocchio_reference.py`` (NumPy 2.4.6).
 
-Panda: pinocchio.buildModelFromUrdf("examples/robots/panda.urdf") (Pinocchio's own URDF parser).
-PUMA 560: a Pinocchio model built here from the standard DH table of examples/robots/puma560.toml:
+Panda: pinocchio.buildModelFromUrdf("src/tumble/examples/robots/panda.urdf") (Pinocchio's own URDF parser).
+PUMA 560: a Pinocchio model built here from the standard DH table of src/tumble/examples/robots/puma560.toml:
 joint i is a revolute-Z joint placed at Tz(d_{i-1}) Tx(a_{i-1}) Rx(alpha_{i-1}) in joint i-1's frame;
 the link inertia given in DH frame i (= joint frame i moved by Tz(d_i) Tx(a_i) Rx(alpha_i)) is moved to joint frame i.
 Peer arm: tests/test_robot_urdf.PEER_URDF through pinocchio.buildModelFromXML (its continuous joint has
@@ -31,7 +31,7 @@ def dh(a, alpha, d):
         pin.SE3(pin.utils.rotate("x", alpha), np.zeros(3))
 
 
-panda = pin.buildModelFromUrdf("examples/robots/panda.urdf")
+panda = pin.buildModelFromUrdf("src/tumble/examples/robots/panda.urdf")
 panda.gravity.linear[:] = [0, 0, -9.81]
 print(pin.__version__, np.__version__)
 print("panda")
@@ -40,7 +40,7 @@ report(panda, [
     ([0.3, -0.5, 0.7, -1.9, 0.4, 1.2, -0.6], [0.5, -0.4, 0.3, 0.8, -1.1, 0.6, 1.4], [1.0, -2.0, 0.5, 1.5, -0.7, 2.2, -1.3]),
 ])
 
-doc = tomllib.load(open("examples/robots/puma560.toml", "rb"))
+doc = tomllib.load(open("src/tumble/examples/robots/puma560.toml", "rb"))
 puma = pin.Model()
 parent, placement = 0, pin.SE3.Identity()
 for k, row in enumerate(doc["link"]):

@@ -14,7 +14,7 @@ import tumble
 from tumble.cli import app
 from tumble.scenario import load_scenario, run_scenario
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = tumble.examples.directory()
 SRC = Path(__file__).resolve().parents[1] / "src"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

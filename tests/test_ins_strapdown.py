@@ -13,7 +13,7 @@ from tumble.ins import (ALGORITHMS, Coning, Increments, drift_law, from_trajecto
 from tumble.ins.demo import CONING_RANGES
 from tumble._validate import ValidationError
 
-EXAMPLE_CSV = Path(__file__).resolve().parents[1] / "examples" / "ins" / "coning_gyro.csv"
+EXAMPLE_CSV = tumble.examples.directory() / "ins" / "coning_gyro.csv"
 
 # The coning laws are leading-order (small α, small ΩT); the spec is 5 %.
 # Measured at α = 0.01 rad inside CONING_RANGES: none 3.3e-5, one-sample 2.9 %,

@@ -5,8 +5,6 @@ method needs, the run keeps what the model says its exact motion keeps (Model.in
 stated per model and method; otherwise the run is refused with the one message of
 tumble.integrate.check_method, which names the methods that work."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -22,7 +20,7 @@ from helpers import read_by
 
 INERTIA = np.array([[2.0, 0.1, -0.05], [0.1, 3.0, 0.2], [-0.05, 0.2, 4.0]])  # kg m², body axes
 OMEGA0 = np.array([0.3, 1.0, -0.4])  # rad/s: a generic tumble
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 
 
 def _swimmer(t):

@@ -8,7 +8,6 @@ torque-free RigidBody the suite already compiles.
 
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -23,7 +22,7 @@ from tumble.scenario import parse
 
 from test_models import CASES
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = tumble.examples.directory()
 
 
 def fixed(examples):

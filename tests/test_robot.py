@@ -1,13 +1,12 @@
 """tumble.robot: inverse and forward dynamics of serial chains against closed forms, identities and peers."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+import tumble
 from tumble import ValidationError, robot
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 EXAMPLES = ["planar_2link.toml", "puma560.toml", "panda.toml", "panda.urdf"]
 
 # Closed forms, identities and the peer's numbers agree to rounding: measured

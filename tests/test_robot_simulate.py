@@ -14,7 +14,7 @@ from tumble.robot.cli import app
 
 from helpers import read_by
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "robot.md"
 Q0 = np.array([0.1, 0.5, -0.3, 0.2, 0.4, -0.1])
 QD0 = np.array([0.3, -0.2, 0.4, 0.5, -0.6, 0.7])
@@ -233,7 +233,7 @@ def test_demo_writes_its_files_and_keeps_the_energy(tmp_path):
     """The Panda falling for 2 s: energy E ≈ 94 J kept to a measured 6e-12 J (tolerance 1e-10 J, see above)."""
     from tumble.robot.demo import demo_robot
 
-    summary = demo_robot(tmp_path, Path(__file__).resolve().parents[1] / "examples" / "robots" / "panda.urdf")
+    summary = demo_robot(tmp_path, tumble.examples.directory() / "robots" / "panda.urdf")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["robot_fall.nc", "robot_fall.png"]
     assert summary["max_energy_drift_J"] < ENERGY_TOL
     assert summary["energy_scale_J"] > 50.0

@@ -2,7 +2,7 @@
 
 Pinocchio (PyPI ``pin``) builds each robot from the same URDF with its own parser; tumble's RNEA, CRBA, ABA,
 frame placements, centre of mass and centroidal momentum matrix must agree on 20 random states per robot.
-The URDFs come from ``example-robot-data`` (both in the ``test`` extra) and examples/robots/industrial6.urdf.
+The URDFs come from ``example-robot-data`` (both in the ``test`` extra) and tumble.examples.path("industrial6.urdf").
 """
 
 from importlib import metadata
@@ -11,11 +11,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import tumble
 from tumble import ValidationError, robot
 
 pin = pytest.importorskip("pinocchio")
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 ERD = Path(metadata.distribution("example-robot-data").locate_file("cmeel.prefix/share/example-robot-data/robots"))
 STATES = 20
 # Two implementations of the same algorithms in float64 agree to rounding: measured worst 3e-13 relative to

@@ -1,14 +1,13 @@
 """tumble.robot URDF input: joint types, axes, origins, fixed-link merging, and what is refused."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+import tumble
 from tumble import RigidBody, ValidationError, robot
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 # Same arm through two descriptions: differences are rounding (measured ≤ 4e-15).
 TOL = 1e-12
 

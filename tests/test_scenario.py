@@ -10,7 +10,7 @@ import tumble
 from tumble import attitude
 from tumble.scenario import Scenario, ScenarioError, Time, load_scenario, parse_scenario, run_scenario
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLES = tumble.examples.directory()
 
 # dop853 at rtol = atol = 1e-12 over a few seconds conserves T and |L| to a
 # few 1e-14; 1e-11 leaves room for the accumulation of rounding.

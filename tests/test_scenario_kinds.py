@@ -23,7 +23,7 @@ from tumble.variable import Human, Motion, VariableBody, diver
 from helpers import assert_same_run
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = ROOT / "examples"
+EXAMPLES = tumble.examples.directory()
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 # Every example of the new kinds, with its kind.

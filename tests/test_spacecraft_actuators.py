@@ -2,7 +2,6 @@
 driven by PWPF modulators."""
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -46,7 +45,7 @@ def test_bdot_decays_the_rate_normal_to_the_field_by_the_predicted_factor():
     np.testing.assert_allclose(dipole, k * np.cross(traj.omega, traj.extras["magnetic_field"].data), rtol=1e-12)
 
 
-BDOT_EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "bdot_detumble.toml"
+BDOT_EXAMPLE = tumble.examples.directory() / "spacecraft" / "bdot_detumble.toml"
 # The orbit-averaged B-dot loop: with the body turning slowly, J ω̇ ≈ −k M ω with
 # M = <|B|²E − BBᵀ> over one orbit (inertial axes), so |ω| decays at least at k λ_min(M)/J_max,
 # the slowest mode (Stickler & Alfriend 1976; Avanzini & Giulietti, J. Guidance 35(4), 2012).

@@ -2,7 +2,6 @@
 
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +14,7 @@ from tumble.spacecraft.environment import DipoleField, dipole_field, gravity_gra
 from tumble.spacecraft.orbit import Orbit, lvlh_matrix, lvlh_quat, lvlh_quaternion, orbit_state
 from tumble.spacecraft.passive import gravity_gradient_stability
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "spacecraft"
+EXAMPLES = tumble.examples.directory() / "spacecraft"
 
 # Kepler's equation is solved to the Newton stopping rule (1e-15 rad); the
 # residual |E - e sin E - M| measured over the grid below is <= 4.5e-16 rad.

@@ -1,10 +1,9 @@
 """A spacecraft in orbit: gravity gradient and geomagnetic field from the orbit, momentum dumping."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+import tumble
 from tumble import attitude
 from tumble.spacecraft import (DipoleField, Magnetorquers, MomentumDumping, Orbit, QuaternionPD, Spacecraft,
                                pyramid_wheels)
@@ -20,7 +19,7 @@ FIELD = DipoleField()
 WHEEL_INERTIA = 0.05
 
 
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "momentum_dumping.toml"
+EXAMPLE = tumble.examples.directory() / "spacecraft" / "momentum_dumping.toml"
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,6 @@
 """Gravity-gradient equilibria, libration frequencies and stability regions; the major-axis rule."""
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -172,7 +171,7 @@ def test_major_axis_rule_rotated_body_and_symmetric_tops():
 def test_gravity_gradient_example_librates_about_lvlh():
     """examples/spacecraft/gravity_gradient.toml: released 5° off in pitch, it stays within 6° of LVLH for
     10 orbits (measured largest angle 5.26°: the roll/yaw coupling adds a little to the initial offsets)."""
-    path = Path(__file__).resolve().parent.parent / "examples" / "spacecraft" / "gravity_gradient.toml"
+    path = tumble.examples.directory() / "spacecraft" / "gravity_gradient.toml"
     problem = load_scenario(path).build()
     rel = attitude_in_lvlh(problem.simulate(), problem.torque.orbit)
     assert math.radians(5.0) <= np.max(np.abs([rel.roll, rel.pitch, rel.yaw])) < math.radians(6.0)

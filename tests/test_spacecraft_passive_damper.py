@@ -2,7 +2,6 @@
 
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -166,7 +165,7 @@ def test_damper_refuses_bad_input():
 
 # --- scenarios -----------------------------------------------------------------------------------------
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples" / "spacecraft"
+EXAMPLES = tumble.examples.directory() / "spacecraft"
 
 
 def test_explorer1_example_is_the_demo_spacecraft():

@@ -22,7 +22,7 @@ from helpers import assert_same_run
 pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]
-EXAMPLES = ROOT / "examples" / "spacecraft"
+EXAMPLES = tumble.examples.directory() / "spacecraft"
 
 
 def test_slew_example_reaches_its_target():

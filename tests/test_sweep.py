@@ -13,7 +13,6 @@ import importlib.util
 import math
 import os
 import statistics
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -52,7 +51,7 @@ def plan_of(dispersions, samples=4000, seed=3, chunk=None, model=BODY):
 
 
 def load_example(name):
-    path = Path(__file__).parents[1] / "examples" / "sweep" / f"{name}.py"
+    path = tumble.examples.directory() / "sweep" / f"{name}.py"
     spec = importlib.util.spec_from_file_location(f"sweep_example_{name}", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -365,7 +364,7 @@ def test_a_run_too_big_for_memory_is_refused_before_allocation():
 
 # -- scenario files and the command line ----------------------------------------------
 
-SPINNER = Path(__file__).parents[1] / "examples" / "sweep" / "spinner.toml"
+SPINNER = tumble.examples.directory() / "sweep" / "spinner.toml"
 
 
 def test_tumble_sweep_of_a_scenario_file_writes_the_store_and_the_figure(tmp_path):

@@ -5,8 +5,6 @@ free motion: ``q(t) = [cos(Ωt/2), sin(Ωt/2) e]``), so the module compiles noth
 helpers. tests/test_viewer_browser.py opens the pages in Chromium.
 """
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import xarray as xr
@@ -20,7 +18,7 @@ from tumble.viewer._frames import frame_indices
 from tumble.viewer._shapes import body_mesh, box_mesh, cylinder_mesh, ellipsoid_mesh, equivalent_box
 from tumble.viewer.scenes.spacecraft import spin_angles
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 INERTIA = np.diag([1.0, 2.0, 3.0])   # kg m²
 SPIN = 2.0                           # rad/s about body z, the major axis
 
@@ -117,10 +115,13 @@ def test_the_page_is_one_file_with_the_scene_and_no_external_script(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["spin.html"]   # no temporary file left
 
 
-def test_repr_html_is_an_iframe_and_a_robot_without_its_chain_falls_back_to_text():
-    html = steady_spin(n=21)._repr_html_()
+def test_notebook_html_is_an_iframe_and_a_robot_without_its_chain_falls_back_to_the_table():
+    html = viewer.notebook_html(steady_spin(n=21))
     assert html.startswith("<iframe srcdoc=") and "&lt;!DOCTYPE html&gt;" in html
-    assert arm_trajectory()._repr_html_() is None
+    assert viewer.notebook_html(arm_trajectory()) is None
+    # a notebook shows the run's table, then the viewer where it can draw one; a robot arm's run, the table alone
+    assert steady_spin(n=21)._repr_html_().endswith(html)
+    assert arm_trajectory()._repr_html_().endswith("</table>")
 
 
 @pytest.mark.parametrize("frames", [1, 0, -3, 2.5, "600"])

@@ -27,7 +27,7 @@ from tumble import attitude, robot
 from tumble.spacecraft import MRPFeedback, ReactionWheel, Spacecraft
 from tumble.viewer import Cylinder
 
-ROBOTS = Path(__file__).resolve().parents[1] / "examples" / "robots"
+ROBOTS = tumble.examples.directory() / "robots"
 CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 # Chromium offline: no sandbox (root in CI), no GPU (software GL through SwiftShader for WebGL), and every
 # background service that would reach the network switched off, with a fresh profile.

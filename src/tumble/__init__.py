@@ -27,12 +27,12 @@ from tumble.limits import RigidityWarning  # noqa: E402
 from tumble.simulate import Model, simulate  # noqa: E402
 from tumble.trajectory import Trajectory, load  # noqa: E402
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
 _LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep")
+         "robot", "sweep", "examples")
 
 
 def __getattr__(name):
@@ -54,6 +54,7 @@ __all__ = [
     "attitude",
     "dynamics",
     "ensemble",
+    "examples",
     "flexible",
     "ins",
     "integrate",

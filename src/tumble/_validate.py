@@ -33,6 +33,10 @@ class ValidationError(ValueError):
         return text[len(self.field) + 2:] if self.field else text
 
 
+# Its public name: tracebacks, reprs and pickles say tumble.ValidationError, not this private module.
+ValidationError.__module__ = "tumble"
+
+
 def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = True) -> np.ndarray:
     """Return ``value`` as a float64 array whose trailing axes are ``tail``.
 

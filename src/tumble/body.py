@@ -110,6 +110,14 @@ class RigidBody(RigidMotion):
     """
 
     __slots__ = ("_inertia", "_moments", "_axes", "_mass", "_com", "_check_triangle", "_name", "_q_bp")
+    _inertia: np.ndarray
+    _moments: np.ndarray
+    _axes: np.ndarray
+    _mass: float | None
+    _com: np.ndarray | None
+    _check_triangle: bool
+    _name: str | None
+    _q_bp: np.ndarray | None
 
     def __init__(self, inertia, *, mass=None, com=None, check_triangle: bool = True, name: str | None = None):
         inertia, moments, axes = check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)

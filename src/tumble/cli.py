@@ -6,6 +6,7 @@
     tumble demo top [-o DIRECTORY] [--duration 1.5]
     tumble demo NAME [-o DIRECTORY]        (the demos of tumble._demos.DEMOS: diver, flexible, ...)
     tumble robot torques ROBOT_FILE --q ...
+    tumble examples list | tumble examples copy DIRECTORY
     tumble sweep SCENARIO.toml -o out.zarr [--samples N] [--scheduler ADDR] [--workers N] [--plot out.png]
     tumble info out.nc | out.zarr
     tumble view out.nc -o out.html [--scenario SCENARIO.toml] [--frames 600] [--axis x]
@@ -34,6 +35,7 @@ from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 import tumble
+from tumble import examples as _examples
 from tumble import scenario as scenarios
 from tumble._cli_errors import exit_codes as _exit_codes
 from tumble._demos import DEMOS, Demo
@@ -58,6 +60,9 @@ app = typer.Typer(
 demo_app = typer.Typer(help="Built-in demonstrations.", no_args_is_help=True, rich_markup_mode="markdown")
 app.add_typer(demo_app, name="demo")
 app.add_typer(robot_app, name="robot", help="Robot arms (serial chains from DH tables or URDF): joint torques.")
+examples_app = typer.Typer(help="The example files installed with tumble: scenarios, robots, INS data.",
+                           no_args_is_help=True, rich_markup_mode="markdown")
+app.add_typer(examples_app, name="examples")
 
 # Tennis-racket demo: spin about the intermediate axis, perturbation on the
 # other two (rad/s, principal axes), and output rate. A flip of the default
@@ -260,6 +265,27 @@ def _demo_command(demo: Demo) -> Callable[..., None]:
 
 for _name, _demo in DEMOS.items():
     demo_app.command(_name)(_demo_command(_demo))
+
+
+@examples_app.command("list")
+def examples_list() -> None:
+    """Print every example file, one per line, as ``tumble.examples.path(NAME)`` takes it, and where it is."""
+    with _exit_codes():
+        names = _examples.names()
+    typer.echo(f"# in {_examples.directory()}")
+    for name in names:
+        typer.echo(name)
+
+
+@examples_app.command("copy")
+def examples_copy(
+    directory: Annotated[Path, typer.Argument(help="Directory to copy the examples into (created if missing; "
+                                                   "an existing file there is never overwritten).")],
+) -> None:
+    """Copy every example file into DIRECTORY, keeping the sub-directories, to edit and run."""
+    with _exit_codes():
+        written = _examples.copy(directory)
+    _print_rows([("copied", f"{len(written)} files into {directory}")])
 
 
 @app.command("sweep")

@@ -54,6 +54,7 @@ from .attitude import rotate
 from .dynamics import angular_momentum, kinetic_energy
 
 if TYPE_CHECKING:
+    import pandas
     import xarray
     from matplotlib.figure import Figure
 
@@ -509,11 +510,25 @@ class Trajectory:
 
         write_html(self, path, **options)
 
-    def _repr_html_(self) -> str | None:
-        """The viewer in a notebook cell (an ``<iframe>``; :func:`tumble.viewer.notebook_html`)."""
+    def _repr_html_(self) -> str:
+        """A notebook cell's view: the table of the run (model, method, samples, time span, solver statistics,
+        largest drifts of energy and angular momentum), then the viewer (an ``<iframe>``;
+        :func:`tumble.viewer.notebook_html`) where the trajectory can be drawn without its model."""
+        from tumble._tables import summary_html
         from tumble.viewer import notebook_html
 
-        return notebook_html(self)
+        return summary_html(self) + (notebook_html(self) or "")
+
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The samples as a pandas DataFrame indexed by ``t`` (s), or by ``(t, body)`` for a batch.
+
+        Columns ``q_w … q_z``, ``omega_x … omega_z`` (rad/s, body axes), ``energy`` (J),
+        ``momentum_body_x …`` (N m s, body axes) and one per component of each extra
+        (:func:`tumble._tables.to_dataframe`). pandas comes with xarray; it is imported on the first call.
+        """
+        from tumble._tables import to_dataframe
+
+        return to_dataframe(self)
 
     # -- figure ------------------------------------------------------------------------
 

@@ -7,7 +7,7 @@ floating base, mimic joints and named frames) and its special case
 joint states are plain arrays of shape (n,) or (B, n). The algorithms are
 compiled and batched::
 
-    chain = tumble.robot.load("examples/robots/puma560.toml")
+    chain = tumble.robot.load(tumble.examples.path("puma560.toml"))   # a file installed with tumble
     tau = tumble.robot.rnea(chain, q, qd, qdd)          # inverse dynamics (N·m)
     M = tumble.robot.mass_matrix(chain, q)              # joint-space inertia
     qdd = tumble.robot.forward_dynamics(chain, q, qd, tau)

@@ -1,6 +1,6 @@
 """Demonstration: the Franka Panda released under gravity, its joint angles and its energy balance.
 
-:func:`demo_robot` simulates the arm of ``examples/robots/panda.urdf`` (from the
+:func:`demo_robot` simulates the arm of ``tumble.examples.path("panda.urdf")`` (from the
 source tree, or the URDF given) falling from a bent pose with no joint torque
 (``tumble.simulate(chain, q0=..., t=...)``), and writes the trajectory (NetCDF)
 and a figure of the joint angles and of the drift of the total energy
@@ -33,7 +33,7 @@ _LINTHRESH = 1e-14
 
 
 def demo_robot(out_dir: Path, robot_file: Path) -> dict:
-    """Simulate an arm (the Panda: ``examples/robots/panda.urdf``) falling for 2 s from a bent pose
+    """Simulate an arm (the Panda: ``tumble.examples.path("panda.urdf")``) falling for 2 s from a bent pose
     (dop853, rtol = atol = 1e-12); write ``robot_fall.nc`` and ``.png``.
 
     Returns a summary: the written paths, the largest energy drift (J), the

@@ -26,7 +26,7 @@ the model has them, and wherever an orbit is needed the one ``orbit`` table
     rtol = 1e-12
     atol = 1e-12
 
-    >>> scenario = tumble.scenario.load("examples/intermediate_axis.toml")   # read, parsed, validated once
+    >>> scenario = tumble.scenario.load(tumble.examples.path("intermediate_axis.toml"))   # read, parsed, validated once
     >>> traj = scenario.run()          # a tumble.Trajectory; scenario.model is the tumble model
 
 The schema is documented in ``docs/scenarios.md``. Files are parsed once

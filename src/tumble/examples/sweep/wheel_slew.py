@@ -17,7 +17,7 @@ and keeps the pointing error (the rotation angle from the target attitude)
 at the end of the slew, t = 150 s, with its percentiles, and the pointing
 error over time (percentile bands).
 
-Run:  python examples/sweep/wheel_slew.py [SAMPLES] [figure.png]
+Run:  python src/tumble/examples/sweep/wheel_slew.py [SAMPLES] [figure.png]
 """
 
 from __future__ import annotations

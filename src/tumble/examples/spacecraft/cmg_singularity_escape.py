@@ -6,7 +6,7 @@ every torque column is normal to x, and is asked for 0.5 N·m along −x, the si
 figure of ``docs/spacecraft.md`` (``docs/img/spacecraft_cmg_escape.png``, or the path given as the first
 argument) and prints the numbers quoted there. Run from the repository root::
 
-    python examples/spacecraft/cmg_singularity_escape.py
+    python src/tumble/examples/spacecraft/cmg_singularity_escape.py
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ and keeps the time to flat spin: the first time the nutation angle (between
 the body z axis and the angular momentum) reaches 80°. Each sample's energy-
 sink estimate τ ln(θ_f/θ₀) is kept beside it for comparison.
 
-Run:  python examples/sweep/explorer1_damper.py [SAMPLES] [figure.png]
+Run:  python src/tumble/examples/sweep/explorer1_damper.py [SAMPLES] [figure.png]
 """
 
 from __future__ import annotations

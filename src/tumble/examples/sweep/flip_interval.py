@@ -6,7 +6,7 @@ sign every ``2K(m)/λ`` (``tumble.analytic.flip_interval``); the sweep measures
 that interval on each trajectory (zero crossings of ω_y, linearly
 interpolated between output times) over a grid of ε from 1e-6 to 1e-1 rad/s.
 
-Run:  python examples/sweep/flip_interval.py [figure.png]
+Run:  python src/tumble/examples/sweep/flip_interval.py [figure.png]
 """
 
 from __future__ import annotations
