@@ -15,7 +15,6 @@ import time
 
 import numpy as np
 
-import tumble
 from tumble.ensemble import ensemble_statistics
 
 
