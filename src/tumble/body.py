@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble import attitude
-from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis
+from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes  # noqa: F401 (re-exported: tumble.body.principal_axes)
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.rigid import RigidMotion
 
