@@ -61,7 +61,9 @@ class ChainMotion(Model):
 
     torque = ("joint torques and forces, one per joint, N·m (revolute) or N (prismatic): None (the arm moves "
               "under gravity alone), a constant (n,), or a Python function f(t, q, qd) -> (n,) of the time (s), "
-              "joint coordinates and rates (at Python speed, on one core)")
+              "joint coordinates and rates (at Python speed, on one core); with a floating base q and qd are the "
+              "whole configuration [base position, base quaternion, joints] (7 + n,) and velocity [base omega, "
+              "base velocity, joint rates] (6 + n,)")
 
     def state_fields(self) -> tuple[StateField, ...]:
         n = self.dof
