@@ -47,7 +47,10 @@ def drift(invariant, body, gravity, traj):
 TOL_DOP853 = 1e-12
 # exact_split4 (symplectic, order 4) at dt = 0.05 s over 1e4 time units: the error of a first integral is
 # bounded and O(dt⁴) (measured 4.3e-9 Kovalevskaya, 4.6e-9 G-C; 4.2e-9 and 3.7e-9 already in the first
-# tenth); 1e-12 needs dt ≈ 0.005 s (about 30 s of run, past the suite's budget). Bound 2e-8, and no growth:
+# tenth). The 1e-12 is out of reach for it: smaller steps make it worse, dt = 0.01 s gives 4.8e-10 and
+# dt = 0.005 s 9.5e-10 (Kovalevskaya; G-C 4.0e-10, 8.1e-10), growing linearly in t (4.9e-11 in the first
+# tenth at dt = 0.01 s): 1e6-2e6 steps of the exact free flow, each rounded, with a systematic part; dop853
+# at 1e-15 takes 1.5e5 steps and meets it (above). Bound 2e-8, and no growth:
 # the largest error of the last tenth of the run is within 2x the largest of the first tenth (a drift linear
 # in t would make it 9x).
 TOL_SPLIT = 2e-8
