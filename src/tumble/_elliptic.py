@@ -133,7 +133,7 @@ def jacobi_angle(u, quarter, ks, kcs, n, agm):
         s = (1.0 + k) * s
         c = c * d
         d = d_next
-    h = math.sqrt(s * s + c * c)
+    h = math.hypot(s, c)
     return int(j), math.copysign(s / h, r), c / h, d, math.copysign(sin_z, r), cos_z
 
 

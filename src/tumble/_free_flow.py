@@ -196,8 +196,8 @@ class _Motion(NamedTuple):
     ``ω_k = amp_k dn r`` at ``τ = tau0 + λ (t − t₀) = 2iK + r``; the attitude is
     ``q_NP(t) = h ⊗ exp(½ Δψ a) ⊗ p(t)*`` with ``a = axis_sign e_k``. With the
     nome series (``series``, coefficients ``theta``, :func:`_nome_series`)
-    ``exp(½ Δψ a) = exp(½ precession (t − t₀) a) · (S(τ)/|S(τ)|)^σ`` and the
-    factor of ``S(τ0)`` is in ``h``; otherwise
+    ``exp(½ Δψ a) = exp(½ precession (t − t₀) a) · (S(τ) S(τ0)*/|S(τ) S(τ0)|)^σ``
+    (a complex number standing for a rotation about ``a``); otherwise
     ``Δψ = rate (t − t₀) + B(τ) − bracket0`` (see :func:`torque_free`).
     """
 
@@ -231,7 +231,8 @@ class _Motion(NamedTuple):
     theta: np.ndarray     # (N, 2) nome-series coefficients (c_j, σ s_j)
     moments: tuple        # (I₁, I₂, I₃)
     omega0: tuple         # rate at t0 (principal axes)
-    bracket0: float       # B(tau0)
+    bracket0: float       # B(tau0) (R_J path)
+    phase0: tuple         # (S(τ0)*/|S(τ0)|)^σ as (re, im) (nome series)
     h: tuple              # quaternion q_NP(t0) ⊗ p(t0)
 
 
@@ -298,28 +299,32 @@ def _evaluate(mo, dt):
                                                           mo.nlev, mo.agm)
         w1, w2, w3, pw, px, py, pz = _rates_and_frame(mo, j, s, c, d)
         re, im = _nome_sum(mo.theta, sin_z, cos_z)
+        c0, s0 = mo.phase0
+        re, im = re * c0 - im * s0, re * s0 + im * c0  # (S(τ) S(τ0)*/|S(τ0)|)^σ: near 1 for a short dt
         half = 0.5 * mo.precession * dt
         ch, sh = math.cos(half), math.sin(half)
-        # exp(½Ω dt a) (S/|S|)^σ and p, both unnormalised: one norm for the product
+        # exp(½Ω dt a) (S(τ)/|S(τ)| S(τ0)*/|S(τ0)|)^σ and p, both unnormalised: the product is normalised
         rot_c, rot_s = ch * re - sh * im, (sh * re + ch * im) * mo.axis_sign
-        scale = 1.0 / math.sqrt((re * re + im * im) * (pw * pw + px * px + py * py + pz * pz))
     else:
         w1, w2, w3, pw, px, py, pz, bracket = _frame(mo, mo.tau0 + mo.lam * dt)
         half = 0.5 * (mo.rate * dt + (bracket - mo.bracket0))
         rot_c, rot_s = math.cos(half), math.sin(half) * mo.axis_sign
-        scale = 1.0
     if mo.k == 2:
         aw, ax, ay, az = _quat.qmul(hw, hx, hy, hz, rot_c, 0.0, 0.0, rot_s)
     else:
         aw, ax, ay, az = _quat.qmul(hw, hx, hy, hz, rot_c, rot_s, 0.0, 0.0)
     qw, qx, qy, qz = _quat.qmul(aw, ax, ay, az, pw, -px, -py, -pz)
+    if not mo.series:
+        return w1, w2, w3, qw, qx, qy, qz
+    scale = 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)  # of order 1: no overflow
     return w1, w2, w3, qw * scale, qx * scale, qy * scale, qz * scale
 
 
-# The nome series is used while q = exp(−πK'/K) ≤ 0.6 (m1 ≳ 1e-6): it then needs
-# at most 6 terms and |S| ≥ 0.4 on the real axis, so S/|S| keeps a relative
-# error of a few eps. Closer to the separatrix (q → 1) |S| dips towards 0
-# between terms of size ~1 and the R_J path is used instead.
+# The nome series is used while q = exp(−πK'/K) ≤ 0.6 (1 − m ≳ 7e-8): it then
+# needs at most 6 terms, and |S| ≥ 0.236 on the real axis against a sum of
+# term sizes ≤ 1.87 (worst over v ∈ [0, πK'/K], measured), so S/|S| keeps an
+# absolute error ≤ 8 eps. Closer to the separatrix (q → 1) |S| dips towards 0
+# between terms of size ~1, and the R_J path is used instead.
 _NOME_MAX = 0.6
 # Terms are summed while the bound q^{2j²}e^{jv} on the j-th exceeds 2^-60.
 _NOME_TAIL = 2.0 ** -60
@@ -407,7 +412,7 @@ def _steady(moments, omega, q):
     """The :class:`_Motion` of a constant rate: ``q(t) = q0 ⊗ exp(½ ω0 (t − t0))``."""
     return _Motion(True, False, 2, 0.0, 0.0, np.zeros(1), np.ones(1), 0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
                    1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, False, 0.0, np.zeros((0, 2)),
-                   moments, omega, 0.0, q)
+                   moments, omega, 0.0, (1.0, 0.0), q)
 
 
 @njit(cache=True)
@@ -453,19 +458,15 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     precession = rate + lam * coef * (half_pi - 0.5 * math.pi * beta / sqrt1n) / quarter
     mo = _Motion(
         False, separatrix, k, lam, quarter, ks, kcs, nlev, agm, sj * amp_j, sj * sk * amp_2, sk * amp_k, sk,
-        1.0 / momentum, beta, sqrt1n, *phase, series, precession, theta, moments, omega, 0.0, q0,
+        1.0 / momentum, beta, sqrt1n, *phase, series, precession, theta, moments, omega, 0.0, (1.0, 0.0), q0,
     )
-    if series:  # h = q0 ⊗ p(τ0) ⊗ (S(τ0)*/|S(τ0)|)^σ
+    if series:
         j0, s, c, d, sin_z, cos_z = _elliptic.jacobi_angle(tau0, quarter, ks, kcs, nlev, agm)
         _, _, _, pw, px, py, pz = _rates_and_frame(mo, j0, s, c, d)
+        norm = _quat.qnorm(pw, px, py, pz)
+        pw, px, py, pz = pw / norm, px / norm, py / norm, pz / norm
         re, im = _nome_sum(theta, sin_z, cos_z)
-        hw, hx, hy, hz = _quat.qmul(qw, qx, qy, qz, pw, px, py, pz)
-        rot_s = -im * mo.axis_sign
-        if k == 2:
-            hw, hx, hy, hz = _quat.qmul(hw, hx, hy, hz, re, 0.0, 0.0, rot_s)
-        else:
-            hw, hx, hy, hz = _quat.qmul(hw, hx, hy, hz, re, rot_s, 0.0, 0.0)
-        norm = _quat.qnorm(hw, hx, hy, hz)
-        return _Motion(*mo[:-2], 0.0, (hw / norm, hx / norm, hy / norm, hz / norm))
+        size = math.hypot(re, im)
+        return _Motion(*mo[:-3], 0.0, (re / size, -im / size), _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))
     _, _, _, pw, px, py, pz, bracket0 = _frame(mo, tau0)
-    return _Motion(*mo[:-2], bracket0, _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))
+    return _Motion(*mo[:-3], bracket0, (1.0, 0.0), _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))
