@@ -40,7 +40,10 @@ Regimes (:data:`REGIMES`) and the rates (Landau & Lifshitz, *Mechanics*,
 * ``"sphere"`` (``I₁ = I₃``) and ``"rest"`` (``ω = 0``): constant rate.
 
 The attitude construction (third-kind integral ``Π``) is described with
-:func:`torque_free`.
+:func:`torque_free`. Its periodic part is summed per time point by a nome
+(theta-function) series whose coefficients are fixed per body
+(:func:`_nome_series`: no ``R_J`` and no arctangent per point) while the
+nome ``q ≤ 0.6``; closer to the separatrix by Carlson's ``R_J`` (:func:`_frame`).
 """
 
 from __future__ import annotations
