@@ -73,3 +73,10 @@ def best_of(repeats, fn):
 def fmt(pair, unit="") -> str:
     """``min / median`` of a pair, 3 significant digits."""
     return f"{pair[0]:.3g} / {pair[1]:.3g}{unit}"
+
+
+def cpu_times(repeats, fn):
+    """CPU time of ``max(repeats, 5)`` calls of ``fn`` (s, all threads of the process): ``(min, median, last
+    result)`` — CPU time, not wall time, so that other work on a shared machine does not count."""
+    t = measure(fn, repeats)
+    return float(t.cpu.min()), float(np.median(t.cpu)), t.result

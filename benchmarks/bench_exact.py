@@ -1,11 +1,17 @@
 """Exact torque-free motion: cost per evaluation and accuracy, beside dop853, in one run.
 
-Prints, side by side:
+Prints the machine (CPU, cores, load average), then, side by side, each
+timing as the min and median over 5 repeats of its CPU time (all threads;
+the machine may be shared):
 
-1. one body, many output times: cost per evaluation (rate + attitude) of
-   ``torque_free`` on one core and on all cores, and the cost of
+1. one body, many output times: cost per evaluation (rate + attitude) of the
+   compiled free flow alone (``tumble._free_flow``: what ``method="exact"``
+   runs per output time) and of ``torque_free`` end to end (with the front
+   door's conversion to body axes and the Trajectory) on one core; the CPU
+   time per evaluation on all cores; ``scipy.special.ellipj`` (sn, cn, dn
+   only, no attitude) on as many points, the peer; and
    ``tumble.simulate(method="dop853")`` producing the same samples, with the
-   error of each against the exact solution;
+   error against the exact solution;
 2. a batch of bodies (random inertia, rates, attitudes), one output time
    each: cost per evaluation, including each body's set-up, beside dop853
    integrating the same batch to the same time;
@@ -23,17 +29,18 @@ Run by hand (not a test; timings vary with the machine)::
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
 import numba
 import numpy as np
+import scipy.special
+from numba import njit
 
 import tumble
-from _timing import best_of
-from tumble import attitude
-from tumble.analytic._free import torque_free
+from _timing import best_of, cpu_times, machine
+from tumble import _free_flow, attitude
+from tumble.analytic._free import free_parameters, torque_free
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from test_analytic_free import taylor_reference  # noqa: E402  (the 80-bit reference of the tests)
@@ -59,21 +66,50 @@ def motion_error(a, b):
     return max(np.abs(a.omega - b.omega).max(), attitude.relative_angle(a.q, b.q).max())
 
 
+@njit
+def free_flow_loop(moments, omega_p, q0, t, out):
+    """The compiled free flow alone: set up once, then ``out[i] = (ω_P, q_NP)`` at each ``t[i]``."""
+    motion = _free_flow._setup(moments[0], moments[1], moments[2], omega_p[0], omega_p[1], omega_p[2],
+                               q0[0], q0[1], q0[2], q0[3])
+    for i in range(t.shape[0]):
+        x = _free_flow._evaluate(motion, t[i] - t[0])
+        for c in range(7):
+            out[i, c] = x[c]
+
+
+def per_sample(times, n):
+    """``min/median`` in ns per sample from :func:`_timing.cpu_times`' figures."""
+    return f"{times[0] / n * 1e9:.0f}/{times[1] / n * 1e9:.0f}"
+
+
 def single_body(n_times, span, threads):
-    print(f"\n1. One body, {n_times:,} output times over {span:g} s (ns per output sample)")
-    print(f"{'case':30s} {'exact 1 core':>13s} {f'exact {threads} cores':>14s} {'dop853 1e-13':>13s} "
-          f"{'dop853 err':>11s}")
+    print(f"\n1. One body, {n_times:,} output times over {span:g} s: CPU ns per output sample, min/median of 5")
+    print(f"{'case':30s} {'nome q':>7s} {'kernel 1 core':>14s} {'exact 1 core':>13s} "
+          f"{f'exact {threads} cores':>14s} {'scipy ellipj':>13s} {'dop853 1e-13':>13s} {'dop853 err':>11s}")
     t = np.linspace(0.0, span, n_times)
+    out = np.empty((n_times, 7))
     for case, omega in CASES.items():
         body = body_of(case)
+        p = free_parameters(body.moments, omega)
+        nome = np.exp(-np.pi * scipy.special.ellipk(p.m1) / scipy.special.ellipk(p.m)) if 0 < p.m < 1 else p.m
+        args = (body.moments, np.array(omega, dtype=float), Q0, t, out)
+        free_flow_loop(*args)
         torque_free(body, omega, Q0, t=t[:2])
         numba.set_num_threads(1)
-        serial, exact = best_of(3, lambda: torque_free(body, omega, Q0, t=t))
+        kernel = cpu_times(5, lambda: free_flow_loop(*args))
+        serial = cpu_times(5, lambda: torque_free(body, omega, Q0, t=t))
+        exact = serial[2]
         numba.set_num_threads(threads)
-        parallel, _ = best_of(3, lambda: torque_free(body, omega, Q0, t=t))
+        parallel = cpu_times(5, lambda: torque_free(body, omega, Q0, t=t))
+        u = p.lam * t
+        peer = cpu_times(5, lambda: scipy.special.ellipj(u, p.m))
         numeric_time, numeric = best_of(1, lambda: tumble.simulate(body, omega, q0=Q0, t=t, rtol=1e-13, atol=1e-13))
-        print(f"{case:30s} {serial / n_times * 1e9:13.0f} {parallel / n_times * 1e9:14.0f} "
+        print(f"{case:30s} {nome:7.3f} {per_sample(kernel, n_times):>14s} {per_sample(serial, n_times):>13s} "
+              f"{per_sample(parallel, n_times):>14s} {per_sample(peer, n_times):>13s} "
               f"{numeric_time / n_times * 1e9:13.0f} {motion_error(exact, numeric):11.1e}")
+    print("kernel: the compiled free flow (tumble._free_flow) alone; exact: torque_free end to end; all cores:\n"
+          "CPU time summed over the threads; the attitude's periodic part by the nome series where q <= 0.6,\n"
+          "else by R_J (docs/exact.md); dop853: wall time, one run.")
 
 
 def batch(n_bodies, threads):
@@ -86,21 +122,22 @@ def batch(n_bodies, threads):
     q0 = attitude.normalize(rng.standard_normal((n_bodies, 4)))
     t = np.array([0.0, 10.0])
     body = tumble.RigidBody(np.diag(MOMENTS))
-    print(f"\n2. Batch of {n_bodies:,} states at t = 0 and 10 s (ns per body and output time, set-up included)")
+    print(f"\n2. Batch of {n_bodies:,} states at t = 0 and 10 s (CPU ns per body and output time, set-up "
+          f"included; exact: min/median of 5; dop853: wall, one run)")
     print(f"{'batch':42s} {'exact 1 core':>13s} {f'exact {threads} cores':>14s} {f'dop853 {threads} cores':>15s} "
           f"{'difference':>11s}")
     for label, bodies in (("one RigidBody, N initial states", body),
                           ("N bodies given as an (N, 3, 3) inertia array", inertia)):
         torque_free(bodies if bodies is body else bodies[:2], omega[:2], q0[:2], t=t)
         numba.set_num_threads(1)
-        serial, exact = best_of(3, lambda: torque_free(bodies, omega, q0, t=t))
+        serial = cpu_times(5, lambda: torque_free(bodies, omega, q0, t=t))
         numba.set_num_threads(threads)
-        parallel, _ = best_of(3, lambda: torque_free(bodies, omega, q0, t=t))
+        parallel = cpu_times(5, lambda: torque_free(bodies, omega, q0, t=t))
         numeric_time, numeric = best_of(
             1, lambda: tumble.simulate(bodies, omega, q0=q0, t=t, rtol=1e-13, atol=1e-13))
-        per = n_bodies * t.size / 1e9
-        print(f"{label:42s} {serial / per:13.0f} {parallel / per:14.0f} {numeric_time / per:15.0f} "
-              f"{motion_error(exact, numeric):11.1e}")
+        samples = n_bodies * t.size
+        print(f"{label:42s} {per_sample(serial, samples):>13s} {per_sample(parallel, samples):>14s} "
+              f"{numeric_time / samples * 1e9:15.0f} {motion_error(serial[2], numeric):11.1e}")
     print("(an (N, 3, 3) array builds one RigidBody per member in Python, ~40 us each, for both methods)")
 
 
@@ -138,8 +175,8 @@ def main():
     parser.add_argument("--quick", action="store_true", help="smaller sizes")
     args = parser.parse_args()
     threads = numba.config.NUMBA_NUM_THREADS
-    print(f"tumble exact torque-free benchmark: numba {numba.__version__}, {threads} threads, "
-          f"{os.cpu_count()} CPUs")
+    print(f"tumble exact torque-free benchmark: numba {numba.__version__}, scipy {scipy.__version__}, "
+          f"{threads} threads\n{machine()}")
     single_body(100_000 if args.quick else 1_000_000, 1000.0, threads)
     batch(20_000 if args.quick else 200_000, threads)
     accuracy()

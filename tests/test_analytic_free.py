@@ -330,6 +330,49 @@ def test_exact_to_a_few_ulp_against_extended_precision(moments, omega):
     assert attitude.relative_angle(exact.q, ref_q).max() <= TOL_VS_TAYLOR_ATTITUDE
 
 
+# The attitude's periodic part by the nome series against the same motion with
+# it by Carlson's R_J and arctangents (the form used past the nome q = 0.6):
+# the two share the rates and p(t) and differ in how ψ is summed; the series
+# keeps Ω t as one product where the R_J form adds j half periods, so they
+# part by eps × the angle turned (≤ 30 rad here; measured ≤ 1.1e-14).
+TOL_SERIES_VS_RJ = 4e-14
+
+
+def series_and_rj(moments, omega, times):
+    """Attitudes at ``times`` from one set-up, by the nome series and by the R_J path (principal axes)."""
+    motion = _free_flow._setup(*moments, *omega, *Q0)
+    assert motion.series
+    rj = motion._replace(series=False, bracket0=_free_flow._frame(motion, motion.tau0)[7])
+    return np.array([[_free_flow._evaluate(m, dt)[3:] for dt in times] for m in (motion, rj)])
+
+
+def test_nome_series_matches_carlson_r_j():
+    # both polhode families, |n| ≤ 1 and n < −1, from m = 0.02 to the nome q = 0.59 (1 − m = 1.1e-7, 1.7e-7)
+    rng = np.random.default_rng(11)
+    times = np.linspace(-10.0, 20.0, 31)
+    cases = [((1.0, 2.0, 3.0), (0.1, 0.2, 1.0)), ((1.0, 2.0, 3.0), (1.0, 0.3, -0.2)),
+             ((1.0, 2.0, 3.0), (2.3e-4, 1.0, 2.3e-4)), ((1.0, 2.0, 3.0), (1.5e-3, -1.0, -1.5e-3 / 1.8)),
+             ((1.0, 1.0 + 1e-7, 2.0), (0.2, 0.3, 1e-5)), ((1.0, 2.0, 2.0 + 1e-7), (1e-5, 0.3, 0.2))]
+    for _ in range(12):
+        moments = np.sort(rng.uniform(1.0, 3.0, 3))
+        cases.append((tuple(moments), tuple(rng.standard_normal(3))))
+    for moments, omega in cases:
+        series, rj = series_and_rj(moments, omega, times)
+        assert attitude.relative_angle(series, rj).max() <= TOL_SERIES_VS_RJ, (moments, omega)
+
+
+@pytest.mark.parametrize("omega", [(3e-4, 1.0, 3e-4), (1e-4, 1.0, 1e-4)], ids=["q = 0.58", "q = 0.62"])
+def test_either_side_of_the_nome_switch_against_extended_precision(omega):
+    # 1 − m = 1.8e-7 (the nome series) and 2e-8 (R_J). Over 10 s: the passage
+    # near the unstable intermediate axis amplifies the reference's own 80-bit
+    # rounding (by ~e^{λt}, λ = 0.58 /s), which over 20 s would reach 1e-14.
+    t = np.linspace(0.0, 10.0, 3)
+    exact = torque_free(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), omega, Q0, t=t)
+    ref_w, ref_q = taylor_reference([1.0, 2.0, 3.0], omega, Q0, t)
+    assert np.abs(exact.omega - ref_w).max() <= TOL_VS_TAYLOR_RATE
+    assert attitude.relative_angle(exact.q, ref_q).max() <= TOL_VS_TAYLOR_ATTITUDE
+
+
 @pytest.mark.parametrize("case", ["major", "minor", "near-separatrix-major"])
 @pytest.mark.parametrize("rotated", [False, True])
 def test_invariants_at_all_times(case, rotated, random_rotation):

@@ -12,7 +12,8 @@ at both ends: ``m1`` near 0 (modulus ``k → 1``, where ``K(m)`` diverges like
 * :func:`jacobi` — ``sn, cn, dn`` of a real argument by the descending Landen
   transformation (DLMF 22.7.1-3), in a ratio form that keeps full *relative*
   accuracy of ``cn`` and ``dn`` near the quarter period, after reduction of the
-  argument to ``[−K, K]``; :func:`ellipj` adds the amplitude ``am``;
+  argument to ``[−K, K]``; :func:`jacobi_angle` also returns the theta-function
+  argument ``z = πr/(2K)``'s sine and cosine; :func:`ellipj` adds the amplitude ``am``;
 * :func:`carlson_rf`, :func:`carlson_rj` — Carlson's symmetric integrals by the
   duplication algorithm (B. C. Carlson, "Numerical computation of real or
   complex elliptic integrals", Numer. Algorithms 10 (1995) 13-26), which give
@@ -89,9 +90,24 @@ def jacobi(u, quarter, ks, kcs, n, agm):
     ``cn = dn = sech u``). The full functions are ``sn u = (−1)^j sn r``,
     ``cn u = (−1)^j cn r``, ``dn u = dn r`` and the amplitude is
     ``am u = jπ + atan2(sn r, cn r)``, with ``|r| ≤ K`` and ``cn r ≥ 0``.
+    The method is that of :func:`jacobi_angle`.
+    """
+    if quarter == math.inf:
+        return 0, math.tanh(u), 1.0 / math.cosh(u), 1.0 / math.cosh(u)
+    j, s, c, d, _, _ = jacobi_angle(u, quarter, ks, kcs, n, agm)
+    return j, s, c, d
+
+
+@njit(cache=True)
+def jacobi_angle(u, quarter, ks, kcs, n, agm):
+    """:func:`jacobi` for ``m < 1`` and also ``(sin z, cos z)``, ``z = π r / (2K)``: ``(j, sn, cn, dn, sin z, cos z)``.
+
+    ``z`` is the argument of the theta functions, ``sn r = θ₃θ₁(z)/(θ₂θ₄(z))``
+    (DLMF 22.2.4); :mod:`tumble._free_flow` sums its nome series for the
+    attitude from these two numbers.
 
     Method: at the bottom of the Landen descent (modulus ``k_N ≈ 0``) the
-    functions are ``sin θ, cos θ, 1`` with ``θ = |r| a_N``, and
+    functions are ``sin θ, cos θ, 1`` with ``θ = |r| a_N = π|r|/(2K) = |z|``, and
     ``cos θ = sin((K − |r|) a_N)`` is used past ``π/4`` so that ``cn`` keeps
     its relative accuracy near ``r = K``. Climbing one level with the next
     modulus ``k`` (DLMF 22.7.1-3, with ``1 − k sn² = (1 − k) sn² + cn²``
@@ -101,17 +117,15 @@ def jacobi(u, quarter, ks, kcs, n, agm):
 
     and finally ``sn = s/√(s² + c²)``, ``cn = c/√(s² + c²)``. Every step is a
     product or a sum of non-negative terms, so the relative error stays a few
-    ulp for every ``r`` in ``[0, K]`` and every ``m`` in ``[0, 1]``.
+    ulp for every ``r`` in ``[0, K]`` and every ``m`` in ``[0, 1)``.
     """
-    if quarter == math.inf:
-        return 0, math.tanh(u), 1.0 / math.cosh(u), 1.0 / math.cosh(u)
     j = math.floor(u / (2.0 * quarter) + 0.5)
     r = u - 2.0 * quarter * j
     x = abs(r)
     theta = x * agm
-    s = math.sin(theta)
-    c = math.cos(theta) if theta < 0.25 * math.pi else math.sin((quarter - x) * agm)
-    d = 1.0
+    sin_z = math.sin(theta)
+    cos_z = math.cos(theta) if theta < 0.25 * math.pi else math.sin((quarter - x) * agm)
+    s, c, d = sin_z, cos_z, 1.0
     for i in range(n - 1, -1, -1):
         k = ks[i]
         s2, c2 = s * s, c * c
@@ -120,7 +134,7 @@ def jacobi(u, quarter, ks, kcs, n, agm):
         c = c * d
         d = d_next
     h = math.hypot(s, c)
-    return int(j), math.copysign(s / h, r), c / h, d
+    return int(j), math.copysign(s / h, r), c / h, d, math.copysign(sin_z, r), cos_z
 
 
 @njit(cache=True)

@@ -40,7 +40,10 @@ Regimes (:data:`REGIMES`) and the rates (Landau & Lifshitz, *Mechanics*,
 * ``"sphere"`` (``I₁ = I₃``) and ``"rest"`` (``ω = 0``): constant rate.
 
 The attitude construction (third-kind integral ``Π``) is described with
-:func:`torque_free`.
+:func:`torque_free`. Its periodic part is summed per time point by a nome
+(theta-function) series whose coefficients are fixed per body
+(:func:`_nome_series`: no ``R_J`` and no arctangent per point) while the
+nome ``q ≤ 0.6``; closer to the separatrix by Carlson's ``R_J`` (:func:`_frame`).
 """
 
 from __future__ import annotations
@@ -194,7 +197,10 @@ class _Motion(NamedTuple):
 
     The rates are ``ω_j = amp_j (−1)^i cn r``, ``ω₂ = amp_2 (−1)^i sn r``,
     ``ω_k = amp_k dn r`` at ``τ = tau0 + λ (t − t₀) = 2iK + r``; the attitude is
-    ``q_NP(t) = h ⊗ exp(½ Δψ a) ⊗ p(t)*`` with ``a = axis_sign e_k`` and
+    ``q_NP(t) = h ⊗ exp(½ Δψ a) ⊗ p(t)*`` with ``a = axis_sign e_k``. With the
+    nome series (``series``, coefficients ``theta``, :func:`_nome_series`)
+    ``exp(½ Δψ a) = exp(½ precession (t − t₀) a) · (S(τ) S(τ0)*/|S(τ) S(τ0)|)^σ``
+    (a complex number standing for a rotation about ``a``); otherwise
     ``Δψ = rate (t − t₀) + B(τ) − bracket0`` (see :func:`torque_free`).
     """
 
@@ -223,15 +229,19 @@ class _Motion(NamedTuple):
     chi: float            # 1 where Π is written with the n → m/n transformation, else 0
     sqrt_d: float         # √(1 + m − n − m/n)
     half_pi: float        # Π part of the bracket per half period (R_J and arctan terms)
+    series: bool          # the attitude by the nome series (else by R_J and arctangents)
+    precession: float     # Ω = rate + λ B(K)/K: the mean rate of ψ, rad/s (nome series)
+    theta: np.ndarray     # (N, 2) nome-series coefficients (c_j, σ s_j)
     moments: tuple        # (I₁, I₂, I₃)
     omega0: tuple         # rate at t0 (principal axes)
-    bracket0: float       # B(tau0)
+    bracket0: float       # B(tau0) (R_J path)
+    phase0: tuple         # (S(τ0)*/|S(τ0)|)^σ as (re, im) (nome series)
     h: tuple              # quaternion q_NP(t0) ⊗ p(t0)
 
 
 @njit(cache=True)
 def _frame(mo, tau):
-    """Rates, frame quaternion ``p`` (``a → l``) and bracket ``B`` at phase ``τ``.
+    """Rates, frame quaternion ``p`` (``a → l``, normalised) and bracket ``B`` at phase ``τ`` (R_J path).
 
     ``p = (1 + a·l, a × l) / |·|`` is the shortest rotation taking the body
     axis ``a`` to the unit momentum ``l = Iω/|L|`` (body axes); ``a·l = β dn τ ≥ 0``.
@@ -248,19 +258,35 @@ def _frame(mo, tau):
             third += math.atan2(mo.sqrt_d * s, c * d) / mo.sqrt_d
         g = (j * math.pi + math.atan2(mo.sqrt1n * s, c)) / mo.sqrt1n
         bracket = mo.coef * (2.0 * j * mo.half_pi + third - mo.beta * g)
+    w1, w2, w3, pw, px, py, pz = _rates_and_frame(mo, j, s, c, d)
+    norm = _quat.qnorm(pw, px, py, pz)
+    return w1, w2, w3, pw / norm, px / norm, py / norm, pz / norm, bracket
+
+
+@njit(cache=True)
+def _rates_and_frame(mo, j, s, c, d):
+    """Rates ``(ω₁, ω₂, ω₃)`` from ``(sn, cn, dn)`` of the reduced phase and ``p`` *unnormalised*."""
     sign = 1.0 - 2.0 * (j & 1)
     wc, w2, wd = mo.amp_j * sign * c, mo.amp_2 * sign * s, mo.amp_k * d
     i1, i2, i3 = mo.moments
     ad = 1.0 + mo.beta * d
     sl = mo.axis_sign * mo.inv_momentum
     if mo.k == 2:
-        w1, w3 = wc, wd
-        px, py, pz = -sl * i2 * w2, sl * i1 * w1, 0.0      # a × l, a = ±e₃
-    else:
-        w1, w3 = wd, wc
-        px, py, pz = 0.0, -sl * i3 * w3, sl * i2 * w2      # a × l, a = ±e₁
-    norm = _quat.qnorm(ad, px, py, pz)
-    return w1, w2, w3, ad / norm, px / norm, py / norm, pz / norm, bracket
+        return wc, w2, wd, ad, -sl * i2 * w2, sl * i1 * wc, 0.0      # a × l, a = ±e₃
+    return wd, w2, wc, ad, 0.0, -sl * i3 * wc, sl * i2 * w2          # a × l, a = ±e₁
+
+
+@njit(cache=True)
+def _nome_sum(theta, sin_z, cos_z):
+    """``S^σ`` at ``e^{2iz}`` (unnormalised): ``(1 + Σ c_j cos 2jz, Σ σ s_j sin 2jz)`` (:func:`_nome_series`)."""
+    cx, sx = (cos_z - sin_z) * (cos_z + sin_z), 2.0 * sin_z * cos_z  # cos 2z, sin 2z
+    cj, sj = cx, sx
+    re, im = 1.0, 0.0
+    for i in range(theta.shape[0]):
+        re += theta[i, 0] * cj
+        im += theta[i, 1] * sj
+        cj, sj = cj * cx - sj * sx, sj * cx + cj * sx
+    return re, im
 
 
 @njit(cache=True)
@@ -271,14 +297,82 @@ def _evaluate(mo, dt):
     if mo.steady:
         ew, ex, ey, ez = _quat.qexp(w1 * dt, w2 * dt, w3 * dt)
         return (w1, w2, w3, *_quat.qmul(hw, hx, hy, hz, ew, ex, ey, ez))
-    w1, w2, w3, pw, px, py, pz, bracket = _frame(mo, mo.tau0 + mo.lam * dt)
-    half = 0.5 * (mo.rate * dt + (bracket - mo.bracket0))
-    c, s = math.cos(half), math.sin(half) * mo.axis_sign
-    if mo.k == 2:
-        aw, ax, ay, az = _quat.qmul(hw, hx, hy, hz, c, 0.0, 0.0, s)
+    if mo.series:
+        j, s, c, d, sin_z, cos_z = _elliptic.jacobi_angle(mo.tau0 + mo.lam * dt, mo.quarter, mo.ks, mo.kcs,
+                                                          mo.nlev, mo.agm)
+        w1, w2, w3, pw, px, py, pz = _rates_and_frame(mo, j, s, c, d)
+        re, im = _nome_sum(mo.theta, sin_z, cos_z)
+        c0, s0 = mo.phase0
+        re, im = re * c0 - im * s0, re * s0 + im * c0  # (S(τ) S(τ0)*/|S(τ0)|)^σ: near 1 for a short dt
+        half = 0.5 * mo.precession * dt
+        ch, sh = math.cos(half), math.sin(half)
+        # exp(½Ω dt a) (S(τ)/|S(τ)| S(τ0)*/|S(τ0)|)^σ and p, both unnormalised: the product is normalised
+        rot_c, rot_s = ch * re - sh * im, (sh * re + ch * im) * mo.axis_sign
     else:
-        aw, ax, ay, az = _quat.qmul(hw, hx, hy, hz, c, s, 0.0, 0.0)
-    return (w1, w2, w3, *_quat.qmul(aw, ax, ay, az, pw, -px, -py, -pz))
+        w1, w2, w3, pw, px, py, pz, bracket = _frame(mo, mo.tau0 + mo.lam * dt)
+        half = 0.5 * (mo.rate * dt + (bracket - mo.bracket0))
+        rot_c, rot_s = math.cos(half), math.sin(half) * mo.axis_sign
+    if mo.k == 2:
+        aw, ax, ay, az = _quat.qmul(hw, hx, hy, hz, rot_c, 0.0, 0.0, rot_s)
+    else:
+        aw, ax, ay, az = _quat.qmul(hw, hx, hy, hz, rot_c, rot_s, 0.0, 0.0)
+    qw, qx, qy, qz = _quat.qmul(aw, ax, ay, az, pw, -px, -py, -pz)
+    if not mo.series:
+        return w1, w2, w3, qw, qx, qy, qz
+    scale = 1.0 / math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)  # of order 1: no overflow
+    return w1, w2, w3, qw * scale, qx * scale, qy * scale, qz * scale
+
+
+# The nome series is used while q = exp(−πK'/K) ≤ 0.6 (1 − m ≳ 7e-8): it then
+# needs at most 6 terms, and |S| ≥ 0.236 on the real axis against a sum of
+# term sizes ≤ 1.87 (worst over v ∈ [0, πK'/K], measured), so S/|S| keeps an
+# absolute error ≤ 8 eps. Closer to the separatrix (q → 1) |S| dips towards 0
+# between terms of size ~1, and the R_J path is used instead.
+_NOME_MAX = 0.6
+# Terms are summed while the bound q^{2j²}e^{jv} on the j-th exceeds 2^-60.
+_NOME_TAIL = 2.0 ** -60
+
+
+@njit(cache=True)
+def _nome_series(m, m1, n, quarter, sigma):
+    """``(usable, θ)``: coefficients ``θ[j−1] = (c_j, σ s_j)``, j ≥ 1, of the attitude's periodic part.
+
+    ``usable`` is False past :data:`_NOME_MAX` (then the R_J path is taken).
+
+    With ``1 − β² dn² = (1 − β²)(1 − n sn²)``, ``n = −β² m/(1 − β²)``, the
+    precession integrand ``1/(1 + β dn τ)`` is an elliptic function of ``τ``
+    (periods ``2K``, ``4iK'``) with simple poles only where ``dn τ = −1/β``:
+    ``τ = ±i(2K' − F*)`` with ``F* = F(asin (1 − n)^{-1/2} | m1) = R_F(−n, m − n, 1 − n)``.
+    Summing it by its poles (Whittaker & Watson §21.5; the Jacobi form of
+    ``Π``, DLMF 19.4, 22.16.30-32) gives, with ``z = πτ/(2K)``,
+    ``v = πF*/K`` and the nome of the doubled period ``q² = exp(−2πK'/K)``::
+
+        ψ(t) = Ω t + 2σ arg S(τ),   S = θ₄(z − iv/2 | q²) = 1 + Σ_j (c_j cos 2jz + i s_j sin 2jz),
+        c_j = 2(−1)^j q^{2j²} cosh jv,   s_j = 2(−1)^j q^{2j²} sinh jv          (DLMF 20.2.4)
+
+    where the weight of the residues is exactly ``2σ``, ``σ = sign(I_k − I_j)``
+    (so ``exp(iψ/2)`` is single-valued: no arctangent, no branch), and
+    ``Ω`` is the mean rate. ``S`` is ``2K``-periodic, with no zeros on the real
+    axis and no winding. Since ``v ≤ πK'/K``, the j-th term is below
+    ``2 q^{2j² − j}``.
+    """
+    if m == 0.0:  # a symmetric top: no periodic part
+        return True, np.zeros((0, 2))
+    complementary = _elliptic.carlson_rf(0.0, m, 1.0)  # K' = K(m1)
+    log_q2 = -2.0 * math.pi * complementary / quarter
+    if log_q2 > 2.0 * math.log(_NOME_MAX):
+        return False, np.zeros((0, 2))
+    v = math.pi * _elliptic.carlson_rf(-n, m - n, 1.0 - n) / quarter
+    terms = 1
+    while terms < 64 and math.exp(terms * terms * log_q2 + terms * v) > _NOME_TAIL:
+        terms += 1
+    theta = np.empty((terms - 1, 2))
+    for j in range(1, terms):
+        sign = 1.0 - 2.0 * (j & 1)  # (−1)^j; 2 cosh jv and 2 sinh jv as sums of exponentials
+        low = math.exp(j * j * log_q2 - j * v)
+        theta[j - 1, 0] = sign * (math.exp(j * j * log_q2 + j * v) + low)
+        theta[j - 1, 1] = sign * sigma * low * math.expm1(2.0 * j * v)
+    return True, theta
 
 
 @njit(cache=True)
@@ -320,7 +414,8 @@ def _phase_constants(separatrix, moments, k, j, m, m1, lam, momentum, beta, cn0,
 def _steady(moments, omega, q):
     """The :class:`_Motion` of a constant rate: ``q(t) = q0 ⊗ exp(½ ω0 (t − t0))``."""
     return _Motion(True, False, 2, 0.0, 0.0, np.zeros(1), np.ones(1), 0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
-                   1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, moments, omega, 0.0, q)
+                   1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, False, 0.0, np.zeros((0, 2)),
+                   moments, omega, 0.0, (1.0, 0.0), q)
 
 
 @njit(cache=True)
@@ -331,7 +426,9 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     initial point ``(cn, sn) ∝ (|ω_j|/A_j, s₂ω₂/A₂)`` (normalised; ``(1, 0)``
     for a rotation about axis k) as in the module docstring. Constant rates:
     rest, the sphere, a symmetric top turning about a transverse axis
-    (``λ = 0``) and the fixed point ``ω ∥ e₂`` of the separatrix.
+    (``λ = 0``) and the fixed point ``ω ∥ e₂`` of the separatrix. The mean
+    precession rate is ``Ω = rate + λ B(K)/K`` with the bracket over a half
+    period ``B(K) = coef (half_pi − β π/(2√(1 − n)))`` (``sn K = 1``, ``cn K = 0``).
     """
     code, _, momentum, m, m1, lam, d1, d2, d3 = _parameters(i1, i2, i3, w1, w2, w3)
     moments, omega, deltas, q0 = (i1, i2, i3), (w1, w2, w3), (d1, d2, d3), (qw, qx, qy, qz)
@@ -355,11 +452,24 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     quarter = 0.5 * math.pi / agm if not separatrix else math.inf
     beta = ik * amp_k / momentum
     n = -ik * abs(i2 - ij) / (ij * abs(ik - i2))
+    sqrt1n = math.sqrt(1.0 - n)
+    phase = _phase_constants(separatrix, moments, k, j, m, m1, lam, momentum, beta, cn0, sn0)
+    tau0, rate, coef, half_pi = phase[0], phase[1], phase[2], phase[8]
+    series, theta = False, np.zeros((0, 2))
+    if not separatrix:
+        series, theta = _nome_series(m, m1, n, quarter, math.copysign(1.0, coef))
+    precession = rate + lam * coef * (half_pi - 0.5 * math.pi * beta / sqrt1n) / quarter
     mo = _Motion(
         False, separatrix, k, lam, quarter, ks, kcs, nlev, agm, sj * amp_j, sj * sk * amp_2, sk * amp_k, sk,
-        1.0 / momentum, beta, math.sqrt(1.0 - n),
-        *_phase_constants(separatrix, moments, k, j, m, m1, lam, momentum, beta, cn0, sn0),
-        moments, omega, 0.0, q0,
+        1.0 / momentum, beta, sqrt1n, *phase, series, precession, theta, moments, omega, 0.0, (1.0, 0.0), q0,
     )
-    _, _, _, pw, px, py, pz, bracket0 = _frame(mo, mo.tau0)
-    return _Motion(*mo[:-2], bracket0, _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))
+    if series:
+        j0, s, c, d, sin_z, cos_z = _elliptic.jacobi_angle(tau0, quarter, ks, kcs, nlev, agm)
+        _, _, _, pw, px, py, pz = _rates_and_frame(mo, j0, s, c, d)
+        norm = _quat.qnorm(pw, px, py, pz)
+        pw, px, py, pz = pw / norm, px / norm, py / norm, pz / norm
+        re, im = _nome_sum(theta, sin_z, cos_z)
+        size = math.hypot(re, im)
+        return _Motion(*mo[:-3], 0.0, (re / size, -im / size), _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))
+    _, _, _, pw, px, py, pz, bracket0 = _frame(mo, tau0)
+    return _Motion(*mo[:-3], bracket0, (1.0, 0.0), _quat.qmul(qw, qx, qy, qz, pw, px, py, pz))

@@ -138,9 +138,11 @@ def torque_free(body, omega0, q0=None, *, t) -> Trajectory:
     """Exact torque-free motion of a rigid body (or a batch): body rate and attitude at the times ``t``.
 
     Closed form (no integration): Jacobi elliptic functions for the rate and
-    an incomplete elliptic integral of the third kind for the attitude,
-    evaluated at each output time independently; accurate to rounding over
-    any time span. See the module docstring and ``docs/exact.md``.
+    an incomplete elliptic integral of the third kind for the attitude (its
+    periodic part summed as a theta-function series in the nome, or by
+    Carlson's ``R_J`` within ``1 − m ≲ 7e-8`` of the separatrix), evaluated at
+    each output time independently; accurate to rounding over any time span.
+    See the module docstring and ``docs/exact.md``.
 
     Attitude (Celledoni et al. 2008). ``L_N`` is constant; with the unit
     momentum ``l = Iω/|L|`` in principal axes (given by the rates), a fixed
