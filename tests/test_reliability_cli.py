@@ -129,7 +129,7 @@ def test_info_refuses_damaged_and_hostile_files_in_one_line(saved, tmp_path, dam
     ("bad.toml", b"name = \"\xff\"\n", "bad.toml"),
     ("bad.urdf", b'<robot name="r"><link name="base"/><link name="a"/><joint name="j1" type="revolute">'
                  b'<parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>',
-     "link 'a' <inertial>: the last moving link has no mass"),
+     "link 'a' <inertial>: the link moved by joint 'j1' and every link beyond it have no mass"),
     ("deep.toml", b"a = " + b"[" * 1000 + b"]" * 1000 + b"\n", "deep.toml"),
 ])
 def test_robot_torques_refuses_bad_robot_files_in_one_line(tmp_path, name, content, message):

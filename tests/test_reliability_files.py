@@ -36,7 +36,7 @@ def test_a_second_writer_to_the_same_path_is_refused_and_the_first_wins(tmp_path
         assert out.read_text() == "old"
         first.stdin.write("done\n")  # the first writer finishes
         first.stdin.close()
-        assert first.wait(timeout=30) == 0
+        assert first.wait(timeout=120) == 0
     finally:
         first.kill()
         first.wait()
@@ -69,7 +69,7 @@ def test_a_run_interrupted_while_writing_leaves_no_temporary_file(tmp_path, sig,
     try:
         assert child.stdout.readline() == "writing\n"
         child.send_signal(sig)
-        assert child.wait(timeout=30) == code  # SIGINT: KeyboardInterrupt, then Python dies of SIGINT
+        assert child.wait(timeout=120) == code  # SIGINT: KeyboardInterrupt, then Python dies of SIGINT
     finally:
         child.kill()
         child.wait()

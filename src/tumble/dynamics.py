@@ -111,6 +111,21 @@ def euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3):
     )
 
 
+@register_jitable
+def rigid_rates(c1, c2, c3, r1, r2, r3, qw, qx, qy, qz, w1, w2, w3, t1, t2, t3):
+    """``dy/dt`` of one rigid body from its state ``(q, ω)`` and torque ``τ`` (N·m, principal axes):
+    ``(½ q ⊗ [0, ω], ω̇)`` with ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic (:func:`euler_principal`,
+    coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``).
+
+    The one right-hand side of the rigid body, compiled into the CPU kernel
+    (:mod:`tumble.kernels.rigid`) and the GPU kernel of
+    :mod:`tumble.integrate._cuda` alike, so that both round alike.
+    """
+    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
+    a1, a2, a3 = euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3)
+    return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
+
+
 @njit(cache=True)
 def _omega_dot_principal_batch(moments, omega, torque, out):
     for k in range(omega.shape[0]):

@@ -43,10 +43,10 @@ from numba import cuda, types
 from numba.extending import overload, register_jitable
 
 from tumble import torques
+from tumble.dynamics import rigid_rates
 from tumble._validate import ValidationError
 from tumble.integrate._fixed import landing_steps
 from tumble.integrate._rk4 import axpy, update
-from tumble.kernels.rigid import rates
 
 #: Threads per block, a multiple of the warp (32). The kernel uses no shared
 #: memory, so what limits the warps resident on a multiprocessor is registers:
@@ -85,11 +85,11 @@ def _torque_by_type(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
 
 @register_jitable
 def _derivative(c, P, row, codes, t, y):
-    """``dy/dt`` of one body: the rigid body's one right-hand side (:func:`tumble.kernels.rigid.rates`)
+    """``dy/dt`` of one body: the rigid body's one right-hand side (:func:`tumble.dynamics.rigid_rates`)
     with coefficients ``c`` and the torque of ``codes``."""
     qw, qx, qy, qz, w1, w2, w3 = y
     t1, t2, t3 = _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
-    return rates(c[0], c[1], c[2], c[3], c[4], c[5], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
+    return rigid_rates(c[0], c[1], c[2], c[3], c[4], c[5], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
 
 
 @register_jitable

@@ -15,10 +15,9 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, types
-from numba.extending import register_jitable
 
-from tumble import _free_flow, _protocol, _quat, torques
-from tumble.dynamics import euler_coefficients, euler_principal
+from tumble import _free_flow, _protocol, torques
+from tumble.dynamics import euler_coefficients, rigid_rates
 
 STATE_SIZE = 7
 
@@ -79,21 +78,6 @@ def from_principal(moments, axes, model) -> RigidModel:
 
 
 
-@register_jitable
-def rates(c1, c2, c3, r1, r2, r3, qw, qx, qy, qz, w1, w2, w3, t1, t2, t3):
-    """``dy/dt`` of one body from its state ``(q, ω)`` and torque ``τ`` (N·m, principal axes):
-    ``(½ q ⊗ [0, ω], ω̇)`` with ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic
-    (:func:`tumble.dynamics.euler_principal`, coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``).
-
-    The one right-hand side of the rigid body, compiled into the CPU
-    integrators and the GPU kernel of :mod:`tumble.integrate._cuda` alike, so
-    that both round alike.
-    """
-    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-    a1, a2, a3 = euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3)
-    return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
-
-
 @_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
 def _rigid_point_rates(model, b, t, y):
     if isinstance(model.types[2], types.NoneType):  # torque-free: no torque code at all
@@ -116,7 +100,7 @@ def _rigid_point_rates(model, b, t, y):
         r = b
         qw, qx, qy, qz, w1, w2, w3 = y
         t1, t2, t3 = torque(model, b, t, qw, qx, qy, qz, w1, w2, w3)
-        return rates(c[0, r], c[1, r], c[2, r], c[3, r], c[4, r], c[5, r], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
+        return rigid_rates(c[0, r], c[1, r], c[2, r], c[3, r], c[4, r], c[5, r], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
 
     return impl
 
