@@ -15,8 +15,6 @@ the cores and the load average first: on a shared machine the medians move with 
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import sys
 import time
 from importlib import metadata
@@ -27,6 +25,8 @@ import numpy as np
 
 import tumble
 from tumble import robot
+
+from _timing import machine
 
 
 try:
@@ -47,17 +47,6 @@ def robots() -> dict[str, tuple[Path, bool]]:
                   "talos": (erd / "talos_data/robots/talos_full_v2.urdf", True),
                   "solo12": (erd / "solo_description/robots/solo12.urdf", True)})
     return cases
-
-
-def machine() -> str:
-    cpu = platform.processor() or "?"
-    try:
-        with open("/proc/cpuinfo") as fh:
-            cpu = next(line.split(":", 1)[1].strip() for line in fh if line.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    return (f"{cpu}; {os.cpu_count()} cores, {numba.get_num_threads()} Numba threads; load average "
-            f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}; Python {platform.python_version()}")
 
 
 def timed(fn, calls: int, repeats: int) -> tuple[float, float]:
@@ -95,7 +84,7 @@ def main():
     parser.add_argument("--calls", type=int, default=2000, help="single calls per repeat")
     parser.add_argument("--repeats", type=int, default=7, help="repeats (min and median are printed), >= 5")
     args = parser.parse_args()
-    print(machine())
+    print(f"{machine()}; {numba.get_num_threads()} Numba threads")
     print(f"tumble.robot vs {'Pinocchio ' + pin.__version__ if pin else 'no Pinocchio'}; batch of {args.batch}; "
           "µs per call (one state) or per sample (batch B); each cell min/median")
     cols = ["RNEA 1", "RNEA B", "pin.rnea", "pin.rneaPar", "CRBA 1", "pin.crba", "FD 1", "FD B", "pin.aba"]

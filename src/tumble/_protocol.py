@@ -254,6 +254,25 @@ def rate_at(offset, Y):
     return lambda model, Y, j: (Y[offset, j], Y[offset + 1, j], Y[offset + 2, j])
 
 
+def rhs_of_eight(derivative, Y):
+    """``rhs`` for a model of eight state values whose jitted ``derivative(model, t, y0, ..., y7)`` returns
+    their eight rates as a tuple (held in registers): on the state itself, or on each lane ``Y[:, j]``."""
+    if Y.ndim == 1:
+
+        def impl(model, b0, t, Y, OUT):
+            (OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6], OUT[7]) = derivative(
+                model, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6], Y[7])
+
+        return impl
+
+    def impl(model, b0, t, Y, OUT):
+        for j in range(Y.shape[1]):
+            (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j], OUT[7, j]) = \
+                derivative(model, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j], Y[7, j])
+
+    return impl
+
+
 def lanewise_rhs(derivative, Y):
     """``rhs`` for a model whose jitted ``derivative(model, t, y, out)`` works on one state vector:
     called on the state itself, or on each lane ``Y[:, j]`` of a block."""

@@ -95,20 +95,7 @@ def _frame_rhs(model, b0, t, Y, OUT):
         d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, frame3)
         return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3, w3 - frame3
 
-    if Y.ndim == 1:
-
-        def impl(model, b0, t, Y, OUT):
-            (OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6], OUT[7]) = derivative(
-                model, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6], Y[7])
-
-    else:
-
-        def impl(model, b0, t, Y, OUT):
-            for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j], OUT[7, j]) = \
-                    derivative(model, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j], Y[7, j])
-
-    return impl
+    return _protocol.rhs_of_eight(derivative, Y)
 
 
 @njit(cache=True)

@@ -125,20 +125,7 @@ def _variable_rhs(model, b0, t, Y, OUT):
         dl = torque_rate(model, t, qw, qx, qy, qz, w1, w2, w3)
         return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], dl[0], dl[1], dl[2], 1.0
 
-    if Y.ndim == 1:
-
-        def impl(model, b0, t, Y, OUT):
-            (OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6], OUT[7]) = derivative(
-                model, t, Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6], Y[7])
-
-    else:
-
-        def impl(model, b0, t, Y, OUT):
-            for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j], OUT[7, j]) = \
-                    derivative(model, t, Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j], Y[7, j])
-
-    return impl
+    return _protocol.rhs_of_eight(derivative, Y)
 
 
 @_protocol.implements(_protocol.project, VariableModel, inline=True)
