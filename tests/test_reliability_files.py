@@ -44,9 +44,13 @@ def test_a_second_writer_to_the_same_path_is_refused_and_the_first_wins(tmp_path
 
 
 WRITER = """
-import sys, time
+import signal, sys, time
 from pathlib import Path
 from tumble.trajectory import write_atomic
+
+# Ctrl-C raises KeyboardInterrupt, as in a terminal, even where this process was started with SIGINT ignored
+# (a shell's background job, as CI may run the suite)
+signal.signal(signal.SIGINT, signal.default_int_handler)
 
 def write(tmp):
     Path(tmp).write_text("partial")
