@@ -120,10 +120,12 @@ def nutation_angle(traj: Trajectory, axis) -> np.ndarray:
     a = as_array(axis, "axis", tail=(3,))
     if a.shape != (3,) or not np.linalg.norm(a) > 0.0:
         raise ValidationError(f"axis: must be a non-zero vector of shape (3,), got {a.tolist()}")
+    a = a / np.linalg.norm(a)
     L = traj.momentum_body
-    cos = (L @ a) / (np.linalg.norm(L, axis=-1) * np.linalg.norm(a))
-    sin = np.linalg.norm(np.cross(L, a), axis=-1) / (np.linalg.norm(L, axis=-1) * np.linalg.norm(a))
-    return np.arctan2(sin, cos)
+    x, y, z = L[..., 0], L[..., 1], L[..., 2]
+    along = x * a[0] + y * a[1] + z * a[2]  # L·a
+    across = np.sqrt((y * a[2] - z * a[1]) ** 2 + (z * a[0] - x * a[2]) ** 2 + (x * a[1] - y * a[0]) ** 2)  # |L × a|
+    return np.arctan2(across, along)  # atan2 of the two (|L| cancels): accurate at 0 and π/2 alike
 
 
 def energy_sink_time_constant(axial: float, transverse: float, damper: SphericalDamper, spin: float) -> float:
