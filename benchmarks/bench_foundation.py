@@ -57,34 +57,23 @@ def euler_rhs(t, y):
                      C1 * w2 * w3, C2 * w3 * w1, C3 * w1 * w2])
 
 
-def numpy_rk4(y, dt, steps):
-    """A hand-written RK4 loop in NumPy (the peer for the per-step cost)."""
+def rk4_loop(rhs, y, dt, steps):
+    """A hand-written RK4 loop on ``rhs(t, y)``, normalising q each step: in NumPy with :func:`euler_rhs`
+    (the peer for the per-step cost), and the same loop under ``@njit`` with the right-hand side under
+    ``@njit``, as a user would write it (the issue's 'naive Numba loop')."""
     for k in range(steps):
         t = k * dt
-        k1 = euler_rhs(t, y)
-        k2 = euler_rhs(t + dt / 2, y + dt / 2 * k1)
-        k3 = euler_rhs(t + dt / 2, y + dt / 2 * k2)
-        k4 = euler_rhs(t + dt, y + dt * k3)
+        k1 = rhs(t, y)
+        k2 = rhs(t + dt / 2, y + dt / 2 * k1)
+        k3 = rhs(t + dt / 2, y + dt / 2 * k2)
+        k4 = rhs(t + dt, y + dt * k3)
         y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        y[:4] /= np.linalg.norm(y[:4])
+        y[:4] /= np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2 + y[3] ** 2)
     return y
 
 
 naive_rhs = njit(euler_rhs)
-
-
-@njit
-def naive_numba_rk4(y, dt, steps):
-    """The NumPy loop above under @njit, as a user would write it (the issue's 'naive Numba loop')."""
-    for k in range(steps):
-        t = k * dt
-        k1 = naive_rhs(t, y)
-        k2 = naive_rhs(t + dt / 2, y + dt / 2 * k1)
-        k3 = naive_rhs(t + dt / 2, y + dt / 2 * k2)
-        k4 = naive_rhs(t + dt, y + dt * k3)
-        y = y + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        y[:4] /= np.sqrt(y[0] ** 2 + y[1] ** 2 + y[2] ** 2 + y[3] ** 2)
-    return y
+naive_numba_rk4 = njit(rk4_loop)
 
 
 def single_body(steps):
@@ -96,11 +85,11 @@ def single_body(steps):
     out, stats = np.empty((2, 1, 7)), np.zeros((1, 5))
     run = lambda: _fixed.run_one(_rk4.SCHEME, model, y.copy(), t, m, h, out, stats)  # noqa: E731
     run()  # compile / load from cache
-    naive_numba_rk4(y[0].copy(), 1e-3, 10)
+    naive_numba_rk4(naive_rhs, y[0].copy(), 1e-3, 10)
     ns = lambda timing, n: tuple(1e9 / r for r in timing.rates(n)["cpu"])  # noqa: E731
     return {"tumble": ns(measure(run), steps),
-            "naive Numba": ns(measure(lambda: naive_numba_rk4(y[0].copy(), 1e-3, steps)), steps),
-            "NumPy": ns(measure(lambda: numpy_rk4(y[0].copy(), 1e-3, 2000)), 2000)}
+            "naive Numba": ns(measure(lambda: naive_numba_rk4(naive_rhs, y[0].copy(), 1e-3, steps)), steps),
+            "NumPy": ns(measure(lambda: rk4_loop(euler_rhs, y[0].copy(), 1e-3, 2000)), 2000)}
 
 
 def c_reference():
