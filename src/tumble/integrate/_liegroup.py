@@ -54,14 +54,14 @@ class CF4(NamedTuple):
 SCHEME = CF4()
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def rotate_right(qw, qx, qy, qz, rx, ry, rz):
     """``q ⊗ qexp(r)``: ``q`` followed by the rotation of rotation vector ``r`` (rad, body axes)."""
     ew, ex, ey, ez = _quat.qexp(rx, ry, rz)
     return times_unit(qw, qx, qy, qz, ew, ex, ey, ez)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def times_unit(qw, qx, qy, qz, ew, ex, ey, ez):
     """``q ⊗ e`` for a unit quaternion ``e`` (an exponential of :func:`tumble._quat.qexp`), keeping ``|q|``.
 
@@ -160,7 +160,7 @@ def _cf4_step(model, b0, t, h, Y, K, S, W, Q2):
             Y[i, j] += h / 6.0 * (K[0, i, j] + 2.0 * K[1, i, j] + 2.0 * K[2, i, j] + K[3, i, j])
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _combine(W, weights, h, j):
     """The rotation vector ``h Σₛ weights[s] ωₛ`` of lane ``j`` (rad)."""
     a, b, c, d = weights
