@@ -37,7 +37,9 @@ def _simulate(method: str, *, members: int = 1, torque=None) -> Callable[[], Non
     return run
 
 
-def _heavy_top() -> object:
+def _heavy_top():
+    """The heavy-top torque of the paths: 1 kg, centre of mass 0.1 m along body z from the pivot, standard
+    gravity along −z inertial (:class:`tumble.torques.Gravity`)."""
     from tumble import torques
 
     return torques.Gravity(1.0, [0.0, 0.0, 0.1])

@@ -57,6 +57,15 @@ def _array(value, name: str) -> np.ndarray:
     return arr
 
 
+def _set_broadcast(dispersion, **arrays) -> None:
+    """Set the fields ``arrays`` of a frozen elementwise dispersion, broadcast to one shape, and its
+    ``n_raw``: one uniform variate per component."""
+    shape = np.broadcast_shapes(*(a.shape for a in arrays.values()))
+    for name, value in arrays.items():
+        object.__setattr__(dispersion, name, np.broadcast_to(value, shape))
+    object.__setattr__(dispersion, "n_raw", math.prod(shape))
+
+
 class Dispersion(abc.ABC):
     """How one input varies over the samples; ``shape`` is that of one sample's value."""
 
@@ -85,10 +94,7 @@ class Normal(Dispersion):
         mean, std = _array(self.mean, "mean"), _array(self.std, "std")
         if np.any(std < 0):
             raise ValidationError(f"std: must be >= 0, got {std.tolist()}")
-        shape = np.broadcast_shapes(mean.shape, std.shape)
-        object.__setattr__(self, "mean", np.broadcast_to(mean, shape))
-        object.__setattr__(self, "std", np.broadcast_to(std, shape))
-        object.__setattr__(self, "n_raw", math.prod(shape))
+        _set_broadcast(self, mean=mean, std=std)
 
     @property
     def shape(self):
@@ -110,12 +116,9 @@ class Uniform(Dispersion):
 
     def __post_init__(self):
         low, high = _array(self.low, "low"), _array(self.high, "high")
-        shape = np.broadcast_shapes(low.shape, high.shape)
         if np.any(high < low):
             raise ValidationError(f"high: must be >= low, got low {low.tolist()}, high {high.tolist()}")
-        object.__setattr__(self, "low", np.broadcast_to(low, shape))
-        object.__setattr__(self, "high", np.broadcast_to(high, shape))
-        object.__setattr__(self, "n_raw", math.prod(shape))
+        _set_broadcast(self, low=low, high=high)
 
     @property
     def shape(self):
@@ -146,12 +149,9 @@ class TruncatedNormal(Dispersion):
             raise ValidationError(f"std: must be > 0, got {std.tolist()}")
         low = _array(mean - 3 * std if self.low is None else self.low, "low")
         high = _array(mean + 3 * std if self.high is None else self.high, "high")
-        shape = np.broadcast_shapes(mean.shape, std.shape, low.shape, high.shape)
         if np.any(high <= low):
             raise ValidationError(f"high: must be > low, got low {low.tolist()}, high {high.tolist()}")
-        for name, value in (("mean", mean), ("std", std), ("low", low), ("high", high)):
-            object.__setattr__(self, name, np.broadcast_to(value, shape))
-        object.__setattr__(self, "n_raw", math.prod(shape))
+        _set_broadcast(self, mean=mean, std=std, low=low, high=high)
 
     @property
     def shape(self):
