@@ -41,10 +41,16 @@ def drift(invariant, body, gravity, traj):
 
 
 # dop853 at its tightest tolerance (rtol = atol = 1e-15, ~1.5e5 steps) over 1e4 time units: the drift of an
-# invariant is the accumulated local error and rounding, measured 6.4e-13 (Kovalevskaya, K = 2.01 rad⁴/s⁴) and
-# 7.8e-13 (G-C, G = 1.09 rad³/s³) relative, the energy ≤ 4.7e-13. (An initial state whose invariant is small
-# against its terms, G = 0.026 with terms ≈ 1, reads 40x larger relative to itself.) The bound, 1e-12.
-TOL_DOP853 = 1e-12
+# invariant is the accumulated local error (it scales with rtol: 1.2e-11 at 1e-14, 1.6e-10 at 1e-13), and it
+# depends on the last bits of the start. The same code measured 6.4e-13 (Kovalevskaya, K = 2.01 rad⁴/s⁴) and
+# 7.8e-13 (G-C, G = 1.09 rad³/s³) relative under OpenBLAS's Haswell kernels, and 1.07e-12 and 1.23e-12 under
+# its AVX-512 kernels (OPENBLAS_CORETYPE): LAPACK's eigen-decomposition of the turned inertia, behind the
+# principal axes, differs in its last bit between the two. The energy: ≤ 4.7e-13 under both. The bound,
+# 1e-12, is met under one and missed by up to 23 % under the other; the bound here is 2e-12 for the two
+# invariants and 1e-12 for the energy. (An initial state whose invariant is small against its terms, G = 0.026
+# with terms ≈ 1, reads 40x larger relative to itself.)
+TOL_DOP853 = 2e-12
+TOL_DOP853_ENERGY = 1e-12
 # exact_split4 (symplectic, order 4) at dt = 0.05 s over 1e4 time units: the error of a first integral is
 # bounded and O(dt⁴) (measured 4.3e-9 Kovalevskaya, 4.6e-9 G-C; 4.2e-9 and 3.7e-9 already in the first
 # tenth). The 1e-12 is out of reach for it: smaller steps make it worse, dt = 0.01 s gives 4.8e-10 and
@@ -62,7 +68,7 @@ def test_invariant_kept_over_1e4_time_units_by_dop853(name):
     traj = tumble.simulate(body, omega0=omega0, q0=Q0, t=SPAN, torque=gravity, method="dop853", rtol=1e-15,
                            atol=1e-15)
     assert drift(invariant, body, gravity, traj) <= TOL_DOP853
-    assert drift(heavy_top_energy, body, gravity, traj) <= TOL_DOP853
+    assert drift(heavy_top_energy, body, gravity, traj) <= TOL_DOP853_ENERGY
 
 
 @pytest.mark.parametrize("name", CASES)
@@ -83,7 +89,7 @@ def test_kovalevskaya_invariant_drifts_for_a_perturbed_inertia():
     traj = tumble.simulate(perturbed, omega0=omega0, q0=Q0, t=SPAN[:11], torque=gravity, method="dop853",
                            rtol=1e-15, atol=1e-15)
     assert drift(kovalevskaya_invariant, body, gravity, traj) > 1e-2
-    assert drift(heavy_top_energy, perturbed, gravity, traj) <= TOL_DOP853
+    assert drift(heavy_top_energy, perturbed, gravity, traj) <= TOL_DOP853_ENERGY
 
 
 def test_invariants_do_not_depend_on_the_body_axes():
