@@ -44,7 +44,7 @@ class GimbalModel(NamedTuple):
         return False
 
 
-@njit(inline="always")
+@njit(cache=True)
 def _derivative(p, qw, qx, qy, qz, phi_dot, theta_dot, spin):
     """d/dt of the state (the equations of the module docstring); ψ does not enter."""
     It, Is, A, B, C, J, mgl, tau_theta, tau_phi, c_phi, c_spin = (
@@ -64,7 +64,7 @@ def _derivative(p, qw, qx, qy, qz, phi_dot, theta_dot, spin):
     return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], phi_ddot, theta_ddot, spin_dot, psi_dot
 
 
-@_protocol.implements(_protocol.rhs, GimbalModel, inline=True)
+@_protocol.implements(_protocol.rhs, GimbalModel)
 def _gimbal_rhs(model, b0, t, Y, OUT):
     if Y.ndim == 1:
 
@@ -82,7 +82,7 @@ def _gimbal_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@_protocol.implements(_protocol.project, GimbalModel, inline=True)
+@_protocol.implements(_protocol.project, GimbalModel)
 def _gimbal_project(model, b0, t, Y):
     return _protocol.quaternion_projection(Y)
 
