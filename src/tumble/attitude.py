@@ -128,13 +128,17 @@ def _batch(*args: tuple[str, np.ndarray, int]) -> tuple[int, ...]:
 # --------------------------------------------------------------------------
 # Compiled batch loops over flattened arrays; they call the _quat kernels.
 # Inputs are validated (finite, non-zero where a rotation is meant) before.
+# Results are stored component by component: assigning a tuple to a row
+# (out[n] = ...) compiles Numba's shape-mismatch message formatter, 1.8 s of
+# CPU in the first process that needs it (Numba 0.68).
 # --------------------------------------------------------------------------
 
 
 @njit(cache=True)
 def _multiply_loop(p, q, out):
     for n in range(out.shape[0]):
-        out[n] = qmul(p[n, 0], p[n, 1], p[n, 2], p[n, 3], q[n, 0], q[n, 1], q[n, 2], q[n, 3])
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qmul(p[n, 0], p[n, 1], p[n, 2], p[n, 3],
+                                                          q[n, 0], q[n, 1], q[n, 2], q[n, 3])
 
 
 @njit(cache=True)
@@ -151,9 +155,9 @@ def _rotate_loop(q, v, inverse, out):
         s = qnorm(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
         w, x, y, z = q[n, 0] / s, q[n, 1] / s, q[n, 2] / s, q[n, 3] / s
         if inverse:
-            out[n] = qrotate_inv(w, x, y, z, v[n, 0], v[n, 1], v[n, 2])
+            out[n, 0], out[n, 1], out[n, 2] = qrotate_inv(w, x, y, z, v[n, 0], v[n, 1], v[n, 2])
         else:
-            out[n] = qrotate(w, x, y, z, v[n, 0], v[n, 1], v[n, 2])
+            out[n, 0], out[n, 1], out[n, 2] = qrotate(w, x, y, z, v[n, 0], v[n, 1], v[n, 2])
 
 
 @njit(cache=True)
@@ -166,19 +170,19 @@ def _to_matrix_loop(q, out):
 @njit(cache=True)
 def _from_matrix_loop(m, out):
     for n in range(out.shape[0]):
-        out[n] = qfrom_matrix(m[n])
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qfrom_matrix(m[n])
 
 
 @njit(cache=True)
 def _from_rotvec_loop(r, out):
     for n in range(out.shape[0]):
-        out[n] = qexp(r[n, 0], r[n, 1], r[n, 2])
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qexp(r[n, 0], r[n, 1], r[n, 2])
 
 
 @njit(cache=True)
 def _to_rotvec_loop(q, out):
     for n in range(out.shape[0]):
-        out[n] = qlog(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
+        out[n, 0], out[n, 1], out[n, 2] = qlog(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
 
 
 @njit(cache=True)
@@ -201,7 +205,7 @@ def _from_euler_loop(angles, i, j, k, out):
         b = _axis_quat(j, angles[n, 1])
         c = _axis_quat(k, angles[n, 2])
         ab = qmul(a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3])
-        out[n] = qmul(ab[0], ab[1], ab[2], ab[3], c[0], c[1], c[2], c[3])
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qmul(ab[0], ab[1], ab[2], ab[3], c[0], c[1], c[2], c[3])
 
 
 @njit(cache=True)
