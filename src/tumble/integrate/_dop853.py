@@ -151,7 +151,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
             t = target if landing else t + step
             store(y, y_new)
             project(model, b, t, y)
-            K[0] = K[_STAGES]
+            store(K[0], K[_STAGES])  # by loops: a row assignment's shape check compiles a message formatter
             rejected_last = False
             if landing:
                 store(out[k], y)
