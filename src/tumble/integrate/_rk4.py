@@ -98,7 +98,7 @@ def _rk4_workspace(scheme, model, b0, Y):
                                      np.empty_like(Y))
 
 
-@_protocol.implements(_fixed.advance, RK4, inline=True)
+@_protocol.implements(_fixed.advance, RK4)
 def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     if _protocol.implemented(point_rates, model):
         return _fused_advance(Y)
