@@ -220,6 +220,22 @@ def test_rk4_motion_does_not_depend_on_the_body_axes_to_rounding(kind, random_ro
     assert frame_difference(FULL, rotation, first, second) <= TOL_FRAME_RK4
 
 
+@pytest.mark.parametrize("bodies", [1, 6], ids=["one body", "one per member"])
+def test_states_reach_body_axes_by_the_quaternion_product_and_the_rotation(bodies, random_batch):
+    # the compiled change of axes of the outputs against the batched API: q_NB = q_NP ⊗ q_BP* bit for bit
+    # (the same product), ω_B = R_BP ω_P to the rounding of its three terms (einsum pairs them otherwise)
+    from tumble.rigid import RigidBodies, _to_body_axes
+
+    model = RigidBodies.of(random_batch(bodies)[0])
+    _, axes, q_bp = model._principal()
+    states = np.random.default_rng(8).normal(size=(4, 6, 7)) * [1.0, 1.0, 1.0, 1.0, 1e-3, 1.0, 1e3]
+    q, omega = np.empty((4, 6, 4)), np.empty((4, 6, 3))
+    _to_body_axes(states, q_bp, axes, q, omega)
+    np.testing.assert_array_equal(q, attitude.multiply(states[..., :4], attitude.conjugate(q_bp)))
+    np.testing.assert_allclose(omega, np.einsum("bij,tbj->tbi", axes, states[..., 4:]), rtol=0,
+                               atol=2 * EPS * np.abs(states[..., 4:]).sum(axis=-1).max())
+
+
 # -- batches -------------------------------------------------------------------------------
 
 

@@ -211,6 +211,18 @@ def test_settling_and_crossing_times():
     np.testing.assert_array_equal(Max(x, after=1.0)(traj), [2.0, 0.0, 4.0])
 
 
+def test_final_and_max_read_only_the_times_they_need():
+    # a pointwise series is evaluated at the times the reduction reads only: the same numbers, bit for bit,
+    # as the series over the whole run, then cut
+    traj = tumble.simulate(BODY, np.random.default_rng(4).normal([0.0, 0.0, 1.0], 0.1, size=(N, 3)), t=T, **RK4)
+    for series in (NutationAngle([0.0, 0.6, 0.8]), PointingError([0.5, 0.5, 0.5, 0.5])):
+        whole = series(traj)
+        np.testing.assert_array_equal(Final(series)(traj), whole[-1], err_msg=repr(series))
+        np.testing.assert_array_equal(Max(series, after=1.0)(traj), whole[T >= 1.0].max(axis=0), err_msg=repr(series))
+    drift = tumble.sweep.Component("energy_drift")  # not pointwise (relative to t = 0): read over the whole run
+    np.testing.assert_array_equal(Final(drift)(traj), traj.energy_drift[-1])
+
+
 def test_outcome_percentiles_are_over_the_samples_where_the_event_happened():
     # omega_z crosses 1.0 rad/s only in the samples started above it (no torque: omega_z oscillates about its
     # start by the small transverse rates): the others have no crossing time (NaN); the percentiles are

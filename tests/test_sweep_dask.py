@@ -173,6 +173,38 @@ def test_a_client_killed_mid_sweep_resumes_computing_only_the_missing_chunks(sch
     assert_same(ds, reference)
 
 
+THREADS = textwrap.dedent("""
+    import numba, numpy as np, tumble  # imported by the spawned workers too, before their environment is set
+
+    @numba.njit
+    def _full(m, value):
+        return np.full(m, value)
+
+    def threads(traj):  # compiled in the worker, after the chunk's run started Numba's threads
+        return _full(traj.q.shape[1], numba.get_num_threads())
+
+    if __name__ == "__main__":
+        body, dispersions = tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), {"omega0": tumble.sweep.Normal([0, 0, 1.0], 0.1)}
+        with tumble.sweep.local_cluster(1) as cluster, cluster.get_client() as client:
+            ds = tumble.sweep(body, dispersions, samples=4, chunk=2, t=[0.0, 0.01], method="rk4", dt=0.01,
+                              client=client, outcomes={"threads": threads})
+        print(numba.config.NUMBA_NUM_THREADS, ds.threads.values.tolist())
+""")
+
+
+@pytest.mark.skipif((os.cpu_count() or 1) < 2, reason="Numba's pool has one thread on one core whatever the setting")
+def test_a_local_clusters_tasks_run_numba_on_one_thread_and_compile(reference, tmp_path):
+    # a script that imports tumble at the top, as most do: a spawned worker process re-imports it, and with
+    # it Numba, before the Nanny sets NUMBA_NUM_THREADS=1; the tasks still run on one thread, and a function
+    # compiled in a task after Numba's threads started does not fail on the changed setting
+    script = tmp_path / "threads.py"
+    script.write_text(THREADS)
+    env = {name: value for name, value in ENV.items() if name != "NUMBA_NUM_THREADS"}
+    out = subprocess.run([sys.executable, str(script)], env=env, capture_output=True, text=True, timeout=4 * TIMEOUT,
+                         check=True).stdout.split(maxsplit=1)
+    assert int(out[0]) > 1 and out[1].strip() == "[1, 1, 1, 1]"  # a pool of threads; the tasks on one
+
+
 def _done(store):
     """Chunks marked done in the store (0 while it does not exist)."""
     if not store.exists():

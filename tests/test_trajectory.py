@@ -127,6 +127,34 @@ def test_body_index_errors():
         traj.body(0).body(0)
 
 
+def test_at_cuts_every_sampled_array_along_time():
+    traj = _batch(n=5, n_bodies=3)
+    traj = Trajectory(traj.t, traj.q, traj.omega, traj.inertia, traj.method, traj.info,
+                      extras={"x": Extra(np.arange(30.0).reshape(5, 3, 2), ("k",), "m", "a test extra")},
+                      totals={"energy": np.arange(15.0).reshape(5, 3)})
+    for index, rows in ((-1, [4]), (slice(1, None, 2), [1, 3]), ([0, 4], [0, 4]), (np.array([2]), [2])):
+        part = traj.at(index)
+        for name in ("t", "q", "omega"):
+            np.testing.assert_array_equal(getattr(part, name), getattr(traj, name)[rows], err_msg=name)
+        np.testing.assert_array_equal(part.x, traj.x[rows])
+        np.testing.assert_array_equal(part.energy, traj.energy[rows])
+        assert part.extras["x"][1:] == traj.extras["x"][1:]
+        np.testing.assert_array_equal(part.inertia, traj.inertia)
+        assert part.info == traj.info and part.method == traj.method and part.batch_size == 3
+        # an invariant derived per sample is the same number either way
+        np.testing.assert_array_equal(part.momentum_body, traj.momentum_body[rows])
+
+
+def test_at_index_errors():
+    traj = _batch(n=5)
+    with pytest.raises(IndexError, match="out of range"):
+        traj.at([5])
+    with pytest.raises(ValidationError, match="^index: "):
+        traj.at(0.5)
+    with pytest.raises(ValidationError, match="^t: .*at least one time"):
+        traj.at(slice(5, None))
+
+
 def test_arrays_are_read_only_copies():
     omega = np.array([[1.0, 2.0, 3.0]])
     traj = _trajectory(omega, [IDENTITY])

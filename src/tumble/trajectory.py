@@ -307,6 +307,27 @@ class Trajectory:
         return Trajectory(self.t, pick(self.q), pick(self.omega), inertia, self.method, self.info, extras, totals,
                           self.model)
 
+    def at(self, index) -> Trajectory:
+        """The trajectory at the output samples ``index`` only: a slice or integer indices along time, kept
+        in order (an int gives one sample, ``at(-1)`` the last); every sampled array, extra and total is
+        cut the same way, the inertia and ``info`` are kept."""
+        if isinstance(index, slice):
+            pick = index
+        else:
+            pick = np.atleast_1d(np.asarray(index))
+            if pick.ndim != 1 or pick.dtype.kind not in "iu":
+                raise ValidationError(f"index: must be a slice or integer indices along time, got {index!r}")
+            if pick.size and not (-len(self) <= pick.min() and pick.max() < len(self)):
+                raise IndexError(f"index: output samples out of range for n = {len(self)}: {pick.tolist()}")
+
+        def cut(a):
+            return None if a is None else a[pick]
+
+        extras = {name: e._replace(data=e.data[pick]) for name, e in self.extras.items()}
+        totals = {name: value[pick] for name, value in self.totals.items()}
+        return Trajectory(self.t[pick], cut(self.q), cut(self.omega), self.inertia, self.method, self.info, extras,
+                          totals, self.model)
+
     # -- invariants ------------------------------------------------------------------
 
     @cached_property

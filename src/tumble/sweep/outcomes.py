@@ -15,7 +15,9 @@ attitude), :class:`NutationAngle` (the angle between a body axis and the
 angular momentum) and :class:`Component` (a sampled field or extra); the
 reductions of a series :class:`Max`, :class:`Final`, :class:`SettlingTime`
 and :class:`CrossingTime`. Any Python callable of the same form works too;
-the store records a callable by its module and qualified name.
+the store records a callable by its module and qualified name. :class:`Final`
+and :class:`Max` evaluate a pointwise series (:class:`PointingError`,
+:class:`NutationAngle`) at the output times they read only.
 
 Angles are in rad, times in s.
 """
@@ -108,6 +110,19 @@ def _series_of(of, traj: Trajectory) -> np.ndarray:
     return values
 
 
+#: The series whose value at an output time depends on the state at that time only.
+_POINTWISE = (PointingError, NutationAngle)
+
+
+def _series_at(of, traj: Trajectory, index) -> np.ndarray:
+    """The series ``of`` at the output samples ``index`` (:meth:`Trajectory.at`), (len(index), m): a
+    pointwise series is evaluated there only (the same numbers, elementwise, for a fraction of the work);
+    any other (a drift, a running integral, a user's function) on the whole run, then cut."""
+    if isinstance(of, _POINTWISE):
+        return _series_of(of, traj.at(index))
+    return _series_of(of, traj)[index]
+
+
 @dataclass(frozen=True)
 class Max:
     """Outcome: the largest value of the series ``of`` at output times ``t >= after`` (s)."""
@@ -116,11 +131,10 @@ class Max:
     after: float = -np.inf
 
     def __call__(self, traj: Trajectory) -> np.ndarray:
-        values = _series_of(self.of, traj)
-        keep = traj.t >= self.after
-        if not keep.any():
+        keep = np.flatnonzero(traj.t >= self.after)
+        if not keep.size:
             raise ValidationError(f"after: no output time at or after {self.after} s (the last is {traj.t[-1]} s)")
-        return values[keep].max(axis=0)
+        return _series_at(self.of, traj, keep).max(axis=0)
 
 
 @dataclass(frozen=True)
@@ -130,7 +144,7 @@ class Final:
     of: object
 
     def __call__(self, traj: Trajectory) -> np.ndarray:
-        return _series_of(self.of, traj)[-1]
+        return _series_at(self.of, traj, [-1])[0]
 
 
 @dataclass(frozen=True)

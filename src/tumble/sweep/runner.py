@@ -39,7 +39,29 @@ def local_cluster(workers: int | None = None):
 
 
 def _run_chunk(plan: Plan, k: int):
+    _numba_settings_from_environment()
     return plan.run(k)
+
+
+def _numba_settings_from_environment() -> None:
+    """Hold a chunk to the worker's ``NUMBA_NUM_THREADS`` (1 on :func:`local_cluster`), where it is set.
+
+    Numba reads its settings when imported, and a worker process started by ``spawn`` imports it before the
+    Nanny sets the worker's environment (it re-imports the client's ``__main__``, and with it tumble): its
+    pool then starts with one thread per core (2 workers ran 4 threads on 2 cores), and the first
+    compilation after the pool started (a kernel not in the cache) failed, Numba refusing to change the
+    number of running threads. So the settings are read again before the first chunk starts the pool (a
+    no-op once they agree), and the chunk's thread is held to the number (Numba's count is per thread; the
+    pool itself keeps the size it was imported with)."""
+    limit = os.environ.get("NUMBA_NUM_THREADS")
+    if limit is None:
+        return
+    import numba
+    from numba.core import config
+    from numba.np.ufunc import parallel
+
+    config.reload_config()
+    numba.set_num_threads(max(1, min(int(limit), parallel.NUM_THREADS)))
 
 
 def run_chunks(plan: Plan, store: SweepStore, *, client=None, workers: int | None = None,

@@ -147,7 +147,8 @@ class SweepStore:
         ds = xr.Dataset(data, coords={"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})},
                         attrs={SETTINGS_ATTR: plan.settings(), COMPLETE_ATTR: False})
         encoding = {name: {"fill_value": None} for name in ds.data_vars}
-        if self.path is None:
+        if self.path is None:  # loaded whole by dataset(): compressing the chunks there would be work for nothing
+            encoding = {name: {**e, "compressors": None} for name, e in encoding.items()}
             import zarr
 
             self._memory = zarr.storage.MemoryStore()
