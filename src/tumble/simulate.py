@@ -319,7 +319,7 @@ def _describe(torque) -> str:
     return repr(torque)
 
 
-def _solver_options(model: Model, method, given: dict) -> tuple[integrate.Method, dict]:
+def _solver_options(model: Model | None, method, given: dict) -> tuple[integrate.Method, dict]:
     """The :class:`~tumble.integrate.Method` and the options it reads (defaults filled in); an option given
     that the method does not read is refused."""
     method = str(method)

@@ -246,8 +246,9 @@ class SpacecraftTable(_InertiaOrMoments):
 
     def build(self) -> Spacecraft:
         """The :class:`~tumble.spacecraft.Spacecraft`; a refusal is reported against its key."""
-        parts: dict[str, Any] = {key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
-                 for key in ("wheels", "thrusters", "controller")}
+        parts: dict[str, Any] = {  # the keyword arguments of Spacecraft
+            key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
+            for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
