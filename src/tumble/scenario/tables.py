@@ -15,10 +15,10 @@ from pydantic import BaseModel, Discriminator, Field, Tag, field_validator
 
 from tumble import attitude, integrate
 from tumble.body import RigidBody
-from tumble.simulate import SolverOptions
 from tumble.scenario._errors import ScenarioError
 from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, _Quaternion, _Table, _Text,
                                      _Vector)
+from tumble.simulate import SolverOptions
 
 __all__ = ["Body", "EulerAngles", "Initial", "MAX_SAMPLES", "ModelState", "Solver", "Time"]
 

@@ -244,7 +244,7 @@ class WheelTorques:
         :class:`PythonLaw`)
     """
 
-    torques: Any  # a function, or samples: an array (len(t), n_w) or (n_w,), (len(t), n_w) once validated
+    torques: Any  # a function of time, or samples (len(t), n_w) or (n_w,): an array (len(t), n_w) once validated
     t: object = None
     interpolation: str = "linear"
     slot: int | None = field(init=False, repr=False, default=None)
