@@ -198,6 +198,13 @@ def test_zero_order_hold_refuses_steps_that_miss_the_samples():
         tumble.simulate(craft, [0.0, 0.0, 0.0], t=[0.0, 0.33], method="rk4", dt=0.05)
 
 
+def test_zero_order_hold_refuses_the_closed_form():
+    # method="exact" has no step (dt is None): once a TypeError dividing the control period by None
+    craft = _craft(control_period=0.25)
+    with pytest.raises(ValidationError, match="method: a sampled controller"):
+        tumble.simulate(craft, [0.0, 0.0, 0.0], t=[0.0, 1.0], method="exact")
+
+
 @pytest.mark.parametrize("kwargs, message", [
     ({"inertia": None}, "inertia: give exactly one"),
     ({"wheels": [ReactionWheel([0, 0, 1], 0.01)], "hub": RigidBody(np.eye(3), mass=1.0), "inertia": None},

@@ -367,6 +367,13 @@ def test_simulate_with_a_store_streams_chunks_that_equal_the_batch(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["front.zarr", "run.zarr"]  # no temporary store left
 
 
+def test_simulate_with_a_store_refuses_an_empty_batch(tmp_path):
+    # once zarr's GroupNotFoundError ("No group found in store None"): no chunk had made the store
+    with pytest.raises(tumble.ValidationError, match="^store: the batch has no members"):
+        tumble.simulate(BODY, np.zeros((0, 3)), t=T, **RK4, store=tmp_path / "empty.zarr")
+    assert os.listdir(tmp_path) == []
+
+
 def test_a_run_too_big_for_memory_is_refused_before_allocation():
     # 1e6 bodies x 1e5 output times: 1.4e13 bytes, more than any test machine has
     with pytest.raises(tumble.ValidationError, match=r"^store: 1000000 members x 100000 output times need at least "

@@ -9,6 +9,7 @@ helpers for rotations and point masses live beside it.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import _quat
 from tumble._validate import ValidationError, as_array
@@ -34,7 +35,7 @@ _TRIANGLE_RTOL = 1e-9
 _ROTATION_TOL = 1e-10
 
 
-def frozen(arr: np.ndarray) -> np.ndarray:
+def frozen(arr: ArrayLike) -> np.ndarray:
     """A read-only float64 copy of ``arr``."""
     arr = np.array(arr, dtype=np.float64)
     arr.flags.writeable = False

@@ -125,7 +125,7 @@ def memory_bytes() -> int:
         return 2**63 - 1
 
 
-def require_memory(nbytes: int, name: str, what: str) -> None:
+def require_memory(nbytes: float, name: str, what: str) -> None:
     """Refuse (naming ``name``) an allocation of ``nbytes`` sized from input — ``what`` says what it holds —
     when it is more than half the machine's physical memory: checked before allocating, so that a hostile
     size is a one-line error, not an hour of swapping or a process killed for memory."""

@@ -13,8 +13,12 @@ quick-start demo, one body under every method, a batch, a heavy top.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from tumble.simulate import SolverOptions
 
 __all__ = ["PATHS"]
 
@@ -31,7 +35,8 @@ def _simulate(method: str, *, members: int = 1, torque=None) -> Callable[[], Non
 
         body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
         omega0 = _OMEGA0 if members == 1 else np.tile(_OMEGA0, (members, 1))
-        options = {"rtol": 1e-10, "atol": 1e-12} if method == "dop853" else {} if method == "exact" else {"dt": 0.01}
+        options: SolverOptions = ({"rtol": 1e-10, "atol": 1e-12} if method == "dop853" else {} if method == "exact"
+                                  else {"dt": 0.01})
         tumble.simulate(body, omega0, t=_T, method=method, torque=torque() if torque else None, **options)
 
     return run

@@ -446,8 +446,8 @@ def _parse_seq(seq) -> tuple[tuple[int, int, int], bool]:
         )
     if seq[0] == seq[1] or seq[1] == seq[2]:
         raise ValidationError(f"seq: consecutive axes must differ, got {seq!r}")
-    axes = tuple("xyz".index(c) for c in seq.lower())
-    return axes, seq.isupper()
+    i, j, k = ("xyz".index(c) for c in seq.lower())
+    return (i, j, k), seq.isupper()
 
 
 def from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndarray:

@@ -27,7 +27,7 @@ import importlib
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import numpy as np
 import typer
@@ -80,8 +80,8 @@ _POLHODE_OMEGA = (1.0, 10.0, 1.0)
 _POLHODE_FRAMES = 600
 # The T-handle as the viewer draws it: RigidBody.t_handle()'s handle (along x, from the origin) and cross bar
 # (along y, centred on the handle's end), solid cylinders of its default radius and lengths (m).
-_T_HANDLE_PIECES = [dict(radius=0.004, length=0.08, axis="x", position=(0.04, 0.0, 0.0)),
-                    dict(radius=0.004, length=0.08, axis="y", position=(0.08, 0.0, 0.0))]
+_T_HANDLE_PIECES: list[dict[str, Any]] = [dict(radius=0.004, length=0.08, axis="x", position=(0.04, 0.0, 0.0)),
+                                          dict(radius=0.004, length=0.08, axis="y", position=(0.08, 0.0, 0.0))]
 
 _stderr = Console(stderr=True)
 

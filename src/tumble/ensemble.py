@@ -35,9 +35,16 @@ SAMPLES_PER_CHUNK = 2**19
 #: The statistics computed for every quantity, in the order of the ``statistic`` dimension.
 STATISTICS = ("mean", "std", "min", "max")
 
+
+def _omega(traj: Trajectory) -> np.ndarray:
+    """The body rates of a chunk of rigid bodies (which have an attitude), rad/s, body axes."""
+    assert traj.omega is not None
+    return traj.omega
+
+
 #: Quantities reduced by default: name -> (function of a chunk's Trajectory, units, description).
 DEFAULT_QUANTITIES: dict[str, tuple[Callable[[Trajectory], np.ndarray], str, str]] = {
-    "omega": (lambda traj: traj.omega, "rad/s", "angular velocity, body axes"),
+    "omega": (_omega, "rad/s", "angular velocity, body axes"),
     "energy_drift": (lambda traj: traj.energy_drift, "1", "(T - T0)/T0"),
     "momentum_norm_drift": (lambda traj: traj.momentum_norm_drift, "1", "(|L| - |L0|)/|L0|"),
     "momentum_inertial_drift": (lambda traj: traj.momentum_inertial_drift, "1", "|L_I - L_I0|/|L_I0|"),

@@ -120,7 +120,7 @@ class FlexibleBody(Model):
     """
 
     body: RigidBody
-    modes: tuple
+    modes: tuple[Mode, ...]
 
     torque = "external torque on the hub, body axes (N·m): a tumble.torques model or f(t, q, omega)"
 
@@ -297,8 +297,8 @@ def slew_torque(axis, angle: float, *, duration: float, inertia: float, ramp: fl
 #: The demo spacecraft: 3000 kg·m² about the slew axis z, a solar array with two modes about z.
 DEMO_BODY = FlexibleBody(
     body=RigidBody(np.diag([2000.0, 1500.0, 3000.0])),
-    modes=(Mode(frequency=2 * math.pi * 0.2, damping=0.003, participation=[0.0, 0.0, 25.0]),
-           Mode(frequency=2 * math.pi * 1.1, damping=0.005, participation=[0.0, 0.0, 8.0])),
+    modes=(Mode(frequency=2 * math.pi * 0.2, damping=0.003, participation=np.array([0.0, 0.0, 25.0])),
+           Mode(frequency=2 * math.pi * 1.1, damping=0.005, participation=np.array([0.0, 0.0, 8.0]))),
 )
 _DEMO_SLEW = dict(angle=math.radians(30.0), duration=40.0, ramp=0.4)  # rad, s, s
 _DEMO_SETTLE = 60.0  # s simulated after the manoeuvre
@@ -329,9 +329,11 @@ def demo_flexible(out_dir) -> dict:
     T = _DEMO_SLEW["duration"]
     torque = slew_torque([0.0, 0.0, 1.0], inertia=fbody.body.inertia[2, 2], **_DEMO_SLEW)
     t = np.linspace(0.0, T + _DEMO_SETTLE, int(20 * (T + _DEMO_SETTLE)) + 1)
-    options = dict(t=t, torque=torque, method="dop853", rtol=_DEMO_TOLERANCE, atol=_DEMO_TOLERANCE)
-    flexible = tumble.simulate(fbody, np.zeros(3), **options)
-    rigid = tumble.simulate(fbody.body, np.zeros(3), **options)
+    flexible = tumble.simulate(fbody, np.zeros(3), t=t, torque=torque, method="dop853", rtol=_DEMO_TOLERANCE,
+                               atol=_DEMO_TOLERANCE)
+    rigid = tumble.simulate(fbody.body, np.zeros(3), t=t, torque=torque, method="dop853", rtol=_DEMO_TOLERANCE,
+                            atol=_DEMO_TOLERANCE)
+    assert flexible.q is not None and flexible.omega is not None and rigid.q is not None  # both have an attitude
 
     after = t >= T
     error = (slew_angle(flexible.q) - _DEMO_SLEW["angle"])[after] / _ARCSEC
@@ -359,6 +361,8 @@ def slew_figure(flexible: Trajectory, rigid: Trajectory, end: float, target: flo
     from the ``target`` angle (rad) after the manoeuvre ends at ``end`` (s)."""
     from matplotlib.figure import Figure
 
+    assert flexible.q is not None and flexible.omega is not None, "the flexible hub's trajectory has an attitude"
+    assert rigid.q is not None and rigid.omega is not None, "the rigid body's trajectory has an attitude"
     fig = Figure(figsize=(10, 7), layout="constrained")
     (a, b), (c, d) = fig.subplots(2, 2)
     t = flexible.t

@@ -69,6 +69,12 @@ class AxisymmetricBody(Model):
     """
 
     __slots__ = ("body", "frame_spin", "transverse", "axial", "axes", "q_bp")
+    body: RigidBody
+    frame_spin: float  # κ
+    transverse: float  # I_t, kg·m²
+    axial: float  # I_a, kg·m²
+    axes: np.ndarray  # (3, 3) R_BP, the symmetry axis third
+    q_bp: np.ndarray  # (4,) its quaternion
 
     def __init__(self, body: RigidBody, *, frame_spin: float = 0.0):
         if not isinstance(body, RigidBody):

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy.integrate import quad
@@ -245,7 +246,7 @@ def demo_lorentz(out_dir) -> dict:
         raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
     star = NEUTRON_STAR
     omega = 2.0 * math.pi / star["period"]
-    summary = {"omega": omega, "rim_speed": omega * star["radius"] / SPEED_OF_LIGHT}
+    summary: dict[str, Any] = {"omega": omega, "rim_speed": omega * star["radius"] / SPEED_OF_LIGHT}
     for shape in ("sphere", "shell", "ring"):
         fixes = SpinningMatter(shape, star["mass"], star["radius"]).corrections(omega)
         summary[shape] = {name: float(value) for name, value in fixes.items()}

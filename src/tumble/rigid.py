@@ -20,6 +20,7 @@ RigidBody or an (N, 3, 3) inertia array, validated in one vectorised call).
 
 from __future__ import annotations
 
+import abc
 from collections.abc import Sequence
 
 import numpy as np
@@ -49,6 +50,18 @@ class RigidMotion(Model):
     """
 
     __slots__ = ()
+
+    @abc.abstractmethod
+    def _principal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The principal moments (B, 3), kg·m², ascending; axes R_BP (B, 3, 3); quaternions q_BP (B, 4)."""
+
+    @abc.abstractmethod
+    def _reported_inertia(self) -> np.ndarray:
+        """The inertia tensor(s) in body axes, kg·m²: (3, 3), or (N, 3, 3) with one per member."""
+
+    @abc.abstractmethod
+    def _masses(self) -> float | np.ndarray | None:
+        """The mass(es), kg, or None when unknown (for the rigidity check)."""
 
     def state_fields(self) -> tuple[StateField, ...]:
         return (

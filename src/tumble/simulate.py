@@ -32,7 +32,7 @@ import abc
 import difflib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, TypedDict
 
 import numpy as np
 
@@ -47,6 +47,18 @@ _LARGEST_STATE = 1e150
 
 #: Solver options when not given (those the method reads).
 DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
+
+
+class SolverOptions(TypedDict, total=False):
+    """The solver options of :func:`simulate` as keyword arguments (``**options``): those the method reads.
+
+    dt : fixed step, s; rtol, atol : tolerances of an adaptive method; max_steps : steps per body
+    """
+
+    dt: float
+    rtol: float
+    atol: float
+    max_steps: int
 
 
 @dataclass(frozen=True)
@@ -307,7 +319,7 @@ def _describe(torque) -> str:
     return repr(torque)
 
 
-def _solver_options(model: Model, method, given: dict) -> tuple[integrate.Method, dict]:
+def _solver_options(model: Model | None, method, given: dict) -> tuple[integrate.Method, dict]:
     """The :class:`~tumble.integrate.Method` and the options it reads (defaults filled in); an option given
     that the method does not read is refused."""
     method = str(method)
@@ -336,7 +348,8 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
             hint = f" (did you mean {close[0]!r}?)" if close else ""
             raise ValidationError(f"{name}: a {type(model).__name__} has no initial state {name!r}{hint}; it takes "
                                   + ", ".join(f"{f.name} ({f.description})" for f in fields))
-    arrays, sizes = {}, {}
+    arrays: dict[str, np.ndarray] = {}
+    sizes: dict[str, int] = {}
     for f in fields:
         value = given.get(f.name)
         if value is None:
@@ -365,7 +378,7 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
     return _broadcast(arrays, sizes), n
 
 
-def _broadcast(arrays: dict, sizes: dict) -> dict[str, np.ndarray]:
+def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str, np.ndarray]:
     n = max(sizes.values(), default=1)
     return {name: np.broadcast_to(a, (n, a.shape[-1])) for name, a in arrays.items()}
 

@@ -135,6 +135,7 @@ class SloshBody(Model):
     def reduced_mass(self) -> float:
         """``μ = m M / (m + M)`` (kg)."""
         m, M = self.pendulum.mass, self.body.mass
+        assert M is not None  # checked in __post_init__
         return m * M / (m + M)
 
     # -- the model interface (tumble.simulate.Model) ----------------------------------
@@ -290,7 +291,7 @@ def steady_spin_eigenvalues(sbody: SloshBody, omega, direction) -> np.ndarray:
 #: The demo spinner: a prolate hub spinning about its minor axis z with a tank off the axis.
 DEMO_BODY = SloshBody(
     body=RigidBody(np.diag([600.0, 600.0, 300.0]), mass=900.0),
-    pendulum=Pendulum(mass=60.0, length=0.6, hinge=[0.2, 0.0, 0.0], damping=1.0),
+    pendulum=Pendulum(mass=60.0, length=0.6, hinge=np.array([0.2, 0.0, 0.0]), damping=1.0),
 )
 _DEMO_SPIN = 2.0  # rad/s about z
 _DEMO_WOBBLE = 0.035  # rad/s about x at the start: an initial nutation of 1.8°

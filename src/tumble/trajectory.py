@@ -44,7 +44,7 @@ import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any, Final, NamedTuple
 
 import filelock
 import numpy as np
@@ -63,7 +63,7 @@ __all__ = ["Extra", "Trajectory", "load", "write_atomic"]
 CONVENTIONS = (
     "quaternion: Hamilton, scalar-first [w,x,y,z], body->inertial; omega in body axes; SI units"
 )
-_ENGINE = "h5netcdf"  # NetCDF-4 (HDF5) reader and writer used by save() and load()
+_ENGINE: Final = "h5netcdf"  # NetCDF-4 (HDF5) reader and writer used by save() and load()
 _INFO_PREFIX = "solver_"  # global attributes of the NetCDF file that hold Trajectory.info
 _EXTRA_ATTR = "tumble_extra"  # variable attribute that marks a Trajectory.extras entry in a dataset
 _TOTAL_ATTR = "tumble_total"  # variable attribute that marks a model's total (energy, momentum_body)
@@ -421,8 +421,9 @@ class Trajectory:
                 attrs["frame"] = frame
             return xr.Variable(dims, data, attrs)
 
-        data_vars = {}
+        data_vars: dict[str, xr.Variable] = {}
         if self.q is not None:
+            assert self.inertia is not None  # with q (checked in __post_init__)
             inertia_dims = ("axis", "axis2") if self.inertia.ndim == 2 else ("body", "axis", "axis2")
             data_vars.update(
                 omega=variable(lead + ("axis",), self.omega, "rad/s",

@@ -112,9 +112,9 @@ def free_parameters(moments, omega_p) -> FreeParameters:
     codes = np.empty(flat_omega.shape[0], dtype=np.int64)
     values = np.empty((flat_omega.shape[0], 6))
     _parameters_batch(flat_moments, flat_omega, codes, values)
-    regime = np.asarray(REGIMES)[codes].reshape(shape)
-    fields = [values[:, i].reshape(shape) for i in range(6)]
-    if not shape:
+    regime: str | np.ndarray = np.asarray(REGIMES)[codes].reshape(shape)
+    fields: list[float] | list[np.ndarray] = [values[:, i].reshape(shape) for i in range(6)]
+    if not shape:  # one body: numbers
         regime, fields = str(regime), [float(f) for f in fields]
     energy, momentum, m, m1, lam, quarter = fields
     return FreeParameters(

@@ -236,9 +236,9 @@ def polhode_through(body: RigidBody, omega, *, n: int = _DEFAULT_POINTS) -> Polh
     sign = -1 if omega_p[c] < 0.0 else 1
     theta = _amplitude(moments, c, sign, omega_p) + _angles(_count(n, "n", 3))
     if not np.cross(omega_p, moments * omega_p).any():
-        return Polhode(np.tile(omega_p, (theta.size, 1)), params.momentum, c, sign)
+        return Polhode(np.tile(omega_p, (theta.size, 1)), float(params.momentum), c, sign)
     points = _curve(moments, _levels_of_rates(moments, omega_p), c, sign, theta)
-    return Polhode(points, params.momentum, c, sign)
+    return Polhode(points, float(params.momentum), c, sign)  # one body: |L| a number
 
 
 def polhode_family(body: RigidBody, energy: float, n_curves: int = 5, *, n: int = _DEFAULT_POINTS) -> list[Polhode]:

@@ -434,7 +434,8 @@ class HeavyTop:
             disc = max(f2 * f2 - 4.0 * beta * f1, 0.0)
             q = -0.5 * (f2 + math.copysign(math.sqrt(disc), f2))
             others = (q / beta, f1 / q) if q != 0.0 else (0.0, 0.0)
-            return tuple(sorted((0.0, *others)))
+            low, middle, high = sorted((0.0, *others))
+            return low, middle, high
 
         def g(x):
             return f0 + x * (f1 + x * (f2 + x * beta))

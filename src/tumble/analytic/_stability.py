@@ -138,10 +138,10 @@ def growth_rate(body: RigidBody, spin: float) -> float:
     like ``e^{σt}`` while they stay small. 0 for a symmetric body.
     """
     i1, i2, i3 = _body(body).moments
-    spin = as_array(spin, "spin")
-    if spin.ndim != 0:
-        raise ValidationError(f"spin: must be a number (rad/s), got shape {spin.shape}")
-    return abs(float(spin)) * float(np.sqrt(max((i3 - i2) * (i2 - i1), 0.0) / (i1 * i3)))
+    rate = as_array(spin, "spin")
+    if rate.ndim != 0:
+        raise ValidationError(f"spin: must be a number (rad/s), got shape {rate.shape}")
+    return abs(float(rate)) * float(np.sqrt(max((i3 - i2) * (i2 - i1), 0.0) / (i1 * i3)))
 
 
 def flip_interval(body: RigidBody, omega) -> float:

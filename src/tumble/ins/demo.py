@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -184,7 +185,7 @@ def demo_coning(out_dir, *, points: int = 12) -> dict:
     x = np.geomspace(0.05, 1.0, int(points))
     figure = Figure(figsize=(6.4, 4.6), layout="constrained")
     ax = figure.add_subplot()
-    summary = {"half_angle": coning.half_angle, "frequency": coning.frequency}
+    summary: dict[str, Any] = {"half_angle": coning.half_angle, "frequency": coning.frequency}
     for algorithm in ALGORITHMS:
         T = x / coning.frequency
         measured = np.abs([measure_drift(coning, algorithm, float(step), 400) for step in T])
@@ -234,6 +235,7 @@ def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
     steps = 6 * max(1, round(duration / (3 * dt)))  # whole three-sample updates, grid at dt / 2
     t = 0.5 * dt * np.arange(steps + 1)
     truth = simulate(np.diag([0.05, 0.1, 0.12]), [0.5, 2.0, 0.3], t=t, method="exact")
+    assert truth.q is not None  # a rigid body's attitude
     exact = from_trajectory(truth, oversample=2)
     errors = DEMO_GYRO_ERRORS
     cases = {
@@ -243,7 +245,7 @@ def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
     }
     figure = Figure(figsize=(6.4, 4.6), layout="constrained")
     ax = figure.add_subplot()
-    summary = {"duration_s": float(t[-1]), "sample_rate_hz": 1.0 / dt}
+    summary: dict[str, Any] = {"duration_s": float(t[-1]), "sample_rate_hz": 1.0 / dt}
     for name, increments in cases.items():
         nav = strapdown(increments, q0=truth.q[0], algorithm="three-sample")
         error = attitude.relative_angle(nav.attitude.q, truth.q[::6])

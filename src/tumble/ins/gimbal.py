@@ -46,6 +46,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -203,6 +204,6 @@ class GimbaledGyro(Model):
         """Deprecated: ``tumble.simulate(gyro, t=t, spin=spin, method=..., ...)``, which it calls."""
         warnings.warn("GimbaledGyro.simulate is deprecated: call tumble.simulate(gyro, t=..., spin=..., ...)",
                       DeprecationWarning, stacklevel=2)
-        options = {name: value for name, value in dict(rtol=rtol, atol=atol, dt=dt).items()
+        options: dict[str, Any] = {name: value for name, value in dict(rtol=rtol, atol=atol, dt=dt).items()
                    if method not in METHODS or name in METHODS[method].options}
         return tumble.simulate(self, t=t, spin=spin, method=method, **options, **initial_state)

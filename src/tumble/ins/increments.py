@@ -115,6 +115,9 @@ def from_trajectory(trajectory: Trajectory, *, oversample: int = 2, specific_for
     """
     if not isinstance(trajectory, Trajectory) or trajectory.batch_size is not None:
         raise ValidationError("trajectory: must be a Trajectory of one body (use trajectory.body(i))")
+    if trajectory.q is None or trajectory.omega is None:
+        raise ValidationError("trajectory: must have an attitude (q and omega) for a gyro to measure, not the "
+                              f"{trajectory.model or 'model'} trajectory given")
     oversample = int(oversample)
     if oversample < 2 or oversample % 2:
         raise ValidationError(f"oversample: must be an even number >= 2 (Simpson's rule), got {oversample}")

@@ -84,7 +84,7 @@ class Splitting(NamedTuple):
 AXES = np.array([1, 0, 2], dtype=np.int64)
 
 
-def _blanes_moan_s6():
+def _blanes_moan_s6() -> tuple[np.ndarray, np.ndarray]:
     a1, a2, a3 = 0.0792036964311957, 0.353172906049774, -0.0420650803577195
     b1, b2 = 0.209515106613362, -0.143851773179818
     a4, b3 = 1.0 - 2.0 * (a1 + a2 + a3), 0.5 - (b1 + b2)

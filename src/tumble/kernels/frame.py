@@ -48,10 +48,15 @@ class FrameModel(NamedTuple):
     params: np.ndarray
     codes: np.ndarray | None
 
-    #: Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side.
-    provides = frozenset({"rhs"})
-    #: True when the torque program calls a Python function (the batch then runs on one core).
-    calls_python = property(torques.program_calls_python)
+    @property
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side."""
+        return frozenset({"rhs"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.program_calls_python(self)
 
 
 def build(transverse: float, axial: float, frame_spin: float, axes: np.ndarray, torque) -> FrameModel:

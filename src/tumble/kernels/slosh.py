@@ -49,10 +49,15 @@ class SloshModel(NamedTuple):
     params: np.ndarray
     codes: np.ndarray
 
-    #: Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate.
-    provides = frozenset({"rhs", "body_rate"})
-    #: True when the torque program calls a Python function (the batch then runs on one core).
-    calls_python = property(torques.program_calls_python)
+    @property
+    def provides(self) -> frozenset[str]:
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
+        return frozenset({"rhs", "body_rate"})
+
+    @property
+    def calls_python(self) -> bool:
+        """True when the torque program calls a Python function (the batch then runs on one core)."""
+        return torques.program_calls_python(self)
 
 
 @njit(cache=True)

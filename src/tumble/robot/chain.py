@@ -76,7 +76,7 @@ def _dh_link(row: Mapping, k: int, modified: bool, check_triangle: bool) -> Link
         origin_rotation, origin_position = fixed_z, np.zeros(3)
         frame_rotation = _rx(alpha)
         frame_position = slide + np.array([a, 0.0, 0.0])
-    return Link(joint=joint, axis=(0.0, 0.0, 1.0), origin_position=origin_position,
+    return Link(joint=joint, axis=np.array([0.0, 0.0, 1.0]), origin_position=origin_position,
                 origin_rotation=origin_rotation, frame_position=frame_position, frame_rotation=frame_rotation,
                 offset=offset, mass=row.get("mass", 0.0), com=row.get("com", (0.0, 0.0, 0.0)),
                 inertia=row.get("inertia", np.zeros((3, 3))), lower=lower, upper=upper,
@@ -141,7 +141,8 @@ class SerialChain(RobotTree):
         return cls(rows, gravity=gravity, name=name)
 
     @classmethod
-    def from_urdf(cls, source, *, check_triangle: bool = True, gravity=DEFAULT_GRAVITY) -> SerialChain:
+    def from_urdf(  # type: ignore[override]  # a chain has no floating base and no mimic joints to ask for
+            cls, source, *, check_triangle: bool = True, gravity=DEFAULT_GRAVITY) -> SerialChain:
         """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         Refused when the URDF describes a tree or has mimic joints (use :meth:`RobotTree.from_urdf`)."""

@@ -45,7 +45,7 @@ def demo_robot(out_dir: Path, robot_file: Path) -> dict:
     t = np.linspace(0.0, _DURATION, _SAMPLES)
     run = simulate(chain, q0=np.array(_Q0), t=t, method="dop853", rtol=_TOLERANCE, atol=_TOLERANCE)
     drift = run.energy - run.energy[0]
-    outside = ~chain.within_limits(run.joint_position)
+    outside = np.logical_not(chain.within_limits(run.joint_position))
     first = int(outside.argmax()) if outside.any() else None  # the first sample beyond the limits
     nc, png = out_dir / "robot_fall.nc", out_dir / "robot_fall.png"
     run.save(nc)

@@ -62,16 +62,18 @@ class Link:
     ``upper`` are the joint limits (rad or m, on ``q``; ±inf when unlimited).
     """
 
+    # The array fields take array_like values (the tuple defaults) and hold read-only float64 arrays once
+    # __post_init__ has converted them: a conversion mypy does not follow, hence the ignores.
     joint: str = "revolute"
-    axis: np.ndarray = (0.0, 0.0, 1.0)
-    origin_position: np.ndarray = (0.0, 0.0, 0.0)
+    axis: np.ndarray = (0.0, 0.0, 1.0)  # type: ignore[assignment]
+    origin_position: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
     origin_rotation: np.ndarray | None = None
-    frame_position: np.ndarray = (0.0, 0.0, 0.0)
+    frame_position: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
     frame_rotation: np.ndarray | None = None
     offset: float = 0.0
     mass: float = 0.0
-    com: np.ndarray = (0.0, 0.0, 0.0)
-    inertia: np.ndarray = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    com: np.ndarray = (0.0, 0.0, 0.0)  # type: ignore[assignment]
+    inertia: np.ndarray = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))  # type: ignore[assignment]
     lower: float = -math.inf
     upper: float = math.inf
     name: str | None = None

@@ -30,6 +30,9 @@ extra ``beyond_limits`` says, per sample, whether a joint has left its range.
 
 from __future__ import annotations
 
+import abc
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 
 from tumble import _callback, torques
@@ -38,6 +41,9 @@ from tumble.kernels import featherstone as _featherstone
 from tumble.kernels import robot as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra
+
+if TYPE_CHECKING:
+    from tumble.robot.tree import RobotTree
 
 __all__ = ["ChainMotion"]
 
@@ -64,6 +70,44 @@ class ChainMotion(Model):
               "joint coordinates and rates (at Python speed, on one core); with a floating base q and qd are the "
               "whole configuration [base position, base quaternion, joints] (7 + n,) and velocity [base omega, "
               "base velocity, joint rates] (6 + n,)")
+
+    # -- what the tree provides (tumble.robot.RobotTree) -----------------------
+    _params: np.ndarray  # (nb, 45): the layout of tumble.kernels.featherstone
+    _gravity: np.ndarray  # (3,) m/s², world frame
+
+    @property
+    @abc.abstractmethod
+    def nq(self) -> int: ...
+
+    @property
+    @abc.abstractmethod
+    def nv(self) -> int: ...
+
+    @property
+    @abc.abstractmethod
+    def dof(self) -> int: ...
+
+    @property
+    @abc.abstractmethod
+    def floating_base(self) -> bool: ...
+
+    @property
+    @abc.abstractmethod
+    def joint_names(self) -> tuple[str | None, ...]: ...
+
+    @property
+    @abc.abstractmethod
+    def name(self) -> str | None: ...
+
+    @property
+    @abc.abstractmethod
+    def lower(self) -> np.ndarray: ...
+
+    @property
+    @abc.abstractmethod
+    def upper(self) -> np.ndarray: ...
+
+    # -- the model interface (tumble.simulate.Model) ----------------------------
 
     def state_fields(self) -> tuple[StateField, ...]:
         n = self.dof
@@ -135,7 +179,7 @@ class ChainMotion(Model):
             "joint_velocity": Extra(qd, joint, "rad/s or m/s", "joint rates dq/dt"),
             "joint_torque": Extra(tau, joint, "N m or N", "joint torques applied at the samples, tau(t, q, dq/dt)"),
             "work": Extra(work, (), "J", "work done by the joint torques since the start, W = int tau . dq/dt dt"),
-            "beyond_limits": Extra(outside.any(axis=-1).astype(np.float64), (), "1",
+            "beyond_limits": Extra(np.asarray(outside.any(axis=-1), dtype=np.float64), (), "1",
                                    "1 where a joint is beyond its limits (not enforced: no joint stops), else 0"),
         }
         if self.floating_base:
@@ -152,8 +196,9 @@ class ChainMotion(Model):
         """The floating base's motion and the centroidal momentum (world axes) at every sample."""
         from tumble.robot.kinematics import centroidal_momentum
 
+        tree = cast("RobotTree", self)  # the model interface of RobotTree, its one subclass
         flat_q, flat_qd = q.reshape(-1, self.nq), qd.reshape(-1, self.nv)
-        h = np.array([centroidal_momentum(self, a, b) for a, b in zip(flat_q, flat_qd)]).reshape(*q.shape[:-1], 6)
+        h = np.array([centroidal_momentum(tree, a, b) for a, b in zip(flat_q, flat_qd)]).reshape(*q.shape[:-1], 6)
         vector = ("xyz",)
         return {
             "base_position": Extra(q[..., 0:3], vector, "m", "origin of the floating base, world frame"),

@@ -64,6 +64,21 @@ class RobotTree(ChainMotion):
 
     __slots__ = ("_links", "_parents", "_gravity", "_name", "_frames", "_mimic", "_params", "_lower", "_upper",
                  "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links")
+    _links: tuple[Link, ...]
+    _parents: tuple[int, ...]
+    _gravity: np.ndarray  # (3,) m/s², world frame
+    _name: str | None
+    _frames: tuple[Frame, ...]
+    _mimic: dict[int, tuple[int, float, float]]  # {link: (copied link, multiplier, offset)}
+    _params: np.ndarray  # (nb, 45), the layout of tumble.kernels.featherstone
+    _lower: np.ndarray  # (dof,) read-only
+    _upper: np.ndarray
+    _no_wrench: np.ndarray  # (6,) zeros
+    _no_wrenches: np.ndarray  # (1, 6) zeros
+    _nq: int
+    _nv: int
+    _floating: bool
+    _coordinate_links: tuple[int, ...]  # the links of the independent joint coordinates
 
     def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity=DEFAULT_GRAVITY,
                  name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None):
@@ -207,7 +222,7 @@ class RobotTree(ChainMotion):
     def within_limits(self, q) -> np.ndarray | bool:
         """True where ``lower ≤ q ≤ upper`` for every joint; ``q`` of shape (…, nq)."""
         joints = self.joint_coordinates(q)
-        ok = ((joints >= self._lower) & (joints <= self._upper)).all(axis=-1)
+        ok = np.asarray(((joints >= self._lower) & (joints <= self._upper)).all(axis=-1))
         return bool(ok) if ok.ndim == 0 else ok
 
     def with_gravity(self, gravity) -> RobotTree:
@@ -248,12 +263,15 @@ def _coordinates(links, mimic: dict, floating: bool):
     index = 6 if floating else 0
     for i, link in enumerate(links):
         if floating and i == 0:
-            coordinate.append(0), multiplier.append(1.0), offset.append(0.0)
+            c, o = 0, 0.0
         elif i in mimic:
-            coordinate.append(-1), multiplier.append(1.0), offset.append(link.offset)
+            c, o = -1, link.offset
         else:
-            coordinate.append(index), multiplier.append(1.0), offset.append(link.offset)
+            c, o = index, link.offset
             index += 1
+        coordinate.append(c)
+        multiplier.append(1.0)
+        offset.append(o)
     for i, spec in mimic.items():
         where = f"mimic[{i}]"
         try:

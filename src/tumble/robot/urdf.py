@@ -190,7 +190,7 @@ def read_urdf(source, *, check_triangle: bool = True, floating_base: bool = Fals
         for tag in ("parent", "child"):
             end = el.find(tag)
             link = None if end is None else end.get("link")
-            if link not in links:
+            if link is None or link not in links:
                 raise ValidationError(f"{where}: <{tag} link={link!r}> names no <link> of the robot")
             ends.append(link)
         parent, child = ends

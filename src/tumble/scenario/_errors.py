@@ -17,7 +17,7 @@ import re
 import tomllib
 from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
-from typing import get_args
+from typing import Any, get_args
 
 from tumble._validate import ValidationError
 from tumble.scenario._values import SHAPE_TAGS, _Table
@@ -66,7 +66,7 @@ def keyed(keys: Mapping[str, str], fallback: str) -> Iterator[None]:
     except ScenarioError:
         raise
     except ValidationError as exc:
-        argument = re.match(r"[^.\[]*", exc.field).group()
+        argument = re.split(r"[.\[]", exc.field, maxsplit=1)[0]  # the argument: the field up to . or [
         if exc.field and argument in keys:
             problem = (keys[argument] + exc.field[len(argument):], exc.rule)
         else:
@@ -115,7 +115,8 @@ def toml_problem(exc: tomllib.TOMLDecodeError) -> tuple[str, str]:
 def describe(error: Mapping, root: type[_Table]) -> tuple[str, str]:
     """``(key path, rule)`` of one pydantic error raised while validating the table ``root``."""
     path, table = _locate(error["loc"], root)
-    kind, ctx, got = error["type"], error.get("ctx") or {}, error.get("input")
+    kind, ctx = error["type"], error.get("ctx") or {}
+    got: Any = error.get("input")  # what the file gave, of any type
     if kind == "missing":
         rule = "missing required key"
     elif kind == "extra_forbidden":

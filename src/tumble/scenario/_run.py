@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from tumble.scenario._errors import in_file, keyed
-from tumble.simulate import Model, simulate
+from tumble.simulate import Model, SolverOptions, simulate
 from tumble.trajectory import Trajectory
 
 __all__ = ["RUN_KEYS", "Run"]
@@ -33,10 +33,10 @@ class Run:
     """
 
     model: Model
-    initial: dict[str, np.ndarray]
+    initial: dict[str, Any]  # array_like values; keyword arguments of simulate, so typed as its **initial_state
     t: np.ndarray
     method: str
-    options: dict[str, float]
+    options: SolverOptions
     torque: Any = None
     keys: dict[str, str] = field(default_factory=dict)
     source: str = "<scenario>"

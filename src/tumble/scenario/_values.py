@@ -6,7 +6,7 @@ and finite (``nan`` and ``inf`` are refused) unless a type says otherwise.
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal, Union
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal, TypeVar, Union
 
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag
 
@@ -20,7 +20,7 @@ _Bool = Annotated[bool, Field(strict=True)]
 _Text = Annotated[str, Field(strict=True)]
 _Axis = Literal["x", "y", "z"]
 
-#: The tags of :func:`_flat_or_rows`: not keys of a file (an error's key path leaves them out).
+#: The tags of :data:`_FlatOrRows`: not keys of a file (an error's key path leaves them out).
 SHAPE_TAGS = ("<flat>", "<rows>")
 
 
@@ -29,12 +29,14 @@ def _shape_of(value) -> str:
     return SHAPE_TAGS[isinstance(value, list) and bool(value) and isinstance(value[0], list)]
 
 
-def _flat_or_rows(flat, rows):
-    """A value written either as ``flat`` (a number, or an array of numbers) or as ``rows`` (an array of
-    arrays), chosen by what the file wrote, so that a bad value gets the one rule of the form it meant
-    (a gain that is a number or a matrix; one torque per wheel, or a row of them per time)."""
-    return Annotated[Union[Annotated[flat, Tag(SHAPE_TAGS[0])], Annotated[rows, Tag(SHAPE_TAGS[1])]],
-                     Discriminator(_shape_of)]
+_Flat = TypeVar("_Flat")
+_Rows = TypeVar("_Rows")
+
+#: ``_FlatOrRows[flat, rows]``: a value written either as ``flat`` (a number, or an array of numbers) or as
+#: ``rows`` (an array of arrays), chosen by what the file wrote, so that a bad value gets the one rule of the
+#: form it meant (a gain that is a number or a matrix; one torque per wheel, or a row of them per time).
+_FlatOrRows = Annotated[Union[Annotated[_Flat, Tag(SHAPE_TAGS[0])], Annotated[_Rows, Tag(SHAPE_TAGS[1])]],
+                        Discriminator(_shape_of)]
 
 
 class _Table(BaseModel):
@@ -62,6 +64,9 @@ class _InertiaOrMoments(_Table):
     """A table that gives an inertia as ``inertia`` (3×3, kg m²) or as ``moments`` (its diagonal, kg m²):
     the library's ``inertia`` argument is reported against whichever of the two keys the file gave.
     A subclass declares both fields and checks that exactly one is given."""
+
+    if TYPE_CHECKING:
+        moments: object  # the subclass's field (None when the file gives inertia)
 
     def argument_keys(self, prefix: str) -> dict[str, str]:
         keys = super().argument_keys(prefix)

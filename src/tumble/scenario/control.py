@@ -37,7 +37,7 @@ import numpy as np
 from pydantic import Field, field_validator
 
 from tumble import attitude
-from tumble.scenario._values import _flat_or_rows, _Limit, _Matrix, _Number, _Positive, _Quaternion, _Table, _Vector
+from tumble.scenario._values import _FlatOrRows, _Limit, _Matrix, _Number, _Positive, _Quaternion, _Table, _Vector
 from tumble.scenario.tables import EulerAngles
 from tumble.spacecraft import control
 
@@ -91,7 +91,7 @@ class MRPTable(Regulator):
 
     kind: Literal["mrp_feedback"]
     K: _Positive
-    P: _flat_or_rows(_Positive, _Matrix)
+    P: _FlatOrRows[_Positive, _Matrix]
     Ki: _Positive | None = None
 
     def build(self):
@@ -137,8 +137,8 @@ class WheelTorquesTable(_Table):
     ``"linear"`` (default) or ``"previous"`` (zero-order hold), the end rows held outside."""
 
     kind: Literal["wheel_torques"]
-    torques: _flat_or_rows(Annotated[list[_Number], Field(min_length=1)],
-                           Annotated[list[Annotated[list[_Number], Field(min_length=1)]], Field(min_length=1)])
+    torques: _FlatOrRows[Annotated[list[_Number], Field(min_length=1)],
+                         Annotated[list[Annotated[list[_Number], Field(min_length=1)]], Field(min_length=1)]]
     times: Annotated[list[_Number], Field(min_length=1)] | None = None
     interpolation: Literal["linear", "previous"] | None = None
     renamed: ClassVar[dict[str, str]] = {"t": "times"}

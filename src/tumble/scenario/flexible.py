@@ -61,7 +61,7 @@ class ModeTable(_Table):
     participation: _Vector
 
     def build(self) -> flexible.Mode:
-        return flexible.Mode(self.frequency, self.damping, self.participation)
+        return flexible.Mode(self.frequency, self.damping, np.array(self.participation))
 
 
 class FlexibleTable(_Table):
@@ -98,7 +98,7 @@ class FlexibleScenario(Scenario):
                 with keyed(mode.argument_keys(f"flexible.mode[{i}]"), f"flexible.mode[{i}]"):
                     modes.append(mode.build())
             with keyed({"modes": "flexible.mode"}, "flexible"):
-                model = flexible.FlexibleBody(body, modes)
+                model = flexible.FlexibleBody(body, tuple(modes))
             torque = build_torque(self.torque, body)
             keys = {**self.initial.argument_keys("initial"), **RUN_KEYS}
             with keyed(keys, "initial"):
@@ -114,13 +114,16 @@ class FlexibleScenario(Scenario):
         solver, and shows the pointing error, from the rigid body's final angle, after the last
         sample time of the tabulated torques (the end of the manoeuvre; the start without one).
         """
+        assert traj.q is not None  # the hub's attitude
         if np.abs(traj.q[:, 1:3]).max() > _ABOUT_Z:
             return traj.plot(title=self.name)
         run = self.build()
+        assert isinstance(run.model, flexible.FlexibleBody)
         rigid = simulate(run.model.body, t=run.t, method=run.method, torque=run.torque,
                          omega0=run.initial["omega0"], q0=run.initial["q0"], **run.options)
         ends = [entry.times[-1] for entry in self.torque if isinstance(entry, TabulatedTorque)]
         end = float(np.clip(max(ends, default=traj.t[0]), traj.t[0], traj.t[-1]))
+        assert rigid.q is not None
         figure = flexible.slew_figure(traj, rigid, end, float(flexible.slew_angle(rigid.q[-1])))
         if self.name:
             figure.suptitle(self.name)

@@ -31,7 +31,7 @@ The body takes no external torque (in the air).
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from pydantic import create_model
@@ -72,10 +72,13 @@ class AngleTable(_Table):
         return Motion(self.start, [(move.begin, move.end, move.target) for move in self.moves])
 
 
-HumanAngles = create_model("HumanAngles", __base__=_Table,
-                           __doc__="``[human.angles]``: an optional :class:`AngleTable` per joint angle of de Leva's "
-                                   "body, by its name (a missing angle is 0).",
-                           **{name: (AngleTable | None, None) for name in Human.de_leva().dofs})
+if TYPE_CHECKING:  # a model made at import time, one field per joint angle: to mypy, a table of any keys
+    HumanAngles = _Table
+else:
+    HumanAngles = create_model("HumanAngles", __base__=_Table,
+                               __doc__="``[human.angles]``: an optional :class:`AngleTable` per joint angle of de "
+                                       "Leva's body, by its name (a missing angle is 0).",
+                               **{name: (AngleTable | None, None) for name in Human.de_leva().dofs})
 
 
 class HumanTable(_Table):

@@ -58,6 +58,7 @@ class OrbitTable(_Table):
 
     def build(self) -> Orbit:
         a = self.semi_major_axis if self.altitude is None else EARTH_RADIUS + self.altitude
+        assert a is not None  # the validator gives exactly one of altitude and semi_major_axis
         angle = math.radians if self.degrees else float
         options = {} if self.mu is None else {"mu": self.mu}
         return Orbit(semi_major_axis=a, eccentricity=self.eccentricity,

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +25,7 @@ from tumble.scenario._values import _Vector
 from tumble.scenario.damper import SphericalDamperTable
 from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import Torque, build_torque
-from tumble.simulate import simulate
+from tumble.simulate import SolverOptions, simulate
 from tumble.spacecraft import Spacecraft, SphericalDamper
 from tumble.trajectory import Trajectory
 
@@ -64,7 +65,7 @@ class Problem:
     q0: np.ndarray
     t: np.ndarray
     method: str
-    options: dict[str, float]
+    options: SolverOptions
     torque: torques.TorqueModel | None
     source: str = "<scenario>"
     damper: SphericalDamper | None = None
@@ -85,7 +86,7 @@ class Problem:
 
     def simulate(self, *, progress: Callable[[int, int], None] | None = None) -> Trajectory:
         """Run :func:`tumble.simulate`; an argument it refuses is reported against its scenario key."""
-        damper = {} if self.damper_omega0 is None else {"damper_omega0": self.damper_omega0}
+        damper: dict[str, Any] = {} if self.damper_omega0 is None else {"damper_omega0": self.damper_omega0}
         with in_file(self.source), keyed(_RUN_KEYS, ""):
             return simulate(self.model, t=self.t, method=self.method, torque=self.torque, progress=progress,
                             omega0=self.omega0, q0=self.q0, **damper, **self.options)

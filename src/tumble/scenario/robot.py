@@ -47,7 +47,7 @@ class RobotTable(_Table):
     gravity: _Vector | None = None
     torque: list[_Number] | None = None
 
-    def chain(self, directory: Path) -> robot.SerialChain:
+    def chain(self, directory: Path) -> robot.RobotTree:
         """The chain of the robot file (a relative ``file`` is taken from ``directory``) under ``gravity``; a
         refusal is reported against ``robot.file`` or ``robot.gravity``."""
         path = directory / self.file

@@ -44,7 +44,7 @@ top of the spacecraft's own environment) are the shared tables
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal, Protocol
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -120,7 +120,7 @@ class HubTable(_InertiaOrMoments):
         return self
 
     def build(self) -> RigidBody:
-        inertia = self.inertia if self.inertia is not None else np.diag(self.moments)
+        inertia = self.inertia if self.moments is None else np.diag(self.moments)  # exactly one is given
         return RigidBody(inertia, mass=self.mass, com=self.com)
 
 
@@ -198,7 +198,15 @@ class FieldTable(_Table):
         return DipoleField() if self.model == "dipole" else np.array(self.uniform)
 
 
-def _built(table: _Table, key: str):
+class _Buildable(Protocol):
+    """A table that builds a library object (``build``) and maps its arguments to keys (``argument_keys``)."""
+
+    def argument_keys(self, prefix: str) -> dict[str, str]: ...
+
+    def build(self) -> Any: ...
+
+
+def _built(table: _Buildable, key: str):
     """``table.build()``, a refusal by the library reported against the key behind the argument."""
     with keyed(table.argument_keys(key), key):
         return table.build()
@@ -238,8 +246,9 @@ class SpacecraftTable(_InertiaOrMoments):
 
     def build(self) -> Spacecraft:
         """The :class:`~tumble.spacecraft.Spacecraft`; a refusal is reported against its key."""
-        parts = {key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
-                 for key in ("wheels", "thrusters", "controller")}
+        parts: dict[str, Any] = {  # the keyword arguments of Spacecraft
+            key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
+            for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
@@ -333,6 +342,7 @@ class SpacecraftScenario(Scenario):
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
         """Final rate and angle to the target, wheels (peak speed, saturation), change of the total momentum
         (hub + actuators)."""
+        assert traj.q is not None and traj.omega is not None  # the hub's attitude and rate
         rows = [("rate", f"final |omega| {np.linalg.norm(traj.omega[-1]):.3g} rad/s")]
         target = self.target()
         if target is not None:

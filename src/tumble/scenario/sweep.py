@@ -40,10 +40,12 @@ Angles are in rad.
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 from typing import Literal
 
 from pydantic import model_validator
 
+from tumble._validate import as_array
 from tumble.scenario._errors import ScenarioError, in_file
 from tumble.scenario._run import Run
 from tumble.scenario._values import _Bool, _Number, _Table, _Text
@@ -85,7 +87,7 @@ class DispersionTable(_Table):
                 except TypeError as exc:
                     raise ValueError(f"{name}: {exc}") from None
         if self.grid is not None:
-            return _d.Grid(self.grid)
+            return _d.Grid(as_array(self.grid, "points"))  # the check Grid makes, and an array for its type
         return _d.UniformAttitude()
 
 
@@ -192,7 +194,8 @@ def sweep_arguments(scenario, samples=None) -> dict:
                 states[key] = state
             else:
                 parameters.append(key)
-        outcomes, statistics = {}, {}
+        outcomes: dict[str, Callable] = {}  # name → f(traj): the sweep's outcomes and statistics
+        statistics: dict[str, Callable] = {}
         for group, out, make in ((table.outcomes, outcomes, "outcome_function"),
                                  (table.statistics, statistics, "series_function")):
             for name, entry in group.items():

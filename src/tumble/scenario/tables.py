@@ -8,7 +8,7 @@ inertial (``docs/scenarios.md``). The ``orbit`` table is in
 
 from __future__ import annotations
 
-from typing import Annotated, ClassVar, Literal, Union
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal, Union
 
 import numpy as np
 from pydantic import BaseModel, Discriminator, Field, Tag, field_validator
@@ -18,6 +18,7 @@ from tumble.body import RigidBody
 from tumble.scenario._errors import ScenarioError
 from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, _Quaternion, _Table, _Text,
                                      _Vector)
+from tumble.simulate import SolverOptions
 
 __all__ = ["Body", "EulerAngles", "Initial", "MAX_SAMPLES", "ModelState", "Solver", "Time"]
 
@@ -59,6 +60,9 @@ class MomentsBody(_Table):
 
 class _Shape(_Table):
     """A homogeneous solid: its keys are the arguments of ``RigidBody.<shape>(...)``."""
+
+    if TYPE_CHECKING:
+        shape: str  # each solid's field: the name of its RigidBody constructor
 
     def build(self) -> RigidBody:
         constructor = getattr(RigidBody, self.shape)
@@ -278,9 +282,11 @@ class Time(_Table):
         """The output times: ``linspace(start, stop, samples)``, or ``start + k step`` up to ``stop``."""
         if self.samples is not None:
             return np.linspace(self.start, self.stop, self.samples)
-        n = _step_count(self.start, self.stop, self.step)
-        end = self.start + n * self.step
-        if abs(end - self.stop) <= _STEP_ROUNDING * self.step:
+        step = self.step
+        assert step is not None  # the validator gives exactly one of samples and step
+        n = _step_count(self.start, self.stop, step)
+        end = self.start + n * step
+        if abs(end - self.stop) <= _STEP_ROUNDING * step:
             end = self.stop  # land exactly on stop despite rounding
         return np.linspace(self.start, end, n + 1)
 
@@ -308,7 +314,7 @@ class Solver(_Table):
     method: _Text = "dop853"
     rtol: _Positive | None = None
     atol: _Positive | None = None
-    dt: _Positive | None = Field(None, validate_default=True)
+    dt: _Positive | None = Field(default=None, validate_default=True)
 
     @field_validator("method")
     @classmethod
@@ -331,6 +337,13 @@ class Solver(_Table):
             raise ValueError(f"not used by method {method.name!r}, which takes {takes}")
         return value
 
-    def options(self) -> dict[str, float]:
+    def options(self) -> SolverOptions:
         """The options given, as keyword arguments of :func:`tumble.simulate`."""
-        return self.model_dump(include={"rtol", "atol", "dt"}, exclude_none=True)
+        options = SolverOptions()
+        if self.rtol is not None:
+            options["rtol"] = self.rtol
+        if self.atol is not None:
+            options["atol"] = self.atol
+        if self.dt is not None:
+            options["dt"] = self.dt
+        return options

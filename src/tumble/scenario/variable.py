@@ -92,6 +92,7 @@ class VariableScenario(Scenario):
 
 def rate_and_energy_rows(traj: Trajectory) -> list[tuple[str, str]]:
     """Summary rows of a body that changes shape: ``|ω|`` and the energy at the start and the end."""
+    assert traj.omega is not None  # the body's rate
     rate = np.linalg.norm(traj.omega, axis=-1)
     return [("rate", f"|omega| {rate[0]:.6g} rad/s at the start, {rate[-1]:.6g} rad/s at the end"),
             ("energy", f"{traj.energy[0]:.6g} J at the start, {traj.energy[-1]:.6g} J at the end "

@@ -112,12 +112,13 @@ class ReactionWheel:
     def part(self) -> Part:
         """The rotor as a :class:`tumble.body.Part` of the spacecraft (body axes):
         inertia ``I_s a aᵀ + I_t (E − a aᵀ)`` about its centre at ``position``."""
-        if not self.has_mass_properties:
+        mass, position, transverse = self.mass, self.position, self.transverse_inertia
+        if mass is None or position is None or transverse is None:  # all or none: checked in __post_init__
             raise ValidationError("wheels: with Spacecraft(hub=...), every wheel needs mass, position and "
                                   "transverse_inertia (the hub inertia excludes the wheels)")
         aa = np.outer(self.axis, self.axis)
-        inertia = self.inertia * aa + self.transverse_inertia * (np.eye(3) - aa)
-        return Part(mass=self.mass, com=self.position, inertia=inertia)
+        inertia = self.inertia * aa + transverse * (np.eye(3) - aa)
+        return Part(mass=mass, com=position, inertia=inertia)
 
 
 @dataclass(frozen=True)
@@ -310,6 +311,6 @@ def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.
     (degrees; default 54.74°, equal control authority about the three axes). ``options`` go
     to every :class:`ReactionWheel`."""
     beta = math.radians(skew)
-    return [ReactionWheel(axis=[math.cos(beta) * math.cos(0.5 * math.pi * i),
-                                math.cos(beta) * math.sin(0.5 * math.pi * i), math.sin(beta)],
+    return [ReactionWheel(axis=np.array([math.cos(beta) * math.cos(0.5 * math.pi * i),
+                                         math.cos(beta) * math.sin(0.5 * math.pi * i), math.sin(beta)]),
                           inertia=inertia, **options) for i in range(4)]

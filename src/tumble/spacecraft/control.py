@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -79,7 +80,7 @@ class QuaternionPD:
 
     natural_frequency: float
     damping_ratio: float = 1.0 / math.sqrt(2.0)
-    target: np.ndarray = (1.0, 0.0, 0.0, 0.0)
+    target: np.ndarray = (1.0, 0.0, 0.0, 0.0)  # type: ignore[assignment]  # array_like: __post_init__ converts
     max_rate: float = math.inf
     max_torque: float = math.inf
 
@@ -121,7 +122,7 @@ class MRPFeedback:
     K: float
     P: object
     Ki: float | None = None
-    target: np.ndarray = (1.0, 0.0, 0.0, 0.0)
+    target: np.ndarray = (1.0, 0.0, 0.0, 0.0)  # type: ignore[assignment]  # array_like: __post_init__ converts
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -243,7 +244,7 @@ class WheelTorques:
         :class:`PythonLaw`)
     """
 
-    torques: object
+    torques: Any  # a function of time, or samples (len(t), n_w) or (n_w,): an array (len(t), n_w) once validated
     t: object = None
     interpolation: str = "linear"
     slot: int | None = field(init=False, repr=False, default=None)

@@ -35,6 +35,7 @@ def spacecraft_figure(traj: Trajectory, *, target=None, title: str | None = None
     """
     from matplotlib.figure import Figure
 
+    assert traj.q is not None and traj.omega is not None  # a spacecraft has an attitude
     if traj.q.ndim != 2:
         raise ValueError("traj: spacecraft_figure draws one spacecraft, not a batch")
     extras, t = traj.extras, traj.t

@@ -27,6 +27,7 @@ import math
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -115,7 +116,7 @@ class Spacecraft(Model):
     orbit: Orbit | None = None
     magnetic_field: object = None
     gravity_gradient: bool = False
-    controller: object = None
+    controller: Any = None  # a law, a sequence of laws or None: the tuple of laws once validated
     control_period: float | None = None
     #: The whole spacecraft as one rigid body (total inertia J, mass, centre of mass), derived.
     body: RigidBody = field(init=False, repr=False)
@@ -160,10 +161,12 @@ class Spacecraft(Model):
                                   "(without the wheels, which then need mass properties)")
         if self.inertia is not None:
             return self.inertia if isinstance(self.inertia, RigidBody) else RigidBody(self.inertia)
-        _check_type(self.hub, RigidBody, "hub")
-        if self.wheels and self.hub.mass is None:
+        hub = self.hub
+        _check_type(hub, RigidBody, "hub")
+        assert hub is not None  # exactly one of inertia and hub: checked above
+        if self.wheels and hub.mass is None:
             raise ValidationError("hub: needs a mass to be combined with the wheels")
-        total = RigidBody.composite([self.hub] + [w.part() for w in self.wheels]) if self.wheels else self.hub
+        total = RigidBody.composite([hub] + [w.part() for w in self.wheels]) if self.wheels else hub
         if self.damper is None:
             return total
         return RigidBody(total.inertia + self.damper.inertia * np.eye(3), mass=total.mass, com=total.com)
@@ -241,20 +244,25 @@ class Spacecraft(Model):
         if self.wheels:
             axes = np.array([w.axis for w in self.wheels])
             routed = self.route == "wheels" and self._torque_law() is not None
+            spin, max_torque, max_speed, viscous, coulomb, coulomb_speed = (
+                np.array([getattr(w, name) for w in self.wheels])
+                for name in ("inertia", "max_torque", "max_speed", "viscous", "coulomb", "coulomb_speed"))
             programs.append(_wheels.program(
-                axes, *(np.array([getattr(w, name) for w in self.wheels]) for name in
-                        ("inertia", "max_torque", "max_speed", "viscous", "coulomb", "coulomb_speed")),
+                axes, spin, max_torque, max_speed, viscous, coulomb, coulomb_speed,
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
         programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper) if part is not None]
-        if self.thrusters:
-            programs.append(self._thruster_program())
+        thrusters = self._thruster_program()
+        if thrusters is not None:  # None: no thrusters
+            programs.append(thrusters)
         for law in self.controller:
             programs += law._programs(self.rate_inertia)
         if isinstance(self.magnetic_field, DipoleField):
+            assert self.orbit is not None  # a DipoleField needs an orbit: checked in __post_init__
             programs.append(_environment.dipole_program(self.orbit.elements(), self.magnetic_field.params()))
         elif self.magnetic_field is not None:
             programs.append(_environment.uniform_program(self.magnetic_field))
         if self.gravity_gradient:
+            assert self.orbit is not None  # checked in __post_init__
             programs.append(_environment.gravity_gradient_program(self.orbit.elements()))
         return tuple(programs)
 
@@ -314,7 +322,7 @@ class Spacecraft(Model):
         period = self.control_period
         if period is None:
             return
-        if method.adaptive:
+        if method.adaptive or dt is None:  # dt is None: a method with no step ("exact")
             raise ValidationError(f"method: a sampled controller (control_period = {period} s) needs a fixed-step "
                                   f"method ('rk4', 'cf4'), whose steps land on the sample times; got {method.name!r}")
         ratio = period / dt
@@ -369,7 +377,12 @@ class Spacecraft(Model):
         def core(offset, size=3):
             return aux[..., offset:offset + size]
 
-        where = functools.partial(_kernel.slices, kernel)
+        def where(kind: str) -> _kernel.Slices:
+            """Where the part of ``kind``, one the spacecraft has, is in the kernel."""
+            found = _kernel.slices(kernel, kind)
+            assert found is not None, kind
+            return found
+
         if self.wheels:
             w = where("wheels")
             state, diag = _wheels.state_slices(w.n, w.s), _wheels.aux_slices(w.n, w.a)
@@ -434,7 +447,7 @@ class Spacecraft(Model):
             d = where("damper")
             add("damper_omega", states[..., _damper_kernel.state_slices(d.n, d.s)["damper_omega"]], ("body_axis",),
                 "rad/s", "angular velocity of the damper sphere relative to inertial, body axes")
-        integral = where("mrp_integral")
+        integral = _kernel.slices(kernel, "mrp_integral")
         if integral is not None:
             add("attitude_error_integral",
                 states[..., _law_kernels.integral_slices(integral.n, integral.s)["attitude_error_integral"]], ("xyz",),

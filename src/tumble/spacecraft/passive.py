@@ -404,6 +404,7 @@ def explorer1_figure(traj: Trajectory, spacecraft: Explorer1 = EXPLORER1) -> Fig
     dm = spacecraft.damper()
     i_s, i_t = spacecraft.locked_moments()
     tau = _damper.energy_sink_time_constant(i_s, i_t, dm, spacecraft.spin)
+    assert traj.omega is not None  # the hub's rate
     theta = _damper.nutation_angle(traj, [0.0, 0.0, 1.0])
     energy = traj.energy
     momentum = np.linalg.norm(traj.momentum_body[0])

@@ -29,8 +29,9 @@ import hashlib
 import inspect
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import Any, TypeGuard
 
 import numpy as np
 
@@ -195,7 +196,8 @@ class Plan:
         return hashlib.sha256(json.dumps(self.settings(), sort_keys=True).encode()).hexdigest()[:16]
 
 
-def _is_builder(model) -> bool:
+def _is_builder(model: object) -> TypeGuard[Callable[..., Any]]:
+    """True for a function of the parameters that builds the model (not a model, nor an inertia array)."""
     return callable(model) and not isinstance(model, (Model, np.ndarray))
 
 
@@ -213,6 +215,12 @@ def _describe_model(model) -> str:
     return repr(model) + extra
 
 
+def _inertia_of(member: Trajectory) -> np.ndarray:
+    """The (3, 3) inertia of a single-member run of a model with an attitude."""
+    assert member.inertia is not None
+    return member.inertia if member.inertia.ndim == 2 else member.inertia[0]
+
+
 def _stack(members: list[Trajectory]) -> Trajectory:
     """One batched trajectory (member axis 1) from single-member runs (each with a member axis of 1)."""
     first = members[0]
@@ -221,8 +229,7 @@ def _stack(members: list[Trajectory]) -> Trajectory:
         parts = [get(tr) for tr in members]
         return None if parts[0] is None else np.concatenate(parts, axis=1)
 
-    inertia = None if first.inertia is None else np.stack(
-        [tr.inertia if tr.inertia.ndim == 2 else tr.inertia[0] for tr in members])
+    inertia = None if first.inertia is None else np.stack([_inertia_of(tr) for tr in members])
     extras = {name: Extra(cat(lambda tr, name=name: tr.extras[name].data), e.dims, e.units, e.description)
               for name, e in first.extras.items()}
     totals = {name: cat(lambda tr, name=name: tr.totals[name]) for name in first.totals}

@@ -46,8 +46,12 @@ import os
 import shutil
 import tempfile
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    import zarr
 
 from tumble._validate import ValidationError
 from tumble.ensemble import STATISTICS, _merge, moments
@@ -68,9 +72,9 @@ class SweepStore:
     def __init__(self, path, plan: Plan):
         self.path = None if path is None else os.fspath(path)
         self.plan = plan
-        self._memory = None
-        self._writable = None  # the group open for writing, once the store exists, and its arrays
-        self._arrays = {}
+        self._memory: zarr.storage.MemoryStore | None = None  # the store when path is None, once made
+        self._writable: zarr.Group | None = None  # the group open for writing once the store exists, and its arrays
+        self._arrays: dict[str, zarr.Array] = {}
         self._done = np.zeros(plan.n_chunks, dtype=bool)
         if self.path is not None and os.path.exists(self.path):
             self._check()
@@ -137,7 +141,8 @@ class SweepStore:
             dims = lead + tuple(f"{name}_dim{k}" for k in range(len(tail)))
             return dims, da.zeros((s, *tail), chunks=(c, *tail), dtype=value.dtype)
 
-        data = {name: empty(name, v, ("sample",)) for name, v in {**first.inputs, **first.outcomes}.items()}
+        data: dict[str, tuple] = {name: empty(name, v, ("sample",))  # name → (dims, values)
+                                  for name, v in {**first.inputs, **first.outcomes}.items()}
         for name, v in first.series.items():
             data[name] = ("sample", "time"), da.zeros((s, len(plan.t)), chunks=(c, len(plan.t)))
         for name, v in first.trajectories.items():
@@ -190,13 +195,14 @@ class SweepStore:
         plan = self.plan
         group = self._group()
         p = np.asarray(percentiles, dtype=np.float64)
-        data = {}
+        data: dict[str, tuple] = {}  # name → (dims, values)
         for name in plan.series:
-            stats = None
+            stats: list[np.ndarray] | None = None
             for k in range(plan.n_chunks):
                 lo, hi = plan.bounds(k)
                 part = moments(group[name][lo:hi].T)
                 stats = part if stats is None else _merge(stats, part)
+            assert stats is not None  # a sweep has at least one chunk
             count, mean, m2, low, high = stats
             for stat, value in zip(STATISTICS, (mean, np.sqrt(m2 / count), low, high), strict=True):
                 data[f"{name}_{stat}"] = ("time", value)

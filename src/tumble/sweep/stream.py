@@ -20,6 +20,7 @@ import os
 import shutil
 import tempfile
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -74,16 +75,18 @@ def simulate_to_store(model, store, *, t, initial_state: dict, options: dict, ch
     model = as_model(model)
     values = {name: np.asarray(v) for name, v in initial_state.items() if v is not None}
     n = _members(model, values)
+    if n < 1:
+        raise ValidationError("store: the batch has no members (initial states of shape (0, size)): nothing to write")
     t = np.asarray(t, dtype=np.float64)
     chunk = max(1, SAMPLES_PER_CHUNK // max(1, t.size)) if chunk is None else int(chunk)
     if chunk < 1:
         raise ValidationError(f"chunk: must be >= 1 member, got {chunk}")
     tmp = None
-    summed = {}
+    summed: dict[str, int] = {}  # the solver statistics, summed over the chunks
     try:
         for lo in range(0, n, chunk):
             hi = min(n, lo + chunk)
-            part = {name: v[lo:hi] if np.ndim(v) == 2 else v for name, v in values.items()}
+            part: dict[str, Any] = {name: v[lo:hi] if np.ndim(v) == 2 else v for name, v in values.items()}
             traj = simulate(_chunk_of(model, lo, hi), t=t, **options, **part)
             ds = traj.to_xarray()
             # labels as variable-length strings: Zarr 3 specifies those, not NumPy's fixed-width ones
@@ -113,6 +116,7 @@ def simulate_to_store(model, store, *, t, initial_state: dict, options: dict, ch
                 progress(hi, n)
         import zarr
 
+        assert tmp is not None  # n >= 1: the first chunk made it
         zarr.open_group(tmp, mode="r+", zarr_format=3).attrs.update(summed)
         os.rename(tmp, path)
     except BaseException:

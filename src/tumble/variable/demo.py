@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import os
 
 import numpy as np
@@ -50,7 +51,7 @@ def demo_diver(out_dir) -> dict:
         "513xd": figure_dive(human, dive, "(c) forward 1½ somersaults with twists, arms out and back in"),
     }
     for name, fig in figures.items():
-        write_atomic(paths[name], lambda tmp, fig=fig: fig.savefig(tmp, format="png", dpi=110))
+        write_atomic(paths[name], functools.partial(fig.savefig, format="png", dpi=110))
     nc_path, html_path = os.path.join(out_dir, "diver_513xd.nc"), os.path.join(out_dir, "diver_513xd.html")
     dive.trajectory.save(nc_path)
     dive.trajectory.to_html(html_path, model=human)

@@ -139,7 +139,7 @@ class Segment:
     joint: tuple = (0.0, 0.0, 0.0)
     axes: tuple = ()
     dofs: tuple = ()
-    part: Part | None = None
+    part: Part = None  # type: ignore[assignment]  # required: __post_init__ refuses None (it orders the fields)
 
     def __post_init__(self):
         if not isinstance(self.part, Part):
@@ -193,7 +193,8 @@ class Human:
         segments = tuple(segments)
         if not segments or segments[0].parent is not None:
             raise ValidationError("segments: the first segment must be the root (parent=None)")
-        index, dofs = {}, []
+        index: dict[str, int] = {}
+        dofs: list[str] = []
         for k, seg in enumerate(segments):
             if not isinstance(seg, Segment):
                 raise ValidationError(f"segments[{k}]: must be a Segment, got {type(seg).__name__}")
@@ -207,7 +208,10 @@ class Human:
             raise ValidationError(f"segments: joint angle names must be unique, got {dofs}")
         self.segments = segments
         self.dofs = tuple(dofs)
-        self._parents = [None] + [index[s.parent] for s in segments[1:]]
+        self._parents: list[int | None] = [None]  # the index of each segment's parent, None for the root
+        for seg in segments[1:]:
+            assert seg.parent is not None  # an earlier segment: checked above
+            self._parents.append(index[seg.parent])
 
     @classmethod
     def de_leva(cls, mass: float = 73.0, height: float = 1.741) -> Human:
@@ -340,6 +344,7 @@ class MovingHuman(VariableBody):
             "shape_energy": Extra(shape_energy, (), "J", "kinetic energy of the shape change relative to the "
                                   "trunk frame"),
         }
+        assert out.omega is not None  # the trunk's rate
         coupling = np.einsum("...i,...i->...", out.omega, out.extras["shape_momentum"].data)   # ω·A
         energy = out.totals["energy"] + coupling + shape_energy
         return out._replace(extras=extras, totals={**out.totals, "energy": energy})

@@ -111,7 +111,9 @@ def _plain(a) -> list:
     """An array as nested lists, NaN as None (JSON null)."""
     a = np.asarray(a, dtype=np.float64)
     if np.isnan(a).any():
-        return np.where(np.isnan(a), None, a.astype(object)).tolist()
+        plain = a.astype(object)
+        plain[np.isnan(a)] = None
+        return plain.tolist()
     return a.tolist()
 
 

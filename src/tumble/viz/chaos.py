@@ -18,6 +18,7 @@ plane (γ₂, ω₃); the largest finite-time exponent of one orbit
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -107,7 +108,7 @@ def figure_chaos(data: dict):
         ax.loglog(top["t"][late], top["lyapunov"][late], label=name)
     t = next(iter(data.values()))["t"]
     t = t[t >= 10.0]
-    ax.loglog(t, np.log(np.maximum(t, np.e)) / t, "k--", linewidth=0.8, label="ln t / t")
+    ax.loglog(t, np.log(np.maximum(t, math.e)) / t, "k--", linewidth=0.8, label="ln t / t")
     ax.set(xlabel="t (s)", ylabel="finite-time largest exponent λ₁(t) (1/s)",
            title="Largest Lyapunov exponent: → 0 like ln t / t when integrable, a plateau when chaotic")
     ax.legend()

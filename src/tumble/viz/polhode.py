@@ -53,6 +53,7 @@ def polhode_figure(body: RigidBody, omega, trajectory: Trajectory | None = None,
     Nothing is shown or saved. A spherical body (no polhodes) is refused.
     """
     from matplotlib.figure import Figure
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     if not isinstance(body, RigidBody):
         raise ValidationError(f"body: must be a RigidBody, got {type(body).__name__}")
@@ -63,7 +64,9 @@ def polhode_figure(body: RigidBody, omega, trajectory: Trajectory | None = None,
     energy = report.energy
 
     fig = Figure(figsize=(13.0, 6.4), layout="constrained")
-    fig.get_layout_engine().set(wspace=0.12)  # room for the 3-D panel's ω₃ label, which the layout does not see
+    engine = fig.get_layout_engine()
+    assert isinstance(engine, ConstrainedLayoutEngine)  # layout="constrained"
+    engine.set(wspace=0.12)  # room for the 3-D panel's ω₃ label, which the layout does not see
     grid = fig.add_gridspec(1, 2, width_ratios=[1.25, 1.0])
     ax3d = fig.add_subplot(grid[0], projection="3d", computed_zorder=False)
     ax2d = fig.add_subplot(grid[1])
@@ -93,7 +96,7 @@ def _default_trajectory(body: RigidBody, omega: np.ndarray, period: float) -> Tr
     if np.isfinite(period):
         span, n = _MOTION_PERIODS * period, int(_MOTION_PERIODS * _SAMPLES_PER_PERIOD)
     else:
-        span, n = _FALLBACK_TURNS * 2.0 * np.pi / np.linalg.norm(omega), int(_FALLBACK_TURNS * 100)
+        span, n = _FALLBACK_TURNS * 2.0 * np.pi / float(np.linalg.norm(omega)), int(_FALLBACK_TURNS * 100)
     return torque_free(body, omega, t=np.linspace(0.0, span, n + 1))
 
 
@@ -165,7 +168,7 @@ def _draw_herpolhode(ax, trajectory: Trajectory, polhode_points: np.ndarray) -> 
     path = herpolhode(trajectory)
     points = path.points
     segments = np.stack([points[:-1], points[1:]], axis=1)
-    lines = LineCollection(segments, cmap="viridis", linewidths=1.4)
+    lines = LineCollection(list(segments), cmap="viridis", linewidths=1.4)  # the segments' stubs: a sequence
     lines.set_array(trajectory.t[:-1])
     ax.add_collection(lines)
     colorbar = ax.figure.colorbar(lines, ax=ax, shrink=0.85, pad=0.02)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -107,12 +107,12 @@ def top_figure(top: HeavyTop, trajectory: Trajectory | None = None, *, com=None,
     ax_rate.set_title("(c) precession rate", loc="left")
 
     if motion is not None:
-        k = slice(None, None, max(1, len(motion.t) // _MAX_MARKERS))
-        ts, th = motion.t[k] - motion.t[0], np.degrees(motion.theta[k])
-        style = dict(ls="none", marker=".", ms=3, color="C3", label="tumble.simulate")
-        above.plot(th * np.sin(motion.phi[k]), -th * np.cos(motion.phi[k]), **style)
+        every = slice(None, None, max(1, len(motion.t) // _MAX_MARKERS))
+        ts, th = motion.t[every] - motion.t[0], np.degrees(motion.theta[every])
+        style: dict[str, Any] = dict(ls="none", marker=".", ms=3, color="C3", label="tumble.simulate")
+        above.plot(th * np.sin(motion.phi[every]), -th * np.cos(motion.phi[every]), **style)
         ax_theta.plot(ts, th, **style)
-        ax_rate.plot(ts, motion.phi_dot[k], **style)
+        ax_rate.plot(ts, motion.phi_dot[every], **style)
 
     above.legend(loc="best", fontsize="small")
     for ax, values in ((ax_theta, theta), (ax_rate, top.precession_rate(t))):

@@ -66,6 +66,7 @@ def attitude_scene(traj, idx: np.ndarray, *, mesh: Mesh | None, mesh_note: str, 
     R = rotations(traj.q[idx])
     if mesh is not None:
         half = float(np.linalg.norm(mesh.vertices, axis=-1).max())
+    assert half is not None, "half: needed when the caller draws the body (mesh None)"
     a = _AXIS_LENGTH * half
     scene = Scene(title=title, t=traj.t[idx], sample=idx, samples=len(traj.t), extent=a,
                   notes=[f"{body}: {mesh_note}; body axes x, y, z (red, green, blue) drawn {a:.4g} m long"])
