@@ -311,14 +311,16 @@ class Trajectory:
         """The trajectory at the output samples ``index`` only: a slice or integer indices along time, kept
         in order (an int gives one sample, ``at(-1)`` the last); every sampled array, extra and total is
         cut the same way, the inertia and ``info`` are kept."""
+        pick: slice | np.ndarray
         if isinstance(index, slice):
             pick = index
         else:
-            pick = np.atleast_1d(np.asarray(index))
-            if pick.ndim != 1 or pick.dtype.kind not in "iu":
+            indices = np.atleast_1d(np.asarray(index))
+            if indices.ndim != 1 or indices.dtype.kind not in "iu":
                 raise ValidationError(f"index: must be a slice or integer indices along time, got {index!r}")
-            if pick.size and not (-len(self) <= pick.min() and pick.max() < len(self)):
-                raise IndexError(f"index: output samples out of range for n = {len(self)}: {pick.tolist()}")
+            if indices.size and not (-len(self) <= indices.min() and indices.max() < len(self)):
+                raise IndexError(f"index: output samples out of range for n = {len(self)}: {indices.tolist()}")
+            pick = indices
 
         def cut(a):
             return None if a is None else a[pick]
