@@ -277,9 +277,22 @@ def scratch(nb):
     return np.empty((nb, _WIDTH))
 
 
+@njit(**_INLINE)
+def _state_fits(P, q, qd, other, g, fext, nv):
+    """True when ``q`` has the tree's nq = nv + (1 with a floating base) entries, ``qd`` and ``other`` nv,
+    ``g`` 3 and ``fext`` 6."""
+    return (q.shape[0] == nv + floating(P) and qd.shape[0] == nv and other.shape[0] == nv and g.shape[0] == 3
+            and fext.shape[0] == 6)
+
+
 @njit(**_JIT)
 def rnea(P, q, qd, qdd, g, fext, tau):
-    """One sample: ``tau`` (nv,) from ``q`` (nq,), ``qd``, ``qdd`` (nv,), ``g`` (3,), ``fext`` (6,)."""
+    """One sample: ``tau`` (nv,) from ``q`` (nq,), ``qd``, ``qdd`` (nv,), ``g`` (3,), ``fext`` (6,).
+
+    Returns False when a size does not fit (then ``tau`` is left as it was) or a torque is not finite.
+    """
+    if not _state_fits(P, q, qd, qdd, g, fext, tau.shape[0]):
+        return False
     return rnea_one(P, q, qd, qdd, g, fext, scratch(P.shape[0]), tau)
 
 
@@ -396,7 +409,17 @@ def crba_one(P, q, W, M):
 
 @njit(**_JIT)
 def crba(P, q, M):
+    """One sample: ``M`` (nv, nv) from ``q`` (nq,). Returns False when a size does not fit (then ``M`` is left as
+    it was) or an entry is not finite."""
+    nv = M.shape[0]
+    if not (q.shape[0] == nv + floating(P) and M.shape[1] == nv):
+        return False
     crba_one(P, q, scratch(P.shape[0]), M)
+    ok = True
+    for r in range(nv):
+        for c in range(nv):
+            ok = ok and math.isfinite(M[r, c])
+    return ok
 
 
 @njit(parallel=True, **_JIT)
@@ -610,6 +633,12 @@ def forward_one(P, q, qd, tau, g, fext, W, X, T, M, zero, qdd):
 
 @njit(**_JIT)
 def aba(P, q, qd, tau, g, fext, qdd):
+    """One sample: ``qdd`` (nv,) from ``q`` (nq,), ``qd``, ``tau`` (nv,), ``g`` (3,), ``fext`` (6,).
+
+    Returns False when a size does not fit (then ``qdd`` is left as it was) or an acceleration is not finite.
+    """
+    if not _state_fits(P, q, qd, tau, g, fext, qdd.shape[0]):
+        return False
     W, X, T, M, zero = fd_scratch(P.shape[0], qd.shape[0])
     return forward_one(P, q, qd, tau, g, fext, W, X, T, M, zero, qdd)
 
