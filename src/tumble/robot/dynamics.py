@@ -65,6 +65,7 @@ def _vectors(a, b, c) -> bool:
 
 
 _VECTOR = numba.types.Array(numba.float64, 1, "A")  # (n,), any stride
+_FLAT = numba.types.Array(numba.float64, 1, "C")  # (n,), contiguous: the model's workspace
 _TABLE = numba.types.Array(numba.float64, 2, "C")  # (rows, columns), C order: the tree's P, a result M
 
 
@@ -74,8 +75,9 @@ class _SingleState:
     resolution of its arguments (measured 0.35 → 0.21 µs for seven arrays). An entry does not check types:
     callers pass float64 ndarrays of these dimensions only (sizes are checked by the kernels)."""
 
-    _SIGNATURES = {"rnea": (_TABLE,) + (_VECTOR,) * 6, "aba": (_TABLE,) + (_VECTOR,) * 6,
-                   "crba": (_TABLE, _VECTOR, _TABLE)}
+    _SIGNATURES = {"rnea": (_TABLE,) + (_VECTOR,) * 5 + (_FLAT, _VECTOR),
+                   "aba": (_TABLE,) + (_VECTOR,) * 5 + (_FLAT, _VECTOR),
+                   "crba": (_TABLE, _VECTOR, _FLAT, _TABLE)}
 
     def __getattr__(self, name):  # only while ``name`` is not yet an attribute: the first call
         entry = getattr(_kernels, name).compile(self._SIGNATURES[name])
@@ -157,13 +159,13 @@ def rnea(model: RobotTree, q, qd, qdd, *, gravity=None, f_ext=None) -> np.ndarra
     """
     if gravity is None and f_ext is None and _vectors(q, qd, qdd):  # one state: the checks are the kernel's
         tau = np.empty(model._nv)
-        if _one.rnea(model._params, q, qd, qdd, model._gravity, model._no_wrench, tau):
+        if _one.rnea(model._params, q, qd, qdd, model._gravity, model._no_wrench, model._workspace, tau):
             return tau
     q, qd, qdd = _three(model, q, qd, qdd, ("q", "qd", "qdd"))  # else (or on failure) checked, errors named
     g, f = _loads(model, q, gravity, f_ext)
     tau = np.empty(qd.shape)
     if q.ndim == 1:
-        ok = _one.rnea(model._params, q, qd, qdd, g, f, tau)
+        ok = _one.rnea(model._params, q, qd, qdd, g, f, model._workspace, tau)
     else:
         _kernels.rnea_batch(model._params, q, qd, qdd, g, f, tau, _chunks(len(q)))
         ok = bool(np.isfinite(tau).all())
@@ -195,12 +197,12 @@ def mass_matrix(model: RobotTree, q) -> np.ndarray:
     nv = model._nv
     if type(q) is _NDARRAY and q.dtype is _F64 and q.ndim == 1:  # one state: the size check is the kernel's
         M = np.empty((nv, nv))
-        if _one.crba(model._params, q, M):
+        if _one.crba(model._params, q, model._workspace, M):
             return M
     q = _joints(model, q, "q")  # else (or on failure) checked, errors named
     M = np.empty((*q.shape[:-1], nv, nv))
     if q.ndim == 1:
-        ok = _one.crba(model._params, q, M)
+        ok = _one.crba(model._params, q, model._workspace, M)
     else:
         _kernels.crba_batch(model._params, q, M, _chunks(len(q)))
         ok = bool(np.isfinite(M).all())
@@ -217,13 +219,13 @@ def forward_dynamics(model: RobotTree, q, qd, tau, *, gravity=None, f_ext=None) 
     """
     if gravity is None and f_ext is None and _vectors(q, qd, tau):  # one state: the checks are the kernel's
         qdd = np.empty(model._nv)
-        if _one.aba(model._params, q, qd, tau, model._gravity, model._no_wrench, qdd):
+        if _one.aba(model._params, q, qd, tau, model._gravity, model._no_wrench, model._workspace, qdd):
             return qdd
     q, qd, tau = _three(model, q, qd, tau, ("q", "qd", "tau"))  # else (or on failure) checked, errors named
     g, f = _loads(model, q, gravity, f_ext)
     qdd = np.empty(qd.shape)
     if q.ndim == 1:
-        ok = _one.aba(model._params, q, qd, tau, g, f, qdd)
+        ok = _one.aba(model._params, q, qd, tau, g, f, model._workspace, qdd)
     else:
         _kernels.aba_batch(model._params, q, qd, tau, g, f, qdd, _chunks(len(q)))
         ok = bool(np.isfinite(qdd).all())

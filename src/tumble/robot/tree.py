@@ -63,7 +63,7 @@ class RobotTree(ChainMotion):
     """
 
     __slots__ = ("_links", "_parents", "_gravity", "_name", "_frames", "_mimic", "_params", "_lower", "_upper",
-                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links")
+                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links", "_workspace")
 
     def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity=DEFAULT_GRAVITY,
                  name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None):
@@ -104,6 +104,9 @@ class RobotTree(ChainMotion):
         nv = len(independent) + 6 * floating
         set_(self, "_nv", nv)
         set_(self, "_nq", nv + floating)
+        # scratch of the single-state rnea / mass_matrix / forward_dynamics: their compiled code holds the
+        # GIL (no nogil) and calls nothing back, so two calls on one model never overlap
+        set_(self, "_workspace", _kernels.workspace(len(links), nv))
 
     @classmethod
     def from_urdf(cls, source, *, floating_base: bool = False, mimic: bool = True, check_triangle: bool = True,
