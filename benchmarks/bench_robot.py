@@ -1,15 +1,19 @@
 """Speed of tumble.robot's RNEA, CRBA and forward dynamics beside Pinocchio, in one run, from the same URDFs.
 
-    PYTHONPATH=src python benchmarks/bench_robot.py [--batch 20000] [--repeats 7]
+    PYTHONPATH=src python benchmarks/bench_robot.py [--batch 20000] [--calls 2000] [--repeats 7]
 
-Robots: the 6-axis tumble.examples.path("industrial6.urdf"), UR5 and Panda (fixed base) and the Talos humanoid and
-Solo12 quadruped (floating base) from example-robot-data. Pinocchio builds its model from the same file with
-its own URDF parser (``buildModelFromUrdf``: axis-aligned RX/RY/RZ joints where the URDF has them), and the
-torques are compared first. Per row: µs per call of ``tumble.robot.rnea`` / ``mass_matrix`` /
-``forward_dynamics`` on one state from Python, per sample of a batched call (parallel over the cores),
-and Pinocchio's ``rnea`` / ``crba`` / ``aba`` called from Python, and its ``rneaInParallel`` per sample
-where this build has it. Each figure: min and median over ``--repeats`` repeats (≥ 5). Prints the CPU,
-the cores and the load average first: on a shared machine the medians move with the load.
+Robots: tumble's 6-axis industrial6.urdf and 7-DOF panda.urdf (``tumble.examples``), UR5 and Panda with its
+two fingers (9 DOF; fixed base) and the Talos humanoid and Solo12 quadruped (floating base) from
+example-robot-data. Pinocchio builds its model from the same file with its own URDF parser
+(``buildModelFromUrdf``: axis-aligned RX/RY/RZ joints where the URDF has them), and the torques are compared
+first. Per row: µs per call of ``tumble.robot.rnea`` / ``mass_matrix`` / ``forward_dynamics`` on one state
+from Python and of Pinocchio's ``rnea`` / ``crba`` / ``aba`` from Python, in CPU time of the calling thread
+(single calls run on one thread; other work on a shared machine does not count); per sample of a batched
+call (parallel over the Numba threads) and of Pinocchio's ``rneaInParallel`` on as many threads N: the CPU
+time of the call on one thread / N (what the N cores would give if they were this run's alone, with perfect
+scaling; on N threads of a loaded machine the CPU time also counts OpenMP threads spinning at the barrier for
+a descheduled one) and the wall time on N threads. Each figure: min and median over ``--repeats`` repeats
+(≥ 5). Prints the CPU, the cores and the load average first, and last the ratios the issue's goals name.
 """
 
 from __future__ import annotations
@@ -36,7 +40,8 @@ except ImportError:  # the comparison is optional
 
 
 def robots() -> dict[str, tuple[Path, bool]]:
-    cases = {"industrial6": (tumble.examples.path("industrial6.urdf"), False)}
+    cases = {"industrial6": (tumble.examples.path("industrial6.urdf"), False),
+             "panda7": (tumble.examples.path("panda.urdf"), False)}
     try:
         erd = Path(metadata.distribution("example-robot-data").locate_file(
             "cmeel.prefix/share/example-robot-data/robots"))
@@ -49,15 +54,40 @@ def robots() -> dict[str, tuple[Path, bool]]:
     return cases
 
 
-def timed(fn, calls: int, repeats: int) -> tuple[float, float]:
-    """(min, median) over ``repeats`` of the mean time of ``calls`` calls of ``fn``, µs."""
+def single(fn, calls: int, repeats: int) -> tuple[float, float]:
+    """(min, median) over ``repeats`` of the mean CPU time of this thread over ``calls`` calls of ``fn``, µs."""
     times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
+    for _ in range(max(repeats, 5)):
+        start = time.thread_time()
         for _ in range(calls):
             fn()
-        times.append((time.perf_counter() - start) / calls * 1e6)
+        times.append((time.thread_time() - start) / calls * 1e6)
     return float(np.min(times)), float(np.median(times))
+
+
+def batched(fn, samples: int, threads: int, repeats: int) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Per sample, µs, (min, median) over ``repeats`` calls: ``fn(1)`` (one thread): process CPU time /
+    (samples × threads); ``fn(threads)``: wall time / samples."""
+    cpu, wall = [], []
+    fn(1)
+    for _ in range(max(repeats, 5)):
+        c = time.process_time()
+        fn(1)
+        cpu.append((time.process_time() - c) / (samples * threads) * 1e6)
+    fn(threads)
+    for _ in range(max(repeats, 5)):
+        w = time.perf_counter()
+        fn(threads)
+        wall.append((time.perf_counter() - w) / samples * 1e6)
+    return (float(np.min(cpu)), float(np.median(cpu))), (float(np.min(wall)), float(np.median(wall)))
+
+
+def on_threads(fn):
+    """``fn`` as a function of the number of Numba threads it runs on (left set after the call)."""
+    def run(n: int):
+        numba.set_num_threads(n)
+        return fn()
+    return run
 
 
 def pin_state(model, tree, q, v):
@@ -75,7 +105,15 @@ def pin_state(model, tree, q, v):
 
 
 def fmt(pair) -> str:
-    return f"{pair[0]:7.2f}/{pair[1]:<7.2f}"
+    return f"{pair[0]:5.2f}/{pair[1]:<5.2f}"
+
+
+NAN = (float("nan"),) * 2
+
+
+def ratio(a, b) -> tuple[float, float]:
+    """(min / min, median / median) of two (min, median) timings."""
+    return a[0] / b[0], a[1] / b[1]
 
 
 def main():
@@ -84,29 +122,32 @@ def main():
     parser.add_argument("--calls", type=int, default=2000, help="single calls per repeat")
     parser.add_argument("--repeats", type=int, default=7, help="repeats (min and median are printed), >= 5")
     args = parser.parse_args()
-    print(f"{machine()}; {numba.get_num_threads()} Numba threads")
-    print(f"tumble.robot vs {'Pinocchio ' + pin.__version__ if pin else 'no Pinocchio'}; batch of {args.batch}; "
-          "µs per call (one state) or per sample (batch B); each cell min/median")
-    cols = ["RNEA 1", "RNEA B", "pin.rnea", "pin.rneaPar", "CRBA 1", "pin.crba", "FD 1", "FD B", "pin.aba"]
-    print(f"{'robot':<12} {'nv':>3} | " + " ".join(f"{c:>15}" for c in cols) + " | max|Δτ|")
+    r, B = args.repeats, args.batch
+    threads = numba.get_num_threads()
+    print(f"{machine()}; {threads} Numba threads")
+    print(f"tumble.robot vs {'Pinocchio ' + pin.__version__ if pin else 'no Pinocchio'}; µs per call of one state "
+          f"(CPU time of the thread) or per sample of a batch of {B} (cpu: CPU time on one thread / {threads}; wall: "
+          f"on {threads} threads); each cell min/median")
+    cols = ["RNEA 1", "pin.rnea", "CRBA 1", "pin.crba", "FD 1", "pin.aba", "RNEA B cpu", "RNEA B wall",
+            "rneaPar cpu", "rneaPar wall", "FD B cpu"]
+    print(f"{'robot':<12} {'nv':>3} | " + " ".join(f"{c:>11}" for c in cols) + " | max|Δτ|")
     rng = np.random.default_rng(1)
-    r = args.repeats
+    rows = {}
     for name, (path, floating) in robots().items():
         tree = robot.RobotTree.from_urdf(path, floating_base=floating, mimic=False, check_triangle=False)
         q = tree.neutral()
         q[tree.nq - tree.dof:] = rng.uniform(-1.0, 1.0, tree.dof)
         qd, qdd = rng.uniform(-1.0, 1.0, (2, tree.nv))
-        Q, QD, QDD = np.tile(q, (args.batch, 1)), *rng.uniform(-1.0, 1.0, (2, args.batch, tree.nv))
+        Q, QD, QDD = np.tile(q, (B, 1)), *rng.uniform(-1.0, 1.0, (2, B, tree.nv))
         tau = robot.rnea(tree, q, qd, qdd)
         TAU = robot.rnea(tree, Q, QD, QDD)
-        robot.mass_matrix(tree, q), robot.forward_dynamics(tree, Q, QD, TAU)
-        row = [timed(lambda: robot.rnea(tree, q, qd, qdd), args.calls, r),
-               tuple(x / args.batch for x in timed(lambda: robot.rnea(tree, Q, QD, QDD), 1, r))]
-        peer = [(float("nan"),) * 2] * 2
-        crba = [timed(lambda: robot.mass_matrix(tree, q), args.calls, r)]
-        fd = [timed(lambda: robot.forward_dynamics(tree, q, qd, tau), args.calls, r),
-              tuple(x / args.batch for x in timed(lambda: robot.forward_dynamics(tree, Q, QD, TAU), 1, r))]
-        peer_crba = peer_aba = (float("nan"),) * 2
+        robot.mass_matrix(tree, q), robot.forward_dynamics(tree, q, qd, tau), robot.forward_dynamics(tree, Q, QD, TAU)
+        row = {"RNEA 1": single(lambda: robot.rnea(tree, q, qd, qdd), args.calls, r),
+               "CRBA 1": single(lambda: robot.mass_matrix(tree, q), args.calls, r),
+               "FD 1": single(lambda: robot.forward_dynamics(tree, q, qd, tau), args.calls, r)}
+        row["RNEA B cpu"], row["RNEA B wall"] = batched(on_threads(lambda: robot.rnea(tree, Q, QD, QDD)), B,
+                                                        threads, r)
+        row["FD B cpu"] = batched(on_threads(lambda: robot.forward_dynamics(tree, Q, QD, TAU)), B, threads, r)[0]
         delta = float("nan")
         if pin is not None:
             root = (pin.JointModelFreeFlyer(),) if floating else ()
@@ -117,18 +158,35 @@ def main():
             ptau = pin_state(model, tree, q, tau)[1]
             expected = pin.rnea(model, data, pq, pv, pa)
             delta = float(np.abs(expected[of] - tau[tree.nv - tree.dof:]).max())
-            peer[0] = timed(lambda: pin.rnea(model, data, pq, pv, pa), args.calls, r)
+            row["pin.rnea"] = single(lambda: pin.rnea(model, data, pq, pv, pa), args.calls, r)
+            row["pin.crba"] = single(lambda: pin.crba(model, data, pq), args.calls, r)
+            row["pin.aba"] = single(lambda: pin.aba(model, data, pq, pv, ptau), args.calls, r)
             if hasattr(pin, "rneaInParallel"):
-                PQ, PV, PA = (np.asfortranarray(np.tile(x, (args.batch, 1)).T) for x in (pq, pv, pa))
-                out = np.zeros((model.nv, args.batch), order="F")
-                threads = numba.get_num_threads()
+                PQ, PV, PA = (np.asfortranarray(np.tile(x, (B, 1)).T) for x in (pq, pv, pa))
+                out = np.zeros((model.nv, B), order="F")
                 pool = pin.ModelPool(model, threads)
-                peer[1] = tuple(x / args.batch for x in timed(
-                    lambda: pin.rneaInParallel(threads, pool, PQ, PV, PA, out), 1, r))
-            peer_crba = timed(lambda: pin.crba(model, data, pq), args.calls, r)
-            peer_aba = timed(lambda: pin.aba(model, data, pq, pv, ptau), args.calls, r)
-        cells = [row[0], row[1], peer[0], peer[1], crba[0], peer_crba, fd[0], fd[1], peer_aba]
-        print(f"{name:<12} {tree.nv:>3} | " + " ".join(fmt(c) for c in cells) + f" | {delta:.1e}")
+                row["rneaPar cpu"], row["rneaPar wall"] = batched(
+                    lambda n: pin.rneaInParallel(n, pool, PQ, PV, PA, out), B, threads, r)
+        rows[name] = row
+        print(f"{name:<12} {tree.nv:>3} | " + " ".join(f"{fmt(row.get(c, NAN)):>11}" for c in cols)
+              + f" | {delta:.1e}", flush=True)
+    print(f"Numba threading layer: {numba.threading_layer()}")
+    if pin is None:
+        return
+    print("goals (min/median ratios or µs):")
+    for name in ("industrial6", "ur5", "panda7", "panda"):
+        if name in rows:
+            x = rows[name]
+            print(f"  {name:<12} RNEA 1 / pin.rnea {fmt(ratio(x['RNEA 1'], x['pin.rnea']))} (goal <= 1.0);"
+                  f"  CRBA 1 / pin.crba {fmt(ratio(x['CRBA 1'], x['pin.crba']))} (goal <= 1.2)")
+    if "panda7" in rows:
+        x = rows["panda7"]
+        print(f"  panda7       RNEA B per sample: {fmt(x['RNEA B cpu'])} µs CPU-based, {fmt(x['RNEA B wall'])} µs "
+              "wall (goal <= 0.2)")
+    if "talos" in rows and "rneaPar cpu" in rows["talos"]:
+        x = rows["talos"]
+        print(f"  talos        RNEA B / rneaInParallel per sample: {fmt(ratio(x['RNEA B cpu'], x['rneaPar cpu']))} "
+              f"CPU-based, {fmt(ratio(x['RNEA B wall'], x['rneaPar wall']))} wall (goal < 1)")
 
 
 if __name__ == "__main__":
