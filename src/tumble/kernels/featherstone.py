@@ -281,16 +281,16 @@ def scratch(nb):
 
 
 def workspace(nb: int, nv: int) -> np.ndarray:
-    """The flat scratch of the single-state entries for a tree of nb bodies and nv velocity coordinates: the
-    per-body scratch (nb, _WIDTH), then ABA's two 6×6 blocks, and for mimic joints M (nv, nv) and nv zeros."""
-    return np.empty(nb * _WIDTH + 72 + nv * nv + nv)
+    """The flat scratch of the single-state entries for a tree of nb bodies and nv velocity coordinates, in
+    order: the per-body scratch (nb, _WIDTH); ABA's two 6×6 blocks; for mimic joints M (nv, nv) and nv zeros;
+    a contiguous copy of the state (q, nq ≤ nv + 1, and two nv-vectors)."""
+    return np.empty(nb * _WIDTH + 72 + nv * nv + 4 * nv + 1)
 
 
 @njit(**_INLINE)
 def _fits(P, S, q, nv):
     """True when ``q`` has the tree's nq = nv + (1 with a floating base) entries and ``S`` is its workspace."""
-    nb = P.shape[0]
-    return q.shape[0] == nv + floating(P) and S.shape[0] == nb * _WIDTH + 72 + nv * nv + nv
+    return q.shape[0] == nv + floating(P) and S.shape[0] == P.shape[0] * _WIDTH + 72 + nv * nv + 4 * nv + 1
 
 
 @njit(**_INLINE)
@@ -306,6 +306,21 @@ def _body_scratch(P, S):
     return S[:P.shape[0] * _WIDTH].reshape(P.shape[0], _WIDTH)
 
 
+@njit(**_INLINE)
+def _state_offset(P, nv):
+    """Where the copy of the state starts in a :func:`workspace`."""
+    return P.shape[0] * _WIDTH + 72 + nv * nv + nv
+
+
+@njit(**_INLINE)
+def _copy(x, S, o):
+    """``x`` (n,) copied into ``S[o:o + n]``, returned as that contiguous view: the array type of a batch's
+    rows, so that one compiled version of each sweep serves single states and batches."""
+    for k in range(x.shape[0]):
+        S[o + k] = x[k]
+    return S[o:o + x.shape[0]]
+
+
 @njit(**_NO_REFCOUNT)
 def rnea(P, q, qd, qdd, g, fext, S, tau):
     """One sample: ``tau`` (nv,) from ``q`` (nq,), ``qd``, ``qdd`` (nv,), ``g`` (3,), ``fext`` (6,), scratch
@@ -313,9 +328,12 @@ def rnea(P, q, qd, qdd, g, fext, S, tau):
 
     Returns False when a size does not fit (then ``tau`` is left as it was) or a torque is not finite.
     """
-    if not _state_fits(P, S, q, qd, qdd, g, fext, tau.shape[0]):
+    nq, nv = q.shape[0], tau.shape[0]
+    if not _state_fits(P, S, q, qd, qdd, g, fext, nv):
         return False
-    return rnea_one(P, q, qd, qdd, g, fext, _body_scratch(P, S), tau)
+    o = _state_offset(P, nv)
+    return rnea_one(P, _copy(q, S, o), _copy(qd, S, o + nq), _copy(qdd, S, o + nq + nv), g, fext,
+                    _body_scratch(P, S), tau)
 
 
 @njit(**_NO_REFCOUNT)
@@ -441,7 +459,7 @@ def crba(P, q, S, M):
     nv = M.shape[0]
     if not (_fits(P, S, q, nv) and M.shape[1] == nv):
         return False
-    crba_one(P, q, _body_scratch(P, S), M)
+    crba_one(P, _copy(q, S, _state_offset(P, nv)), _body_scratch(P, S), M)
     ok = True
     for r in range(nv):
         for c in range(nv):
@@ -668,14 +686,16 @@ def aba(P, q, qd, tau, g, fext, S, qdd):
 
     Returns False when a size does not fit (then ``qdd`` is left as it was) or an acceleration is not finite.
     """
-    nv = qdd.shape[0]
+    nq, nv = q.shape[0], qdd.shape[0]
     if not _state_fits(P, S, q, qd, tau, g, fext, nv):
         return False
     o = P.shape[0] * _WIDTH
     X, T = S[o:o + 36].reshape(6, 6), S[o + 36:o + 72].reshape(6, 6)
-    M, zero = S[o + 72:o + 72 + nv * nv].reshape(nv, nv), S[o + 72 + nv * nv:]
+    M, zero = S[o + 72:o + 72 + nv * nv].reshape(nv, nv), S[o + 72 + nv * nv:o + 72 + nv * nv + nv]
     zero[:] = 0.0
-    return forward_one(P, q, qd, tau, g, fext, _body_scratch(P, S), X, T, M, zero, qdd)
+    o = _state_offset(P, nv)
+    return forward_one(P, _copy(q, S, o), _copy(qd, S, o + nq), _copy(tau, S, o + nq + nv), g, fext,
+                       _body_scratch(P, S), X, T, M, zero, qdd)
 
 
 @njit(**_NO_REFCOUNT)

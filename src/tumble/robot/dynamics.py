@@ -67,8 +67,8 @@ def _vectors(a, b, c) -> bool:
             and c.ndim == 1)
 
 
-_VECTOR = numba.types.Array(numba.float64, 1, "A")  # (n,), any stride
-_FLAT = numba.types.Array(numba.float64, 1, "C")  # (n,), contiguous: the model's workspace
+_VECTOR = numba.types.Array(numba.float64, 1, "A")  # (n,), any stride: q, qd, qdd, tau as given
+_FLAT = numba.types.Array(numba.float64, 1, "C")  # (n,), contiguous: gravity, wrench, the workspace, a result
 _TABLE = numba.types.Array(numba.float64, 2, "C")  # (rows, columns), C order: the tree's P, a result M
 
 
@@ -81,7 +81,7 @@ class _SingleState:
 
     @cached_property
     def rnea(self):
-        return _kernels.rnea.compile((_TABLE,) + (_VECTOR,) * 5 + (_FLAT, _VECTOR))
+        return _kernels.rnea.compile((_TABLE,) + (_VECTOR,) * 3 + (_FLAT,) * 4)
 
     @cached_property
     def crba(self):
@@ -89,7 +89,7 @@ class _SingleState:
 
     @cached_property
     def aba(self):
-        return _kernels.aba.compile((_TABLE,) + (_VECTOR,) * 5 + (_FLAT, _VECTOR))
+        return _kernels.aba.compile((_TABLE,) + (_VECTOR,) * 3 + (_FLAT,) * 4)
 
 
 _one = _SingleState()
