@@ -13,7 +13,8 @@ call (parallel over the Numba threads) and of Pinocchio's ``rneaInParallel`` on 
 time of the call on one thread / N (what the N cores would give if they were this run's alone, with perfect
 scaling; on N threads of a loaded machine the CPU time also counts OpenMP threads spinning at the barrier for
 a descheduled one) and the wall time on N threads. Each figure: min and median over ``--repeats`` repeats
-(≥ 5). Prints the CPU, the cores and the load average first, and last the ratios the issue's goals name.
+(≥ 5). Prints the CPU, the cores and the load average first, then the ratios the issue's goals name, and
+last where one ``rnea`` call's time goes (the Python layer, the compiled entry, the sweep inside Numba).
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ import numpy as np
 
 import tumble
 from tumble import robot
+from tumble.kernels import featherstone
+from tumble.robot import dynamics
 
 from _timing import machine
 
@@ -104,6 +107,32 @@ def pin_state(model, tree, q, v):
     return pq, pv, of
 
 
+@numba.njit
+def sweeps(P, q, qd, qdd, g, f, W, tau, n):
+    """``n`` RNEA sweeps of one state inside Numba (no call from Python)."""
+    for _ in range(n):
+        featherstone.rnea_one(P, q, qd, qdd, g, f, W, tau)
+
+
+def anatomy(tree, calls: int, repeats: int) -> str:
+    """Thread CPU µs (min) of one ``rnea`` call from Python, of its compiled entry called directly, of the
+    sweep inside Numba, of the type checks and of the result's allocation."""
+    q, qd, qdd = np.random.default_rng(0).uniform(-1.0, 1.0, (3, tree.nv))
+    P, g, f, S, tau = tree._params, tree._gravity, tree._no_wrench, tree._workspace, np.empty(tree.nv)
+    entry = dynamics._one.rnea
+    W = featherstone.scratch(P.shape[0])
+    sweeps(P, q, qd, qdd, g, f, W, tau, 1)
+    nothing = single(lambda: None, calls, repeats)[0]
+    public = single(lambda: robot.rnea(tree, q, qd, qdd), calls, repeats)[0] - nothing
+    direct = single(lambda: entry(P, q, qd, qdd, g, f, S, tau), calls, repeats)[0] - nothing
+    sweep = single(lambda: sweeps(P, q, qd, qdd, g, f, W, tau, calls), 1, repeats)[0] / calls
+    checks = single(lambda: dynamics._vectors(q, qd, qdd), calls, repeats)[0] - nothing
+    result = single(lambda: np.empty(tree.nv), calls, repeats)[0] - nothing
+    return (f"rnea {public:.2f} µs = Python layer {public - direct:.2f} (type checks {checks:.2f}, result "
+            f"{result:.2f}) + compiled entry {direct:.2f} (sweep {sweep:.2f}, {sweep / tree.nv * 1e3:.0f} ns "
+            "per joint)")
+
+
 def fmt(pair) -> str:
     return f"{pair[0]:5.2f}/{pair[1]:<5.2f}"
 
@@ -171,22 +200,23 @@ def main():
         print(f"{name:<12} {tree.nv:>3} | " + " ".join(f"{fmt(row.get(c, NAN)):>11}" for c in cols)
               + f" | {delta:.1e}", flush=True)
     print(f"Numba threading layer: {numba.threading_layer()}")
-    if pin is None:
-        return
-    print("goals (min/median ratios or µs):")
-    for name in ("industrial6", "ur5", "panda7", "panda"):
-        if name in rows:
-            x = rows[name]
-            print(f"  {name:<12} RNEA 1 / pin.rnea {fmt(ratio(x['RNEA 1'], x['pin.rnea']))} (goal <= 1.0);"
-                  f"  CRBA 1 / pin.crba {fmt(ratio(x['CRBA 1'], x['pin.crba']))} (goal <= 1.2)")
-    if "panda7" in rows:
+    if pin is not None:
+        print("goals (min/median ratios or µs):")
+        for name in ("industrial6", "ur5", "panda7", "panda"):
+            if name in rows:
+                x = rows[name]
+                print(f"  {name:<12} RNEA 1 / pin.rnea {fmt(ratio(x['RNEA 1'], x['pin.rnea']))} (goal <= 1.0);"
+                      f"  CRBA 1 / pin.crba {fmt(ratio(x['CRBA 1'], x['pin.crba']))} (goal <= 1.2)")
         x = rows["panda7"]
         print(f"  panda7       RNEA B per sample: {fmt(x['RNEA B cpu'])} µs CPU-based, {fmt(x['RNEA B wall'])} µs "
               "wall (goal <= 0.2)")
-    if "talos" in rows and "rneaPar cpu" in rows["talos"]:
-        x = rows["talos"]
-        print(f"  talos        RNEA B / rneaInParallel per sample: {fmt(ratio(x['RNEA B cpu'], x['rneaPar cpu']))} "
-              f"CPU-based, {fmt(ratio(x['RNEA B wall'], x['rneaPar wall']))} wall (goal < 1)")
+        if "talos" in rows and "rneaPar cpu" in rows["talos"]:
+            x = rows["talos"]
+            print(f"  talos        RNEA B / rneaInParallel per sample: "
+                  f"{fmt(ratio(x['RNEA B cpu'], x['rneaPar cpu']))} CPU-based, "
+                  f"{fmt(ratio(x['RNEA B wall'], x['rneaPar wall']))} wall (goal < 1)")
+    arm = robot.RobotTree.from_urdf(robots()["panda7"][0])
+    print(f"panda7, where one call's time goes (thread CPU, min): {anatomy(arm, 10 * args.calls, r)}")
 
 
 if __name__ == "__main__":
