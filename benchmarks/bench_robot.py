@@ -8,7 +8,8 @@ example-robot-data. Pinocchio builds its model from the same file with its own U
 (``buildModelFromUrdf``: axis-aligned RX/RY/RZ joints where the URDF has them), and the torques are compared
 first. Per row: µs per call of ``tumble.robot.rnea`` / ``mass_matrix`` / ``forward_dynamics`` on one state
 from Python and of Pinocchio's ``rnea`` / ``crba`` / ``aba`` from Python, in CPU time of the calling thread
-(single calls run on one thread; other work on a shared machine does not count); per sample of a batched
+(single calls run on one thread; other work on a shared machine does not count), the six timed in turn
+within each repeat; per sample of a batched
 call (parallel over the Numba threads) and of Pinocchio's ``rneaInParallel`` on as many threads N: the CPU
 time of the call on one thread / N (what the N cores would give if they were this run's alone, with perfect
 scaling; on N threads of a loaded machine the CPU time also counts OpenMP threads spinning at the barrier for
@@ -57,15 +58,23 @@ def robots() -> dict[str, tuple[Path, bool]]:
     return cases
 
 
-def single(fn, calls: int, repeats: int) -> tuple[float, float]:
-    """(min, median) over ``repeats`` of the mean CPU time of this thread over ``calls`` calls of ``fn``, µs."""
-    times = []
+def singles(fns: dict, calls: int, repeats: int) -> dict[str, tuple[float, float]]:
+    """(min, median) over ``repeats`` of the mean CPU time of this thread over ``calls`` calls of each of ``fns``
+    (name: function), µs. Each repeat times every function in turn, so that a change of the machine's load
+    falls on all of them alike."""
+    times = {name: [] for name in fns}
     for _ in range(max(repeats, 5)):
-        start = time.thread_time()
-        for _ in range(calls):
-            fn()
-        times.append((time.thread_time() - start) / calls * 1e6)
-    return float(np.min(times)), float(np.median(times))
+        for name, fn in fns.items():
+            start = time.thread_time()
+            for _ in range(calls):
+                fn()
+            times[name].append((time.thread_time() - start) / calls * 1e6)
+    return {name: (float(np.min(t)), float(np.median(t))) for name, t in times.items()}
+
+
+def single(fn, calls: int, repeats: int) -> tuple[float, float]:
+    """:func:`singles` of one function."""
+    return singles({"": fn}, calls, repeats)[""]
 
 
 def batched(fn, samples: int, threads: int, repeats: int) -> tuple[tuple[float, float], tuple[float, float]]:
@@ -171,9 +180,9 @@ def main():
         tau = robot.rnea(tree, q, qd, qdd)
         TAU = robot.rnea(tree, Q, QD, QDD)
         robot.mass_matrix(tree, q), robot.forward_dynamics(tree, q, qd, tau), robot.forward_dynamics(tree, Q, QD, TAU)
-        row = {"RNEA 1": single(lambda: robot.rnea(tree, q, qd, qdd), args.calls, r),
-               "CRBA 1": single(lambda: robot.mass_matrix(tree, q), args.calls, r),
-               "FD 1": single(lambda: robot.forward_dynamics(tree, q, qd, tau), args.calls, r)}
+        one_state = {"RNEA 1": lambda: robot.rnea(tree, q, qd, qdd), "CRBA 1": lambda: robot.mass_matrix(tree, q),
+                     "FD 1": lambda: robot.forward_dynamics(tree, q, qd, tau)}
+        row = {}
         row["RNEA B cpu"], row["RNEA B wall"] = batched(on_threads(lambda: robot.rnea(tree, Q, QD, QDD)), B,
                                                         threads, r)
         row["FD B cpu"] = batched(on_threads(lambda: robot.forward_dynamics(tree, Q, QD, TAU)), B, threads, r)[0]
@@ -187,15 +196,16 @@ def main():
             ptau = pin_state(model, tree, q, tau)[1]
             expected = pin.rnea(model, data, pq, pv, pa)
             delta = float(np.abs(expected[of] - tau[tree.nv - tree.dof:]).max())
-            row["pin.rnea"] = single(lambda: pin.rnea(model, data, pq, pv, pa), args.calls, r)
-            row["pin.crba"] = single(lambda: pin.crba(model, data, pq), args.calls, r)
-            row["pin.aba"] = single(lambda: pin.aba(model, data, pq, pv, ptau), args.calls, r)
+            one_state.update({"pin.rnea": lambda: pin.rnea(model, data, pq, pv, pa),
+                              "pin.crba": lambda: pin.crba(model, data, pq),
+                              "pin.aba": lambda: pin.aba(model, data, pq, pv, ptau)})
             if hasattr(pin, "rneaInParallel"):
                 PQ, PV, PA = (np.asfortranarray(np.tile(x, (B, 1)).T) for x in (pq, pv, pa))
                 out = np.zeros((model.nv, B), order="F")
                 pool = pin.ModelPool(model, threads)
                 row["rneaPar cpu"], row["rneaPar wall"] = batched(
                     lambda n: pin.rneaInParallel(n, pool, PQ, PV, PA, out), B, threads, r)
+        row.update(singles(one_state, args.calls, r))
         rows[name] = row
         print(f"{name:<12} {tree.nv:>3} | " + " ".join(f"{fmt(row.get(c, NAN)):>11}" for c in cols)
               + f" | {delta:.1e}", flush=True)
