@@ -34,9 +34,8 @@ columns    meaning
 
 Motion of joint i: revolute ``R_J = Rz(θ)``; prismatic ``p_J = θ e_z``,
 ``θ = k q[c] + offset``, ``θ̇ = k q̇[c]``; the motion subspace ``S = (e_z, 0)``
-or ``(0, e_z)``, so that ``S q̇`` and ``Sᵀ f`` are one component (Featherstone
-2008, §4.4: a joint's frame may be chosen to make S constant and sparse). A *floating base* is body 0 with a
-free joint (type 2) to the world: its configuration ``q[0:7] = (r, quat)``,
+or ``(0, e_z)``, so that ``S q̇`` and ``Sᵀ f`` are one component. A *floating
+base* is body 0 with a free joint (type 2) to the world: its configuration ``q[0:7] = (r, quat)``,
 the origin of body 0 in the world frame (m) and the unit quaternion
 ``[w, x, y, z]`` of body 0 → world, its velocity ``q̇[0:6] = (ω, v)`` in body
 0 axes; the joint coordinates follow, so the configuration index of
@@ -78,8 +77,8 @@ _INLINE = {**_JIT, "inline": "always"}
 # Numba's reference counting (``_nrt=False``): else every array argument, every array handed
 # to an inlined helper and every row view of a batch costs an atomic increment and decrement
 # of a shared counter, 16 per call and 4 per body in RNEA (measured: 7-DOF RNEA sweep 413 →
-# 341 ns), and a call from Python wraps each array in a counted record (measured: a one-link
-# RNEA from Python 0.43 → 0.22 µs).
+# 341 ns), and a call from Python wraps each array in a counted record (measured: the entry
+# of a one-link RNEA called from Python 0.43 → 0.22 µs).
 _NO_REFCOUNT = {**_JIT, "_nrt": False}
 # Scratch columns per body: transform (0–11), v (12–17), a or c (18–23), f or I^A (24–59),
 # p^A (60–65), U (66–71), D, u (72, 73), p^a (74–79), ABA's a (80–85); CRBA's composite inertia
