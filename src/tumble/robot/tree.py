@@ -63,7 +63,7 @@ class RobotTree(ChainMotion):
     """
 
     __slots__ = ("_links", "_parents", "_gravity", "_name", "_frames", "_mimic", "_params", "_lower", "_upper",
-                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links")
+                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links", "_workspace")
     _links: tuple[Link, ...]
     _parents: tuple[int, ...]
     _gravity: np.ndarray  # (3,) m/s², world frame
@@ -79,6 +79,7 @@ class RobotTree(ChainMotion):
     _nv: int
     _floating: bool
     _coordinate_links: tuple[int, ...]  # the links of the independent joint coordinates
+    _workspace: np.ndarray  # scratch of the single-state entries (tumble.robot.dynamics)
 
     def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity=DEFAULT_GRAVITY,
                  name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None):
@@ -119,6 +120,9 @@ class RobotTree(ChainMotion):
         nv = len(independent) + 6 * floating
         set_(self, "_nv", nv)
         set_(self, "_nq", nv + floating)
+        # scratch of the single-state rnea / mass_matrix / forward_dynamics: their compiled code holds the
+        # GIL (no nogil) and calls nothing back, so two calls on one model never overlap
+        set_(self, "_workspace", _kernels.workspace(len(links), nv))
 
     @classmethod
     def from_urdf(cls, source, *, floating_base: bool = False, mimic: bool = True, check_triangle: bool = True,
@@ -288,26 +292,43 @@ def _coordinates(links, mimic: dict, floating: bool):
     return coordinate, multiplier, offset
 
 
+def _axis_frame(axis) -> np.ndarray:
+    """A rotation ``R_a`` with ``R_a e_z = s`` for the unit joint axis ``s``: its columns ``(x, s × x, s)``, ``x``
+    the unit part of the basis vector least aligned with ``s`` normal to ``s``. A signed permutation (exact) for
+    an axis along ±x, ±y or ±z; the identity for +z."""
+    k = int(np.argmin(np.abs(axis)))
+    x = -axis[k] * axis
+    x[k] += 1.0
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(axis, x), axis])
+
+
 def _pack(links, parents, coordinate, multiplier, offset) -> np.ndarray:
     """The (nb, 45) parameter array of :mod:`._kernels`, in canonical frames.
 
-    The link frame's offset (R_f, p_f) of link λ(i) is folded into the joint
-    origin of joint i, and link i's mass properties are moved from its link
-    frame to the canonical frame (origin on joint i's axis):
-    ``c' = R_f c + p_f``, ``I_c' = R_f I_c R_fᵀ``, ``I_O = I_c' + m(|c'|² E − c'c'ᵀ)``.
+    Canonical body frame i = link frame i · (R_f, p_f)⁻¹ · R_a: origin on joint
+    i's axis, and that axis along z (``R_a``: :func:`_axis_frame`; the identity
+    for the floating base), so that the compiled algorithms only turn about or
+    slide along z. In it the link's user frame is ``(R_f', p_f') = (R_aᵀ R_f,
+    R_aᵀ p_f)``; the joint origin of joint i, ``(R_o, p_o)`` in link λ(i)'s
+    frame, becomes ``(R_f'λ R_o R_a, p_f'λ + R_f'λ p_o)``, and link i's mass
+    properties move to the canonical frame: ``c' = R_f' c + p_f'``, ``I_c' =
+    R_f' I_c R_f'ᵀ``, ``I_O = I_c' + m(|c'|² E − c'c'ᵀ)``.
     """
     P = np.zeros((len(links), _kernels.PARAMS))
     kinds = {"revolute": _kernels.REVOLUTE, "prismatic": _kernels.PRISMATIC, "floating": _kernels.FREE}
+    turn = [np.eye(3) if link.joint == "floating" else _axis_frame(link.axis) for link in links]
+    user_R = [Ra.T @ link.frame_rotation for Ra, link in zip(turn, links)]
+    user_p = [Ra.T @ link.frame_position for Ra, link in zip(turn, links)]
     for i, link in enumerate(links):
         par = parents[i]
-        prev_R, prev_p = (np.eye(3), np.zeros(3)) if par < 0 else (links[par].frame_rotation,
-                                                                  links[par].frame_position)
-        P[i, 0:9] = (prev_R @ link.origin_rotation).ravel()
+        prev_R, prev_p = (np.eye(3), np.zeros(3)) if par < 0 else (user_R[par], user_p[par])
+        P[i, 0:9] = (prev_R @ link.origin_rotation @ turn[i]).ravel()
         P[i, 9:12] = prev_p + prev_R @ link.origin_position
-        P[i, 12:15] = link.axis
+        P[i, 12:15] = (0.0, 0.0, 1.0)
         P[i, 15] = kinds[link.joint]
         P[i, 16] = offset[i]
-        Rf, pf = link.frame_rotation, link.frame_position
+        Rf, pf = user_R[i], user_p[i]
         com = Rf @ link.com + pf
         P[i, 17] = link.mass
         P[i, 18:21] = link.mass * com
