@@ -85,7 +85,8 @@ def joint_torque(model, t, q, qd, tau):
     if law == ZERO:
         tau[:] = 0.0
     elif law == CONSTANT:
-        tau[:] = model.torque
+        for i in range(tau.shape[0]):  # by a loop: a slice assignment compiles a shape-mismatch message formatter
+            tau[i] = model.torque[i]
     else:
         slot = model.law[1]
         with objmode():
