@@ -71,7 +71,7 @@ def build(transverse: float, axial: float, frame_spin: float, axes: np.ndarray, 
     return FrameModel(coefficients=coefficients, params=params, codes=codes)
 
 
-@_protocol.implements(_protocol.rhs, FrameModel, inline=True)
+@_protocol.implements(_protocol.rhs, FrameModel)
 def _frame_rhs(model, b0, t, Y, OUT):
     if isinstance(model.types[2], types.NoneType):  # torque-free: ψ is not needed
 
@@ -111,7 +111,7 @@ def wrap_angle(psi):
     return psi - _TWO_PI * math.floor(psi / _TWO_PI + 0.5)
 
 
-@_protocol.implements(_protocol.project, FrameModel, inline=True)
+@_protocol.implements(_protocol.project, FrameModel)
 def _frame_project(model, b0, t, Y):
     if Y.ndim == 1:
 

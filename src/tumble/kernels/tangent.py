@@ -48,7 +48,7 @@ class TangentModel(NamedTuple):
         return False
 
 
-@_protocol.implements(_protocol.rhs, TangentModel, inline=True)
+@_protocol.implements(_protocol.rhs, TangentModel)
 def _tangent_rhs(model, b0, t, Y, OUT):
 
     def impl(model, b0, t, Y, OUT):
@@ -74,7 +74,7 @@ def _tangent_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@_protocol.implements(_protocol.project, TangentModel, inline=True)
+@_protocol.implements(_protocol.project, TangentModel)
 def _tangent_project(model, b0, t, Y):
     return lambda model, b0, t, Y: None  # |γ| = 1 is kept by the flow; projecting would bend the tangents
 

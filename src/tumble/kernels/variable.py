@@ -108,7 +108,7 @@ def angular_rate(breaks, c, s, qw, qx, qy, qz, lx, ly, lz):
 
 
 
-@_protocol.implements(_protocol.rhs, VariableModel, inline=True)
+@_protocol.implements(_protocol.rhs, VariableModel)
 def _variable_rhs(model, b0, t, Y, OUT):
     if isinstance(model.types[3], types.NoneType):
 
@@ -133,7 +133,7 @@ def _variable_rhs(model, b0, t, Y, OUT):
     return _protocol.rhs_of_eight(derivative, Y)
 
 
-@_protocol.implements(_protocol.project, VariableModel, inline=True)
+@_protocol.implements(_protocol.project, VariableModel)
 def _variable_project(model, b0, t, Y):
 
     if Y.ndim == 1:
