@@ -7,6 +7,7 @@ message that names the field and the rule it breaks, e.g.
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -66,6 +67,8 @@ def require_finite(arr: np.ndarray, name: str) -> None:
 
 def _scalar(x, name: str, rule: str) -> float:
     """``float(x)`` for a single number; anything else (a list, a string) is refused naming ``name``."""
+    if type(x) is float:
+        return x
     try:
         if np.ndim(x) != 0:
             raise TypeError
@@ -77,7 +80,7 @@ def _scalar(x, name: str, rule: str) -> float:
 def require_positive(x: float, name: str) -> float:
     """Return ``float(x)`` if it is finite and > 0, else raise naming ``name``."""
     x = _scalar(x, name, "a finite number > 0")
-    if not np.isfinite(x) or x <= 0.0:
+    if not math.isfinite(x) or x <= 0.0:
         raise ValidationError(f"{name}: must be a finite number > 0, got {x}")
     return x
 
@@ -85,7 +88,7 @@ def require_positive(x: float, name: str) -> float:
 def require_non_negative(x: float, name: str) -> float:
     """Return ``float(x)`` if it is finite and >= 0, else raise naming ``name``."""
     x = _scalar(x, name, "a finite number >= 0")
-    if not np.isfinite(x) or x < 0.0:
+    if not math.isfinite(x) or x < 0.0:
         raise ValidationError(f"{name}: must be a finite number >= 0, got {x}")
     return x
 
@@ -100,8 +103,8 @@ def increasing_times(t, name: str = "t", *, what: str = "output times", at_least
     if times.ndim != 1 or times.size < at_least:
         count = "one" if at_least == 1 else f"at least {at_least}"
         raise ValidationError(f"{name}: must be a 1-D array of {count} {what}, got shape {times.shape}")
-    steps = np.diff(times)
-    if np.any(steps <= 0.0):
+    steps = times[1:] - times[:-1]
+    if (steps <= 0.0).any():
         k = int(np.flatnonzero(steps <= 0.0)[0])
         raise ValidationError(f"{name}: {what} must be strictly increasing ({name}[{k + 1}] = {times[k + 1]} "
                               f"<= {name}[{k}] = {times[k]})")

@@ -297,9 +297,13 @@ def conjugate(q) -> np.ndarray:
 
 def normalize(q) -> np.ndarray:
     """Unit quaternion ``q / |q|`` (…, 4); a zero quaternion raises :class:`ValidationError`."""
-    q = _as_quat(q)
+    return _normalized(_as_quat(q))
+
+
+def _normalized(q: np.ndarray) -> np.ndarray:
+    """:func:`normalize` of a float64 (…, 4) array already checked (finite, non-zero; the front door's)."""
     out = np.empty((math.prod(q.shape[:-1]), 4))
-    _normalize_loop(_flat(q, q.shape[:-1], (4,)), out)
+    _normalize_loop(np.ascontiguousarray(q).reshape((-1, 4)), out)
     return out.reshape(q.shape)
 
 

@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from tumble import attitude, limits, torques
-from tumble._inertia import principal_axes
+from tumble._inertia import frozen, principal_axes
 from tumble._quat import qmul
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import rigid as _kernel
@@ -37,6 +37,14 @@ __all__ = ["RigidMotion", "RigidBodies"]
 
 #: The stack depth from the warnings of :mod:`tumble.limits` to the caller of ``simulate``.
 _STACKLEVEL = 4
+
+
+#: The initial state of every rigid model (made once: a simulate call reads it).
+_STATE_FIELDS = (
+    StateField("omega0", 3, "initial body rate, rad/s, body axes"),
+    StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
+               default=frozen(attitude.identity()), quaternion=True),
+)
 
 
 class RigidMotion(Model):
@@ -64,11 +72,7 @@ class RigidMotion(Model):
         """The mass(es), kg, or None when unknown (for the rigidity check)."""
 
     def state_fields(self) -> tuple[StateField, ...]:
-        return (
-            StateField("omega0", 3, "initial body rate, rad/s, body axes"),
-            StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
-                       default=attitude.identity(), quaternion=True),
-        )
+        return _STATE_FIELDS
 
     def compile(self, torque, t0: float) -> _kernel.RigidModel:
         moments, axes, _ = self._principal()
@@ -77,8 +81,7 @@ class RigidMotion(Model):
     def initial_states(self, kernel, values, t0):
         moments, axes, q_bp = self._principal()
         y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
-        y0[:, :4] = attitude.multiply(values["q0"], q_bp)
-        y0[:, 4:] = np.einsum("bji,bj->bi", axes, values["omega0"])
+        _to_principal_axes(values["q0"], values["omega0"], q_bp, axes, y0)
         limits.check_rigid_motion(moments, y0[:, 4:], self._masses(), stacklevel=_STACKLEVEL)
         return y0
 
@@ -89,6 +92,21 @@ class RigidMotion(Model):
         q, omega = np.empty(states.shape[:-1] + (4,)), np.empty(states.shape[:-1] + (3,))
         _to_body_axes(states, q_bp, axes, q, omega)
         return Outputs(q=q, omega=omega, inertia=self._reported_inertia(), extras={}, totals={}, info={})
+
+
+@njit(cache=True)
+def _to_principal_axes(q0, omega0, q_bp, axes, y0):
+    """The initial states (N, 7) in principal axes from ``q0`` (N, 4) and ``omega0`` (N, 3) in body axes, in
+    one pass: ``q_NP = q_NB ⊗ q_BP`` into ``y0[:, :4]``, ``ω_P = R_BPᵀ ω_B`` into ``y0[:, 4:]``, with ``q_BP``
+    (B, 4) and ``R_BP`` (B, 3, 3) of B = 1 body or one per member. ``q_NP`` is bit for bit
+    :func:`tumble.attitude.multiply`'s product; ``ω_i = (R_0i ω_0 + R_1i ω_1) + R_2i ω_2`` in that order."""
+    shared = q_bp.shape[0] == 1
+    for b in range(y0.shape[0]):
+        j = 0 if shared else b
+        w, x, y, z = qmul(q0[b, 0], q0[b, 1], q0[b, 2], q0[b, 3], q_bp[j, 0], q_bp[j, 1], q_bp[j, 2], q_bp[j, 3])
+        y0[b, 0], y0[b, 1], y0[b, 2], y0[b, 3] = w, x, y, z
+        for i in range(3):
+            y0[b, 4 + i] = axes[j, 0, i] * omega0[b, 0] + axes[j, 1, i] * omega0[b, 1] + axes[j, 2, i] * omega0[b, 2]
 
 
 @njit(cache=True)

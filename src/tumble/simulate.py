@@ -37,7 +37,7 @@ from typing import Any, NamedTuple, TypedDict
 import numpy as np
 
 from tumble import _callback, attitude, integrate
-from tumble._validate import ValidationError, as_array, output_times
+from tumble._validate import ValidationError, as_array, output_times, require_finite
 from tumble.trajectory import Extra, Trajectory
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
@@ -295,14 +295,21 @@ def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverge
 _OUTPUT_WORDS = 11
 
 
+#: Runs that need less memory (bytes) are not checked: asking the system (``psutil``, 30-50 µs) would cost more
+#: than a small run, and a process with less than this left could not run anything.
+_UNCHECKED_BYTES = 2**24
+
+
 def _check_memory(n_times: int, y0: np.ndarray) -> None:
     """Refuse a run whose sampled states and outputs (float64, ``n_times × members × (state + 11)`` words)
     exceed the memory available now, before they are allocated: the error says how many bytes and
-    suggests ``store=``."""
-    import psutil
-
+    suggests ``store=``. Runs under :data:`_UNCHECKED_BYTES` are not checked."""
     members, size = y0.shape
     need = 8 * n_times * members * (size + _OUTPUT_WORDS)
+    if need < _UNCHECKED_BYTES:
+        return
+    import psutil
+
     available = psutil.virtual_memory().available
     if need > available:
         raise ValidationError(f"store: {members} members x {n_times} output times need at least {need:,} bytes "
@@ -357,19 +364,21 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
                 raise ValidationError(f"{f.name}: a {type(model).__name__} needs it: {f.description}")
             value = f.default(_broadcast(arrays, sizes)) if callable(f.default) else f.default
         scalar = f.size == 1 and np.ndim(value) == 0  # a number for a field of one component
-        arr = as_array(value, f.name, tail=() if scalar else (f.size,))
+        # finite checked below with the magnitude (one pass over the values), quaternions here
+        arr = as_array(value, f.name, tail=() if scalar else (f.size,), finite=f.quaternion)
         if scalar:
             arr = arr.reshape(1)
         if arr.ndim > 2:
             raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
-        if not f.quaternion and arr.size and np.abs(arr).max() > _LARGEST_STATE:
+        if not f.quaternion and arr.size and not np.abs(arr).max() <= _LARGEST_STATE:  # NaN fails too
+            require_finite(arr, f.name)
             raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
                                   f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
-        if f.quaternion and np.any(np.linalg.norm(arr, axis=-1) == 0.0):
+        if f.quaternion and not (arr * arr).any(axis=-1).all():  # |q| = 0: every square is 0
             raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
         if arr.ndim == 2 and f.name in given:
             sizes[f.name] = arr.shape[0]
-        arrays[f.name] = attitude.normalize(arr) if f.quaternion else arr
+        arrays[f.name] = attitude._normalized(arr) if f.quaternion else arr
     if model.batch_size is not None:
         sizes["body"] = model.batch_size
     if len(set(sizes.values())) > 1:
@@ -379,19 +388,37 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
 
 
 def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str, np.ndarray]:
+    """The values as read-only (N, size) views (a user's array is never written through them)."""
     n = max(sizes.values(), default=1)
-    return {name: np.broadcast_to(a, (n, a.shape[-1])) for name, a in arrays.items()}
+    out = {}
+    for name, a in arrays.items():
+        view = a.reshape(1, -1) if n == 1 else a.view() if a.shape[0] == n and a.ndim == 2 else None
+        if view is None:
+            view = np.broadcast_to(a, (n, a.shape[-1]))
+        else:
+            view.setflags(write=False)
+        out[name] = view
+    return out
 
 
 def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool) -> Trajectory:
-    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run."""
+    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run.
+
+    ``q`` and ``omega`` are handed over without a copy when ``out`` owns them (fresh C-ordered float64
+    arrays, as the models' outputs are), copied otherwise (a view of the states would keep them alive)."""
     def pick(a):
-        return a[:, 0] if single and a is not None else a
+        if a is None:
+            return None
+        if not (a.flags.owndata and a.flags.c_contiguous and a.dtype == np.float64):
+            a = np.array(a, dtype=np.float64)
+        a.setflags(write=False)  # before picking: a view of a read-only array is read-only
+        return a[:, 0] if single else a
 
     inertia = out.inertia
     if single and inertia is not None and inertia.ndim == 3:
         inertia = inertia[0]
-    extras = {name: Extra(pick(e.data), e.dims, e.units, e.description) for name, e in out.extras.items()}
-    totals = {name: pick(value) for name, value in out.totals.items()}
-    return Trajectory(t=t, q=pick(out.q), omega=pick(out.omega), inertia=inertia, method=method, info=info,
-                      extras=extras, totals=totals, model=type(model).__name__)
+    extras = {name: Extra(e.data[:, 0] if single else e.data, e.dims, e.units, e.description)
+              for name, e in out.extras.items()}
+    totals = {name: value[:, 0] if single else value for name, value in out.totals.items()}
+    return Trajectory._of_run(np.array(t), pick(out.q), pick(out.omega), inertia, method, info, extras, totals,
+                              type(model).__name__)

@@ -256,9 +256,32 @@ class Trajectory:
             raise ValidationError(f"model: must be a string, got {type(self.model).__name__}")
         for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
             object.__setattr__(self, name, None if value is None else _readonly(np.array(value, dtype=np.float64)))
+        self._check_rest(lead)
+
+    def _check_rest(self, lead: tuple[int, ...]) -> None:
+        """Check and store ``info``, ``extras`` and ``totals`` against the leading shape ``lead``."""
         object.__setattr__(self, "info", _check_info(self.info))
         object.__setattr__(self, "extras", _check_extras(self.extras, lead))
         object.__setattr__(self, "totals", _check_totals(self.totals, lead))
+
+    @classmethod
+    def _of_run(cls, t: np.ndarray, q: np.ndarray | None, omega: np.ndarray | None, inertia: np.ndarray | None,
+                method: str, info: dict, extras: dict, totals: dict, model: str) -> Trajectory:
+        """The trajectory of a run of :func:`tumble.simulate`, whose ``t``, ``q`` and ``omega`` were checked
+        there: ``t`` (n,) strictly increasing and finite, ``q`` (n, [N,] 4) and ``omega`` (n, [N,] 3) float64
+        made from states the solver found finite, arrays the caller owns and hands over. They are marked
+        read-only, not copied nor checked again; ``inertia`` is shared when read-only (a model's own), copied
+        otherwise; ``info``, ``extras`` and ``totals`` are checked as by the constructor."""
+        self = object.__new__(cls)
+        if inertia is not None and inertia.flags.writeable:
+            inertia = np.array(inertia, dtype=np.float64)
+        for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
+            object.__setattr__(self, name, None if value is None else _readonly(value))
+        for name, value in (("method", method), ("info", info), ("extras", extras), ("totals", totals),
+                            ("model", model)):
+            object.__setattr__(self, name, value)
+        self._check_rest(q.shape[:-1] if q is not None else np.shape(totals["energy"]))
+        return self
 
     def __getattr__(self, name: str):
         """``traj.NAME`` is ``traj.extras[NAME].data`` for the model's named outputs (e.g. ``traj.wheel_speed``)."""
@@ -372,7 +395,7 @@ class Trajectory:
         """Magnitude ``|L|`` of the angular momentum (the same in every frame), N m s, (n, [N])."""
         return _readonly(np.linalg.norm(self.momentum_body, axis=-1))
 
-    @property
+    @cached_property
     def energy_drift(self) -> np.ndarray:
         """Relative change of kinetic energy from the first sample, ``(T - T₀) / T₀``.
 
@@ -381,7 +404,7 @@ class Trajectory:
         """
         return _relative(self.energy - self.energy[0], self.energy[0])
 
-    @property
+    @cached_property
     def momentum_norm_drift(self) -> np.ndarray:
         """Relative change of ``|L|`` from the first sample, ``(|L| - |L₀|) / |L₀|``.
 
@@ -389,7 +412,7 @@ class Trajectory:
         """
         return _relative(self.momentum_norm - self.momentum_norm[0], self.momentum_norm[0])
 
-    @property
+    @cached_property
     def momentum_inertial_drift(self) -> np.ndarray:
         """Relative change of the inertial momentum vector, ``|L_I - L_I₀| / |L_I₀|``.
 
