@@ -7,6 +7,7 @@ message that names the field and the rule it breaks, e.g.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 
@@ -120,6 +121,7 @@ def output_times(t) -> np.ndarray:
 
 
 
+@functools.cache
 def memory_bytes() -> int:
     """The machine's physical memory (bytes), or 2⁶³ − 1 where the system does not say."""
     try:

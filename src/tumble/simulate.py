@@ -131,7 +131,8 @@ class Model(abc.ABC):
 
     @abc.abstractmethod
     def initial_states(self, kernel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
-        """The state vectors (N, n) from the validated initial values (name → (N, size))."""
+        """The state vectors (N, n) from the validated initial values (name → (N, size)): a new array, which
+        the run integrates in place."""
 
     @abc.abstractmethod
     def outputs(self, kernel, t: np.ndarray, states: np.ndarray) -> Outputs:
@@ -265,7 +266,7 @@ def simulate(
         _check_memory(times.size, y0)
         try:
             solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device,
-                                       **options)
+                                       overwrite_y0=True, **options)
         except integrate.Diverged as diverged:
             raise _divergence(model, kernel, times, diverged) from None
         out = model.outputs(kernel, times, solution.states)

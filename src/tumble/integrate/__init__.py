@@ -212,7 +212,7 @@ class Solution:
 
 
 def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_STEPS, progress=None,
-          device="cpu") -> Solution:
+          device="cpu", overwrite_y0=False) -> Solution:
     """Integrate the compiled ``model`` (:mod:`tumble._protocol`) for a batch of states ``y0`` (N, n) through ``t``.
 
     ``t`` (s) must be strictly increasing (:func:`tumble._validate.output_times`).
@@ -224,10 +224,14 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
     refused (:func:`._fixed.landing_steps`), and so are states that would not fit in memory
     (:func:`tumble._validate.require_memory`). A state that stops being finite stops the run at the
     end of the chunk of output samples it is in, with :class:`Diverged`.
+
+    With ``overwrite_y0``, a C-ordered float64 ``y0`` is integrated in place (it ends as the final states)
+    instead of copied, as ``scipy.linalg``'s ``overwrite_a``: a caller that made ``y0`` for the run saves
+    a copy (:func:`tumble.simulate`; 56 bytes per rigid body).
     """
     m = check_method(method, model.provides, f"a {type(model).__name__}")
     check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
-    y = np.array(y0, dtype=np.float64, order="C")
+    y = (np.asarray if overwrite_y0 else np.array)(y0, dtype=np.float64, order="C")
     n_out = t.shape[0]
     require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
                    f"member(s) × {y.shape[1]} values")
@@ -291,9 +295,10 @@ def _raise_on_divergence(states, method, lo=0, hi=None):
 
 
 def _raise_on_failure(stats, t, max_steps):
-    bad = np.flatnonzero(stats[:, 3] != _dop853.OK)
-    if bad.size == 0:
+    failed = stats[:, 3] != _dop853.OK
+    if not failed.any():
         return
+    bad = np.flatnonzero(failed)
     b = int(bad[0])
     who = f"body {b}: " if stats.shape[0] > 1 else ""
     if stats[b, 3] == _dop853.STEP_TOO_SMALL:

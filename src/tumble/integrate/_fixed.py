@@ -83,7 +83,8 @@ def landing_steps(t_out, dt: float, max_steps: int) -> tuple[np.ndarray, np.ndar
     refused (:class:`~tumble.ValidationError` naming ``max_steps``) when it is
     more than ``max_steps``, before anything is integrated.
     """
-    spans = np.diff(np.asarray(t_out, dtype=np.float64))
+    t_out = np.asarray(t_out, dtype=np.float64)
+    spans = t_out[1:] - t_out[:-1]
     with np.errstate(over="ignore"):
         counts = np.maximum(1.0, np.ceil(spans / dt - 1e-9))
     needed = math.fsum(counts)

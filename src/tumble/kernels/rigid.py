@@ -67,14 +67,22 @@ def from_principal(moments, axes, model) -> RigidModel:
     """
     # a writeable copy: RigidBody.moments is read-only, and Numba would compile every integrator once more
     moments = np.array(moments, dtype=np.float64, order="C")
-    coefficients = np.stack(euler_coefficients(moments[:, 0], moments[:, 1], moments[:, 2]))
+    coefficients = np.empty((6, moments.shape[0]))
+    _coefficients(moments, coefficients)
     if model is None:
         codes, params = None, np.zeros((1, 0))
     else:
         programs = [torques.compile_program(model, a, offset=0) for a in axes]
-        codes, params = programs[0][0], np.stack([p for _, p in programs])
-    return RigidModel(coefficients=np.ascontiguousarray(coefficients), params=np.ascontiguousarray(params),
-                      codes=codes, moments=moments)
+        codes, params = programs[0][0], np.ascontiguousarray(np.stack([p for _, p in programs]))
+    return RigidModel(coefficients=coefficients, params=params, codes=codes, moments=moments)
+
+
+@njit(cache=True)
+def _coefficients(moments, out):
+    """``out[:, b]`` = the Euler coefficients of the principal moments ``moments[b]`` (one compiled call)."""
+    for b in range(moments.shape[0]):
+        out[0, b], out[1, b], out[2, b], out[3, b], out[4, b], out[5, b] = euler_coefficients(
+            moments[b, 0], moments[b, 1], moments[b, 2])
 
 
 
