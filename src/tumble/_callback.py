@@ -18,8 +18,7 @@ from __future__ import annotations
 
 import itertools
 import weakref
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -41,13 +40,18 @@ _SLOTS = itertools.count()
 _KEPT: list[list] = []  # the owners registered inside each open keep_alive() scope
 
 
-@contextmanager
-def keep_alive() -> Iterator[None]:
-    """Hold every owner registered inside the ``with`` block until it ends (a run: compile, then integrate)."""
-    _KEPT.append([])
-    try:
-        yield
-    finally:
+class keep_alive:  # noqa: N801 - used as a function: ``with keep_alive():``
+    """Hold every owner registered inside the ``with`` block until it ends (a run: compile, then integrate).
+
+    A class rather than a ``contextlib.contextmanager`` generator: entered on every ``simulate`` call, it
+    costs a tenth as much."""
+
+    __slots__ = ()
+
+    def __enter__(self) -> None:
+        _KEPT.append([])
+
+    def __exit__(self, *exc) -> None:
         _KEPT.pop()
 
 

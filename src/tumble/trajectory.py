@@ -94,6 +94,9 @@ def _check_info(info: Any) -> dict:
         raise ValidationError(f"info: must be a dict, got {type(info).__name__}")
     out = {}
     for key, value in info.items():
+        if type(key) is str and key and type(value) in (int, float, str):  # the usual entries, at once
+            out[key] = value
+            continue
         if not isinstance(key, str) or not key:
             raise ValidationError(f"info: keys must be non-empty strings, got {key!r}")
         if isinstance(value, (bool, np.bool_)) or not isinstance(
@@ -127,6 +130,8 @@ _RESERVED_DIMS = {"time", "body", "axis", "axis2", "component"}
 
 def _check_extras(extras: Any, lead: tuple[int, ...]) -> dict:
     """Validate ``extras`` (name -> :class:`Extra`) against the leading shape ``(n, [N])``; copy read-only."""
+    if type(extras) is dict and not extras:  # a rigid body's: nothing to check
+        return {}
     if not isinstance(extras, Mapping):
         raise ValidationError(f"extras: must be a dict of name -> Extra, got {type(extras).__name__}")
     out = {}
@@ -149,6 +154,8 @@ def _check_extras(extras: Any, lead: tuple[int, ...]) -> dict:
 
 def _check_totals(totals: Any, lead: tuple[int, ...]) -> dict:
     """Validate a model's ``totals`` (``energy`` (n, [N]), ``momentum_body`` (n, [N,] 3)); copy read-only."""
+    if type(totals) is dict and not totals:  # a rigid body's: nothing to check
+        return {}
     if not isinstance(totals, Mapping):
         raise ValidationError(f"totals: must be a dict of name -> array, got {type(totals).__name__}")
     out = {}
@@ -277,9 +284,9 @@ class Trajectory:
             inertia = np.array(inertia, dtype=np.float64)
         for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
             object.__setattr__(self, name, None if value is None else _readonly(value))
-        for name, value in (("method", method), ("info", info), ("extras", extras), ("totals", totals),
+        for name, given in (("method", method), ("info", info), ("extras", extras), ("totals", totals),
                             ("model", model)):
-            object.__setattr__(self, name, value)
+            object.__setattr__(self, name, given)
         self._check_rest(q.shape[:-1] if q is not None else np.shape(totals["energy"]))
         return self
 

@@ -257,7 +257,10 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
             progress(hi + 1, n_out)
     if n_out == 1:
         out[0] = y
-    return Solution(out, int(stats[:, 0].sum()), int(stats[:, 1].sum()), int(stats[:, 2].sum()))
+    n_steps = int(stats[:, 0].sum())
+    # a fixed-step method: a set number of evaluations per step (counted here, not per body)
+    n_rhs = _SCHEMES[method][1] * n_steps if method in _SCHEMES else int(stats[:, 2].sum())
+    return Solution(out, n_steps, int(stats[:, 1].sum()), n_rhs)
 
 
 def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps, serial):
@@ -267,7 +270,7 @@ def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps,
     if method == "exact":
         _exact.run(model, y, t, out)
     elif method in _SCHEMES:
-        scheme, evaluations = _SCHEMES[method]
+        scheme, _ = _SCHEMES[method]
         m, h = steps
         if y.shape[0] == 1:
             _fixed.run_one(scheme, model, y, t, m, h, out, stats)
@@ -276,7 +279,6 @@ def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps,
                 _fixed.run_block(scheme, model, k, y, t, m, h, out, stats)
         else:
             _fixed.run_batch(scheme, model, y, t, m, h, out, stats)
-        stats[:, 2] = evaluations * stats[:, 0]
     elif serial:
         for b in range(y.shape[0]):
             _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, _dop853.tableau(), out[:, b], stats[b])
