@@ -102,7 +102,7 @@ def check_rigid_motion(moments, omega, mass=None, *, stacklevel: int = 2) -> Non
     moments = np.asarray(moments, dtype=np.float64)
     omega = np.asarray(omega, dtype=np.float64)
     thin = moments[..., 0] < THIN_RATIO * moments[..., 2]
-    if np.any(thin):
+    if thin.any():
         ratio = np.broadcast_to(moments[..., 0] / moments[..., 2], thin.shape)
         warnings.warn(RigidityWarning(
             f"inertia: the smallest principal moment is {ratio.min():.3g} times the largest "
