@@ -27,7 +27,7 @@ import numpy as np
 from numba import njit
 
 from tumble import attitude, limits, torques
-from tumble._inertia import frozen, principal_axes
+from tumble._inertia import principal_axes
 from tumble._quat import qmul
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import rigid as _kernel
@@ -43,7 +43,7 @@ _STACKLEVEL = 4
 _STATE_FIELDS = (
     StateField("omega0", 3, "initial body rate, rad/s, body axes"),
     StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
-               default=frozen(attitude.identity()), quaternion=True),
+               default=attitude.identity(), quaternion=True),
 )
 
 

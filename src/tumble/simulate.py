@@ -70,7 +70,8 @@ class StateField:
                   a field of size 1 also takes a plain number
     description : what it is, with units and frame (used in messages and the docs)
     default     : array_like, a function of the values of the fields before it
-                  (``dict`` name → (N, size) array) returning one, or None for a required field
+                  (``dict`` name → (N, size) array) returning one, or None for a required field;
+                  an array_like is checked (and a quaternion normalised) here, once
     quaternion  : a unit quaternion ``[w, x, y, z]``: refused when zero, normalised here
     """
 
@@ -79,6 +80,12 @@ class StateField:
     description: str
     default: Any = None
     quaternion: bool = False
+
+    def __post_init__(self) -> None:
+        if self.default is not None and not callable(self.default):
+            default = np.array(_checked_value(self, self.default))  # its own copy, shared by every run: read-only
+            default.setflags(write=False)
+            object.__setattr__(self, "default", default)
 
 
 class Outputs(NamedTuple):
@@ -360,32 +367,44 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
     sizes: dict[str, int] = {}
     for f in fields:
         value = given.get(f.name)
-        if value is None:
-            if f.default is None:
-                raise ValidationError(f"{f.name}: a {type(model).__name__} needs it: {f.description}")
-            value = f.default(_broadcast(arrays, sizes)) if callable(f.default) else f.default
-        scalar = f.size == 1 and np.ndim(value) == 0  # a number for a field of one component
-        # finite checked below with the magnitude (one pass over the values), quaternions here
-        arr = as_array(value, f.name, tail=() if scalar else (f.size,), finite=f.quaternion)
-        if scalar:
-            arr = arr.reshape(1)
-        if arr.ndim > 2:
-            raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
-        if not f.quaternion and arr.size and not np.abs(arr).max() <= _LARGEST_STATE:  # NaN fails too
-            require_finite(arr, f.name)
-            raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
-                                  f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
-        if f.quaternion and not (arr * arr).any(axis=-1).all():  # |q| = 0: every square is 0
-            raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
-        if arr.ndim == 2 and f.name in given:
-            sizes[f.name] = arr.shape[0]
-        arrays[f.name] = attitude._normalized(arr) if f.quaternion else arr
+        if value is not None:
+            arr = _checked_value(f, value)
+            if arr.ndim == 2:
+                sizes[f.name] = arr.shape[0]
+        elif f.default is None:
+            raise ValidationError(f"{f.name}: a {type(model).__name__} needs it: {f.description}")
+        elif callable(f.default):
+            arr = _checked_value(f, f.default(_broadcast(arrays, sizes)))
+        else:
+            arr = f.default  # checked when the field was made
+        arrays[f.name] = arr
     if model.batch_size is not None:
         sizes["body"] = model.batch_size
     if len(set(sizes.values())) > 1:
         raise ValidationError(f"batch sizes disagree: {sizes}")
     n = next(iter(sizes.values()), None)
     return _broadcast(arrays, sizes), n
+
+
+def _checked_value(f: StateField, value) -> np.ndarray:
+    """The value of the field ``f`` as a float64 array (size,) or (N, size): finite, at most
+    :data:`_LARGEST_STATE` in magnitude, a quaternion non-zero and normalised."""
+    scalar = f.size == 1 and np.ndim(value) == 0  # a number for a field of one component
+    # finite checked below with the magnitude (one pass over the values), quaternions here
+    arr = as_array(value, f.name, tail=() if scalar else (f.size,), finite=f.quaternion)
+    if scalar:
+        arr = arr.reshape(1)
+    if arr.ndim > 2:
+        raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
+    if not f.quaternion and arr.size and not np.abs(arr).max() <= _LARGEST_STATE:  # NaN fails too
+        require_finite(arr, f.name)
+        raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
+                              f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
+    if f.quaternion:
+        if not (arr * arr).any(axis=-1).all():  # |q| = 0: every square is 0
+            raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
+        arr = attitude._normalized(arr)
+    return arr
 
 
 def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str, np.ndarray]:
