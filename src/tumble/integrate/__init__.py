@@ -257,10 +257,13 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
             progress(hi + 1, n_out)
     if n_out == 1:
         out[0] = y
-    n_steps = int(stats[:, 0].sum())
+    def total(k):  # statistic k summed over the members (a lone body's own: no reduction to set up)
+        return int(stats[0, k] if stats.shape[0] == 1 else stats[:, k].sum())
+
+    n_steps = total(0)
     # a fixed-step method: a set number of evaluations per step (counted here, not per body)
-    n_rhs = _SCHEMES[method][1] * n_steps if method in _SCHEMES else int(stats[:, 2].sum())
-    return Solution(out, n_steps, int(stats[:, 1].sum()), n_rhs)
+    n_rhs = _SCHEMES[method][1] * n_steps if method in _SCHEMES else total(2)
+    return Solution(out, n_steps, total(1), n_rhs)
 
 
 def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps, serial):
