@@ -59,11 +59,13 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
 
 def require_finite(arr: np.ndarray, name: str) -> None:
     """Raise :class:`ValidationError` if ``arr`` holds NaN or ±inf."""
-    bad = ~np.isfinite(arr)
-    if bad.any():
-        idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        where = f" at index {idx[0] if len(idx) == 1 else idx}" if arr.ndim else ""
-        raise ValidationError(f"{name}: must be finite (found {arr[bad].flat[0]}{where})")
+    finite = np.isfinite(arr)
+    if finite.all():
+        return
+    bad = ~finite
+    idx = tuple(int(i) for i in np.argwhere(bad)[0])
+    where = f" at index {idx[0] if len(idx) == 1 else idx}" if arr.ndim else ""
+    raise ValidationError(f"{name}: must be finite (found {arr[bad].flat[0]}{where})")
 
 
 def _scalar(x, name: str, rule: str) -> float:
