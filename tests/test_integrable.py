@@ -72,28 +72,32 @@ def drift(invariant, body, gravity, traj):
     return np.abs(values / values[0] - 1.0).max()
 
 
-# dop853 at rtol = 1e-15 (the tightest it accepts), atol = 1e-16 (1.6e5-2.2e5 steps, 0.2 s each) over 1e4 time
+# dop853 at rtol = 1e-15 (the tightest it accepts), atol = 1e-16 (1.4e5-2.1e5 steps, 0.1-0.2 s each) over 1e4 time
 # units, its update summed with compensation (tumble.integrate._dop853): the drift of an invariant is then its
 # accumulated local error, about 10x smaller per decade of tolerance (K: 1.6e-10, 1.2e-11, 1.1e-12 at
 # rtol = atol = 1e-13, 1e-14, 1e-15). Measured, relative, under OpenBLAS's AVX-512 / Haswell kernels
 # (OPENBLAS_CORETYPE; their eigen-decompositions of the turned inertia differ in the last bit):
-#   Euler        energy 8.2e-14 / 9.9e-14, |L| 1.5e-13 / 1.8e-13
+#   Euler        energy 8.2e-14 / 9.9e-14, |L| 7.5e-14 / 9.0e-14
 #   Lagrange     energy 4.3e-13 / 4.0e-13, L_z 3.5e-13 / 3.7e-13, omega3 6.7e-16 / 7.8e-16 (2.0e-14 uncompensated)
-#   Kovalevskaya energy 2.1e-13 / 2.3e-13, K 5.1e-13 / 5.5e-13
+#   Kovalevskaya energy 2.1e-13 / 2.3e-13, L_z 1.7e-13 / 2.0e-13, K 5.1e-13 / 5.5e-13
 #   G-C          energy 9.9e-14 / 1.1e-13, G 1.65e-12 / 1.63e-12
 # The 1e-12 is met except by G. G drifts linearly in t, 1.6e-16 per time unit, whatever the tolerance
-# below 1e-15 (1.4e-12-1.6e-12 at atol = 1e-16, 1e-17 and at rtol = atol = 1e-16 with the check lifted) and
-# with or without the compensation: the rounding of the right-hand side, which the same top in axes where its
-# centre of mass lies on a principal axis does not have (4.6e-13 there). Bound 2e-12 for G, 1e-12 for the rest.
+# below 1e-15 (1.6e-12 at atol = 1e-16, 1.8e-12-1.9e-12 at atol = 1e-17 and at rtol = atol = 1e-16 with the
+# check lifted), with or without the compensation or the quaternion's normalisation, and with the principal
+# moments and axes set exactly: the rounding of the right-hand side, which depends on the axes the top is
+# described in (about 5e-13 with the symmetry axis along z and the centre of mass along x). Bound 2e-12 for G,
+# 1e-12 for the rest (docs/chaos.md, "Invariants over 1e4 time units").
 DOP853 = dict(method="dop853", rtol=1e-15, atol=1e-16)
 TOL_DOP853 = 1e-12
 TOL_DOP853_G = 2e-12
 # exact_split4 (symplectic, order 4) at dt = 0.05 s over 1e4 time units: the error of a first integral is
 # bounded and O(dt⁴) (measured 4.3e-9 Kovalevskaya, 4.6e-9 G-C; 4.2e-9 and 3.7e-9 already in the first
-# tenth). The 1e-12 is out of reach for it: smaller steps make it worse, dt = 0.01 s gives 4.8e-10 and
+# tenth). The 1e-12 is out of reach for it: smaller steps help to dt = 0.0125 s (3.9e-10), then make it
+# worse, dt = 0.01 s gives 4.8e-10 and
 # dt = 0.005 s 9.5e-10 (Kovalevskaya; G-C 4.0e-10, 8.1e-10), growing linearly in t (4.9e-11 in the first
-# tenth at dt = 0.01 s): 1e6-2e6 steps of the exact free flow, each rounded, with a systematic part; dop853
-# at 1e-15 takes 1.5e5 steps and meets it (above). Bound 2e-8, and no growth:
+# tenth at dt = 0.01 s): 1e6-2e6 steps of the exact free flow, each rounded, with a systematic part of about
+# 5e-16 per step, so 1e-12 would need steps of 5 s, too long for any composition (docs/chaos.md). Bound 2e-8,
+# and no growth:
 # the largest error of the last tenth of the run is within 2x the largest of the first tenth (a drift linear
 # in t would make it 9x).
 TOL_SPLIT = 2e-8
