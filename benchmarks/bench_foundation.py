@@ -4,9 +4,11 @@ Prints, side by side, with the machine (CPU model, cores, load average), min / m
 5 repeats, wall and CPU-time-based rates (``_timing``):
 
 1. single-body RK4, cost per step: tumble's compiled loop, a naive Numba loop and a NumPy loop;
-2. batch RK4, body-steps per second on all cores, one shared inertia and one inertia per body,
-   beside a hand-written C kernel (``rk4_reference.c``, all four stages fused in registers) built
-   here with ``gcc -O3 -march=native -fopenmp -fno-math-errno`` when gcc is present;
+2. batch RK4, body-steps per second on all cores, one shared inertia and one inertia per body:
+   ``simulate`` end to end and its compiled kernel alone, beside a hand-written C kernel
+   (``rk4_reference.c``, all four stages fused in registers) built here with
+   ``gcc -O3 -march=native -fopenmp -fno-math-errno`` when gcc is present, with and without
+   ``-ffp-contract=off`` (no fused multiply-adds, as tumble);
 3. the cost per body of set-up and output at N = 1e6 (a run of one step, less the kernel's share);
 4. the adaptive method against scipy's ``solve_ivp(DOP853)`` at equal error, end to end, with scipy
    given a fair right-hand side (one preallocated-free expression returning one array), and the
@@ -93,20 +95,28 @@ def single_body(steps):
 
 
 def c_reference():
-    """The C kernel's ``rk4_batch`` (ctypes), or None without gcc."""
+    """The C kernel's ``rk4_batch`` (ctypes) built twice, ``{"C reference": …, "C, no FMA": …}``: as gcc
+    contracts ``a·b + c`` into fused multiply-adds by default, and with ``-ffp-contract=off``, rounding every
+    operation as tumble does (which must not contract: its CPU and CUDA-simulator states agree bit for bit).
+    Empty without gcc."""
     gcc = shutil.which("gcc")
     if gcc is None:
-        return None
-    lib = Path(tempfile.mkdtemp()) / "rk4_reference.so"
-    subprocess.run([gcc, "-O3", "-march=native", "-fopenmp", "-fno-math-errno", "-shared", "-fPIC", "-o", str(lib),
-                    str(Path(__file__).with_name("rk4_reference.c"))], check=True)
-    f = ctypes.CDLL(str(lib)).rk4_batch
-    f.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_ssize_t, ctypes.c_double, ctypes.c_long]
-    return f
+        return {}
+    kernels = {}
+    for name, flags in (("C reference", []), ("C, no FMA", ["-ffp-contract=off"])):
+        lib = Path(tempfile.mkdtemp()) / "rk4_reference.so"
+        subprocess.run([gcc, "-O3", "-march=native", "-fopenmp", "-fno-math-errno", *flags, "-shared", "-fPIC",
+                        "-o", str(lib), str(Path(__file__).with_name("rk4_reference.c"))], check=True)
+        f = ctypes.CDLL(str(lib)).rk4_batch
+        f.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_ssize_t, ctypes.c_double,
+                      ctypes.c_long]
+        kernels[name] = f
+    return kernels
 
 
-def batch(n_bodies, steps, per_body, c_kernel):
-    """Body-steps per second (wall and CPU × cores, min / median): tumble.simulate and the C kernel."""
+def batch(n_bodies, steps, per_body, c_kernels):
+    """Body-steps per second (wall and CPU × cores, min / median): tumble.simulate, its compiled kernel alone
+    (``_fixed.run_batch``: no set-up or output conversion) and the C kernels."""
     rng = np.random.default_rng(1)
     omega0 = OMEGA0 + 1e-2 * rng.standard_normal((n_bodies, 3))
     t = np.array([0.0, steps * 1e-3])
@@ -115,13 +125,21 @@ def batch(n_bodies, steps, per_body, c_kernel):
     tumble.simulate(model, omega0, t=t[:1].tolist() + [1e-3], method="rk4", dt=1e-3)  # compile / load from cache
     work = n_bodies * steps
     rows = {"tumble": measure(lambda: tumble.simulate(model, omega0, t=t, method="rk4", dt=1e-3)).rates(work, CORES)}
-    if c_kernel is not None:
+    kernel = _rigid.from_principal(MOMENTS[None] * scale[:, None], np.broadcast_to(np.eye(3), (scale.size, 3, 3)),
+                                   None)
+    m, h = _fixed.landing_steps(t, 1e-3, 10**9)
+    y = np.zeros((n_bodies, 7))
+    y[:, 0], y[:, 4:] = 1.0, omega0
+    out, stats = np.empty((2, n_bodies, 7)), np.zeros((n_bodies, 3), dtype=np.int64)
+    rows["kernel alone"] = measure(lambda: _fixed.run_batch(_rk4.SCHEME, kernel, y, t, m, h, out, stats)).rates(
+        work, CORES)
+    for name, c_kernel in c_kernels.items():
         y = np.zeros((7, n_bodies))
         y[0], y[4:] = 1.0, omega0.T
         # (3, N) one column per body (a scaled inertia has the same c₁, c₂, c₃: the memory traffic is the point)
         c = np.ascontiguousarray(np.repeat([[C1], [C2], [C3]], n_bodies if per_body else 1, axis=1))
-        rows["C reference"] = measure(lambda: c_kernel(y.ctypes.data, c.ctypes.data, int(per_body), n_bodies,
-                                                       1e-3, steps)).rates(work, CORES)
+        rows[name] = measure(lambda c_kernel=c_kernel, y=y, c=c: c_kernel(
+            y.ctypes.data, c.ctypes.data, int(per_body), n_bodies, 1e-3, steps)).rates(work, CORES)
     return rows
 
 
@@ -162,16 +180,18 @@ def main():
     for name, v in r.items():
         print(f"   {name:<14} {fmt(v, ' ns')}")
 
-    c_kernel = c_reference()
+    c_kernels = c_reference()
     n_bodies, steps = (20_000, 200) if args.quick else (100_000, 500)
     for per_body in (False, True):
         print(f"\n2{'b' if per_body else 'a'}. batch RK4, N = {n_bodies}, {steps} steps, "
               f"{'one inertia per body' if per_body else 'one shared inertia'}: body-steps/s (min-time / median)")
-        rows = batch(n_bodies, steps, per_body, c_kernel)
+        rows = batch(n_bodies, steps, per_body, c_kernels)
         for name, v in rows.items():
-            print(f"   {name:<12} wall {fmt(v['wall'])}   cpu {fmt(v['cpu'])}")
-        if "C reference" in rows:
-            print(f"   tumble / C (cpu, best): {rows['tumble']['cpu'][0] / rows['C reference']['cpu'][0]:.0%}")
+            print(f"   {name:<13} wall {fmt(v['wall'])}   cpu {fmt(v['cpu'])}")
+        for c_name in ("C reference", "C, no FMA"):
+            if c_name in rows:
+                print(f"   tumble / {c_name} (cpu, best): {rows['tumble']['cpu'][0] / rows[c_name]['cpu'][0]:.0%}; "
+                      f"kernel alone: {rows['kernel alone']['cpu'][0] / rows[c_name]['cpu'][0]:.0%}")
 
     n_big = 200_000 if args.quick else 1_000_000
     setup, step = big_batch_overhead(n_big)

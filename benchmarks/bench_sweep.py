@@ -10,8 +10,10 @@ series (ω_z, with its per-time statistics and percentiles). Figures:
 
 * plain batch: ``tumble.simulate`` of all the samples in this process (Numba
   threads on every core), the inputs drawn beforehand;
-* the plain batch followed by the sweep's reductions, and the drawing of the
-  inputs alone (one vectorised Philox draw per chunk);
+* the plain batch followed by the sweep's reductions, then also by its per-time
+  statistics and percentiles (the sweep's work in one process, without chunks,
+  store or Dask), and the drawing of the inputs alone (one vectorised Philox
+  draw per chunk);
 * the sweep in this process (``workers=0``: draws, chunks, reductions, store in memory);
 * the sweep on a LocalCluster of 1 and of 2 single-threaded worker processes
   (started and warmed up before the timing);
@@ -41,7 +43,8 @@ import numpy as np
 import psutil
 
 import tumble
-from tumble.sweep import Component, Final, Normal, NutationAngle, UniformAttitude
+from tumble.ensemble import moments
+from tumble.sweep import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
 from tumble.sweep.plan import make_plan
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
@@ -130,6 +133,13 @@ def main():
         return [f(traj) for f in (*REDUCE["outcomes"].values(), *REDUCE["statistics"].values())]
 
     row("plain batch + the same reductions", s, *timed(repeats, reduced))
+
+    def summarised():  # the sweep's work in one process, without chunks, store or Dask
+        outcome, series = reduced()  # (samples,) and (time, samples)
+        moments(series)  # per-time count, mean, M2, min, max
+        return np.percentile(series, PERCENTILES, axis=1), np.nanpercentile(outcome, PERCENTILES, axis=0)
+
+    full = row("  + per-time statistics, percentiles", s, *timed(repeats, summarised))
     row("drawing the inputs only", s, *timed(repeats, lambda: make_plan(
         BODY, DISPERSIONS, samples=s, seed=1, chunk=chunk, t=T, method="rk4", options={"dt": 0.01}, torque=None,
         outcomes={}, series={}, fixed={}).inputs(0, s)))
@@ -151,7 +161,8 @@ def main():
         cluster.close()
         print(f"    (cluster of {n} started in {started:.2f} s, not counted)")
     print(f"\n2 workers / plain batch on {os.cpu_count()} threads: {rates[2] / plain:.3f} (wall, best runs); "
-          f"2 workers / 1 worker: {rates[2] / rates[1]:.2f}")
+          f"2 workers / the same work in one process: {rates[2] / full:.3f}; 2 workers / 1 worker: "
+          f"{rates[2] / rates[1]:.2f}")
     per_chunk = [(d - l) / args.tiny for d, l in zip(sorted(dask), sorted(local), strict=True)]
     print(f"Dask overhead per chunk ({args.tiny} one-sample chunks on 2 workers, minus the same in this process): "
           f"min {min(per_chunk) * 1e3:.2f} ms, median {statistics.median(per_chunk) * 1e3:.2f} ms "

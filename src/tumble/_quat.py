@@ -32,6 +32,22 @@ def qmul(aw, ax, ay, az, bw, bx, by, bz):
 
 
 @njit(cache=True)
+def qmul_vector(aw, ax, ay, az, vx, vy, vz):
+    """``a ⊗ [0, v]``: the Hamilton product with a pure quaternion (a vector ``v``).
+
+    The terms of :func:`qmul` with ``b_w = 0`` left out: the same values (up to
+    the sign of a zero) in 12 multiplications instead of 16, which the
+    quaternion kinematics ``q̇ = ½ q ⊗ [0, ω]`` evaluate at every stage.
+    """
+    return (
+        -ax * vx - ay * vy - az * vz,
+        aw * vx + ay * vz - az * vy,
+        aw * vy - ax * vz + az * vx,
+        aw * vz + ax * vy - ay * vx,
+    )
+
+
+@njit(cache=True)
 def qrotate(qw, qx, qy, qz, vx, vy, vz):
     """Rotate ``v`` by the unit quaternion ``q``: ``q ⊗ v ⊗ q*`` (= R(q) v).
 

@@ -112,17 +112,24 @@ def euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3):
 
 
 @register_jitable
-def rigid_rates(c1, c2, c3, r1, r2, r3, qw, qx, qy, qz, w1, w2, w3, t1, t2, t3):
+def rigid_rates(c1, c2, c3, r1, r2, r3, qw, qx, qy, qz, w1, w2, w3, torque):
     """``dy/dt`` of one rigid body from its state ``(q, ω)`` and torque ``τ`` (N·m, principal axes):
     ``(½ q ⊗ [0, ω], ω̇)`` with ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic (:func:`euler_principal`,
     coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``).
+
+    ``torque`` is ``(τ₁, τ₂, τ₃)``, or None for a torque-free body: compiled
+    code then holds no torque terms at all (``c₁ ω₂ ω₃ + 0·(1/I₁)`` is not
+    folded to ``c₁ ω₂ ω₃`` by a compiler that keeps IEEE semantics; the values
+    are the same, up to the sign of a zero).
 
     The one right-hand side of the rigid body, compiled into the CPU kernel
     (:mod:`tumble.kernels.rigid`) and the GPU kernel of
     :mod:`tumble.integrate._cuda` alike, so that both round alike.
     """
-    d = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
-    a1, a2, a3 = euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3)
+    d = _quat.qmul_vector(qw, qx, qy, qz, w1, w2, w3)
+    a1, a2, a3 = c1 * w2 * w3, c2 * w3 * w1, c3 * w1 * w2
+    if torque is not None:  # the order of euler_principal: (c₁ ω₂ ω₃) + τ₁ (1/I₁)
+        a1, a2, a3 = a1 + torque[0] * r1, a2 + torque[1] * r2, a3 + torque[2] * r3
     return 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3], a1, a2, a3
 
 

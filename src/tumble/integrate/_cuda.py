@@ -60,7 +60,7 @@ def cuda_available() -> bool:
 
 
 def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
-    """The torque (N·m, principal axes) of the program ``codes``, or zero for ``codes = ()``.
+    """The torque (N·m, principal axes) of the program ``codes``, or None (torque-free) for ``codes = ()``.
 
     Compiled code picks the implementation from the type of ``codes`` (the
     overload below), so that a torque-free kernel holds no torque code at all:
@@ -68,7 +68,7 @@ def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
     resident warps. The CUDA simulator runs this Python body.
     """
     if len(codes) == 0:
-        return 0.0, 0.0, 0.0
+        return None
     return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
 
 
@@ -77,7 +77,7 @@ def _torque_by_type(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
     if isinstance(codes, types.BaseTuple):  # torque-free
 
         def impl(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
-            return 0.0, 0.0, 0.0
+            return None
 
         return impl
     return torques.evaluate_compiled
@@ -88,8 +88,8 @@ def _derivative(c, P, row, codes, t, y):
     """``dy/dt`` of one body: the rigid body's one right-hand side (:func:`tumble.dynamics.rigid_rates`)
     with coefficients ``c`` and the torque of ``codes``."""
     qw, qx, qy, qz, w1, w2, w3 = y
-    t1, t2, t3 = _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
-    return rigid_rates(c[0], c[1], c[2], c[3], c[4], c[5], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
+    return rigid_rates(c[0], c[1], c[2], c[3], c[4], c[5], qw, qx, qy, qz, w1, w2, w3,
+                       _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes))
 
 
 @register_jitable

@@ -91,7 +91,7 @@ def _rigid_point_rates(model, b, t, y):
     if isinstance(model.types[2], types.NoneType):  # torque-free: no torque code at all
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
-            return 0.0, 0.0, 0.0
+            return None
 
     else:
 
@@ -107,8 +107,8 @@ def _rigid_point_rates(model, b, t, y):
         c = model.coefficients
         r = b
         qw, qx, qy, qz, w1, w2, w3 = y
-        t1, t2, t3 = torque(model, b, t, qw, qx, qy, qz, w1, w2, w3)
-        return rigid_rates(c[0, r], c[1, r], c[2, r], c[3, r], c[4, r], c[5, r], qw, qx, qy, qz, w1, w2, w3, t1, t2, t3)
+        return rigid_rates(c[0, r], c[1, r], c[2, r], c[3, r], c[4, r], c[5, r], qw, qx, qy, qz, w1, w2, w3,
+                           torque(model, b, t, qw, qx, qy, qz, w1, w2, w3))
 
     return impl
 
