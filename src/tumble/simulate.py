@@ -424,15 +424,18 @@ def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str
 def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool) -> Trajectory:
     """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run.
 
-    ``q`` and ``omega`` are handed over without a copy when ``out`` owns them (fresh C-ordered float64
-    arrays, as the models' outputs are), copied otherwise (a view of the states would keep them alive)."""
-    def pick(a):
+    ``q`` and ``omega`` are checked finite here, once, and handed over without a copy when ``out`` owns
+    them (fresh C-ordered float64 arrays, as the models' outputs are), copied otherwise (a view of the states
+    would keep them alive)."""
+    def pick(a, name):
         if a is None:
             return None
         if not (a.flags.owndata and a.flags.c_contiguous and a.dtype == np.float64):
             a = np.array(a, dtype=np.float64)
         a.setflags(write=False)  # before picking: a view of a read-only array is read-only
-        return a[:, 0] if single else a
+        a = a[:, 0] if single else a
+        require_finite(a, name)  # finite states may still give a model's outputs that are not (a singular inertia)
+        return a
 
     inertia = out.inertia
     if single and inertia is not None and inertia.ndim == 3:
@@ -440,5 +443,5 @@ def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: di
     extras = {name: Extra(e.data[:, 0] if single else e.data, e.dims, e.units, e.description)
               for name, e in out.extras.items()}
     totals = {name: value[:, 0] if single else value for name, value in out.totals.items()}
-    return Trajectory._of_run(np.array(t), pick(out.q), pick(out.omega), inertia, method, info, extras, totals,
+    return Trajectory._of_run(np.array(t), pick(out.q, "q"), pick(out.omega, "omega"), inertia, method, info, extras, totals,
                               type(model).__name__)

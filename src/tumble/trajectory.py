@@ -275,8 +275,8 @@ class Trajectory:
     def _of_run(cls, t: np.ndarray, q: np.ndarray | None, omega: np.ndarray | None, inertia: np.ndarray | None,
                 method: str, info: dict, extras: dict, totals: dict, model: str) -> Trajectory:
         """The trajectory of a run of :func:`tumble.simulate`, whose ``t``, ``q`` and ``omega`` were checked
-        there: ``t`` (n,) strictly increasing and finite, ``q`` (n, [N,] 4) and ``omega`` (n, [N,] 3) float64
-        made from states the solver found finite, arrays the caller owns and hands over. They are marked
+        there: ``t`` (n,) strictly increasing and finite, ``q`` (n, [N,] 4) and ``omega`` (n, [N,] 3) finite
+        float64 of the shapes of a run, arrays the caller owns and hands over. They are marked
         read-only, not copied nor checked again; ``inertia`` is shared when read-only (a model's own), copied
         otherwise; ``info``, ``extras`` and ``totals`` are checked as by the constructor."""
         self = object.__new__(cls)
