@@ -44,7 +44,7 @@ import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Final, NamedTuple
+from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
 
 import filelock
 import numpy as np
@@ -365,7 +365,7 @@ class Trajectory:
         Constant when no external torque acts.
         """
         body = self.momentum_body
-        return _readonly(rotate(self.q, body))
+        return _readonly(rotate(cast(np.ndarray, self.q), body))
 
     @cached_property
     def momentum_norm(self) -> np.ndarray:

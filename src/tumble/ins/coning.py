@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -151,7 +152,7 @@ def measure_drift(coning: Coning, algorithm: str, update_interval: float, update
     increments = coning.increments(T / n, n * int(updates))
     result = strapdown(increments, q0=coning.attitude(0.0), algorithm=algorithm)
     t = result.attitude.t
-    error = attitude.multiply(result.attitude.q, attitude.conjugate(coning.attitude(t)))
+    error = attitude.multiply(cast(np.ndarray, result.attitude.q), attitude.conjugate(coning.attitude(t)))
     change = attitude.to_rotvec(attitude.multiply(error[1:], attitude.conjugate(error[:-1])))[:, 2]
     accumulated = np.concatenate([[0.0], np.cumsum(change)])
     return float(np.polyfit(t[1:], accumulated[1:], 1)[0])

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -248,7 +248,7 @@ def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
     summary: dict[str, Any] = {"duration_s": float(t[-1]), "sample_rate_hz": 1.0 / dt}
     for name, increments in cases.items():
         nav = strapdown(increments, q0=truth.q[0], algorithm="three-sample")
-        error = attitude.relative_angle(nav.attitude.q, truth.q[::6])
+        error = attitude.relative_angle(cast(np.ndarray, nav.attitude.q), truth.q[::6])
         ax.loglog(nav.attitude.t[1:], error[1:], lw=1, label=name)
         summary[name] = {"final_rad": float(error[-1]), "max_rad": float(error.max())}
     span = np.geomspace(3 * dt, t[-1], 50)

@@ -55,6 +55,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -203,7 +204,7 @@ class Gyroscope(Model):
 
     def outputs(self, kernel, t, states) -> Outputs:
         out = self._rotor().outputs(kernel, t, states)
-        height = attitude.rotate(out.q, [0.0, 0.0, 1.0])[..., 2]   # cos θ
+        height = attitude.rotate(cast(np.ndarray, out.q), [0.0, 0.0, 1.0])[..., 2]   # cos θ
         energy = dynamics.kinetic_energy(out.inertia, out.omega) + self.imbalance_torque * height
         return out._replace(totals={"energy": energy})
 

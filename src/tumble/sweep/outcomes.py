@@ -25,6 +25,7 @@ Angles are in rad, times in s.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -61,7 +62,7 @@ class PointingError:
         object.__setattr__(self, "target", tuple((q / np.linalg.norm(q)).tolist()))
 
     def __call__(self, traj: Trajectory) -> np.ndarray:
-        return attitude.relative_angle(np.array(self.target), traj.q)
+        return attitude.relative_angle(np.array(self.target), cast(np.ndarray, traj.q))
 
 
 @dataclass(frozen=True)
