@@ -342,7 +342,7 @@ class Trajectory:
         """
         if "energy" in self.totals:
             return self.totals["energy"]
-        return _readonly(kinetic_energy(self.inertia, self.omega))
+        return _readonly(kinetic_energy(cast(np.ndarray, self.inertia), cast(np.ndarray, self.omega)))
 
     @cached_property
     def momentum_body(self) -> np.ndarray:
@@ -356,7 +356,7 @@ class Trajectory:
         if self.q is None:
             raise ValidationError(f"momentum_body: this {self.model or 'model'} trajectory has no angular momentum "
                                   "(no single attitude; see its extras and energy)")
-        return _readonly(angular_momentum(self.inertia, self.omega))
+        return _readonly(angular_momentum(cast(np.ndarray, self.inertia), cast(np.ndarray, self.omega)))
 
     @cached_property
     def momentum_inertial(self) -> np.ndarray:

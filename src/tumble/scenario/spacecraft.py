@@ -44,7 +44,7 @@ top of the spacecraft's own environment) are the shared tables
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal, Protocol
+from typing import Annotated, Any, Literal, Protocol, cast
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -121,7 +121,7 @@ class HubTable(_InertiaOrMoments):
 
     def build(self) -> RigidBody:
         inertia = self.inertia if self.moments is None else np.diag(self.moments)  # exactly one is given
-        return RigidBody(inertia, mass=self.mass, com=self.com)
+        return RigidBody(cast(Any, inertia), mass=self.mass, com=self.com)
 
 
 class CMGPyramid(_Table):

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
@@ -105,7 +106,7 @@ class Spacecraft(Model):
     torque = ("external torque on the spacecraft, body axes (N·m): a tumble.torques model or f(t, q, omega), "
               "in addition to its own environment")
 
-    inertia: object = None
+    inertia: RigidBody | ArrayLike | None = None
     hub: RigidBody | None = None
     wheels: Sequence[ReactionWheel] = ()
     cmgs: CMGCluster | None = None
