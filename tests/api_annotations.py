@@ -3,7 +3,7 @@
 Public: a function or method (``__init__`` and ``__call__`` included, other dunders not) defined at the top
 level of a module, or in a class there, whose module's dotted path has no component starting with ``_``, outside
 ``tumble.kernels`` (the Numba kernels), and whose own name (and its class's) does not start with ``_``.
-Nested functions do not count. Complete: a return annotation and one on every parameter, ``*args`` and
+Nested functions and ``@overload`` signatures do not count. Complete: a return annotation and one on every parameter, ``*args`` and
 ``**kwargs`` included, ``self``/``cls`` excepted.
 
 Run ``python tests/api_annotations.py`` for the count and the list; tests/test_package.py asserts the list is
@@ -38,11 +38,17 @@ def _is_public_name(name: str) -> bool:
     return not name.startswith("_")
 
 
+def _is_overload(node: ast.FunctionDef | ast.AsyncFunctionDef) -> bool:
+    """An ``@overload`` signature: a declaration of the function defined after it, not one of its own."""
+    return any((isinstance(d, ast.Name) and d.id == "overload") or (isinstance(d, ast.Attribute) and d.attr == "overload")
+               for d in node.decorator_list)
+
+
 def _functions(body: list[ast.stmt], prefix: str, in_class: bool) -> Iterator[tuple[str, ast.FunctionDef | ast.AsyncFunctionDef, bool]]:
     """(qualified name, node, is a method) of the functions and classes' methods in a module or class body."""
     for node in body:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
-            if _is_public_name(node.name):
+            if _is_public_name(node.name) and not _is_overload(node):
                 yield f"{prefix}.{node.name}", node, in_class
         elif isinstance(node, ast.ClassDef):
             if not node.name.startswith("_"):

@@ -183,7 +183,7 @@ class FlexibleBody(Model):
             StateField("eta_rate0", m, f"initial modal rates dη/dt ({m}), kg^½·m/s", default=np.zeros(m)),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.FlexibleModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.FlexibleModel:
         """The compiled model (:class:`tumble.kernels.flexible.FlexibleModel`) under a torque on the hub (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         w = self.frequencies
@@ -197,11 +197,11 @@ class FlexibleBody(Model):
             codes=codes,
         )
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.FlexibleModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q, ω, η, η̇]`` (N, 7 + 2m): the state of :mod:`tumble.kernels.flexible`."""
         return np.concatenate([values["q0"], values["omega0"], values["eta0"], values["eta_rate0"]], axis=1)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.FlexibleModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         m = len(self.modes)
         omega, eta, rate = states[..., 4:7], states[..., 7:7 + m], states[..., 7 + m:]
         extras = {

@@ -70,11 +70,11 @@ class RigidMotion(Model):
                        default=attitude.identity(), quaternion=True),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.RigidModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.RigidModel:
         moments, axes, _ = self._principal()
         return _kernel.from_principal(moments, axes, torques.as_torque_model(torque))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         moments, axes, q_bp = self._principal()
         y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
         y0[:, :4] = attitude.multiply(values["q0"], q_bp)
@@ -82,7 +82,7 @@ class RigidMotion(Model):
         limits.check_rigid_motion(moments, y0[:, 4:], self._masses(), stacklevel=_STACKLEVEL)
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         moments, axes, q_bp = self._principal()
         if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
             limits.check_rigid_motion(moments, states[-1, :, 4:], self._masses(), stacklevel=_STACKLEVEL)

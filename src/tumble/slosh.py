@@ -151,7 +151,7 @@ class SloshBody(Model):
                        "(its component along the rod is removed)", default=np.zeros(3)),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.SloshModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.SloshModel:
         """The compiled model (:class:`tumble.kernels.slosh.SloshModel`) under a torque on the hub (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         p = self.pendulum
@@ -161,7 +161,7 @@ class SloshBody(Model):
             params=params[None, :], codes=codes,
         )
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.SloshModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q, ω, s, ν]`` (N, 13) with ``s`` normalised and ``ν ⊥ s``: the state of :mod:`tumble.kernels.slosh`."""
         direction = values["direction0"]
         norm = np.linalg.norm(direction, axis=-1, keepdims=True)
@@ -172,7 +172,7 @@ class SloshBody(Model):
         nu0 = rate - np.sum(rate * s0, axis=-1, keepdims=True) * s0
         return np.concatenate([values["q0"], values["omega0"], s0, nu0], axis=1)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.SloshModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         omega, s, nu = states[..., 4:7], states[..., 7:10], states[..., 10:13]
         extras = {
             "pendulum_direction": Extra(s, ("body_axis",), "1",

@@ -57,6 +57,7 @@ from tumble.integrate import METHODS
 from tumble.kernels import gimbal as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory
+from tumble.torques import TorqueLike
 
 __all__ = ["GimbaledGyro"]
 
@@ -160,13 +161,13 @@ class GimbaledGyro(Model):
             StateField("theta_dot0", 1, "initial inner gimbal rate, rad/s", default=0.0),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.GimbalModel:
+    def compile(self, torque: TorqueLike, t0: float) -> _kernel.GimbalModel:
         A, B, C = self.inner_gimbal
         return _kernel.GimbalModel(np.array([[self.transverse_inertia, self.spin_inertia, A, B, C, self.outer_gimbal,
                                               self.imbalance, self.inner_torque, self.outer_torque,
                                               self.outer_friction, self.spin_friction]]))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.GimbalModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q_G, φ̇, θ̇, ω₃, ψ = 0]`` (N, 8) with ``q_G`` the z-x-z rotation (0, θ₀, 0)."""
         spin = values["spin"][:, 0]
         if not np.all(np.isfinite(spin) & (spin != 0.0)):
@@ -177,7 +178,7 @@ class GimbaledGyro(Model):
         y0[:, 4], y0[:, 5], y0[:, 6] = values["phi_dot0"][:, 0], values["theta_dot0"][:, 0], spin
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.GimbalModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         R = attitude.to_matrix(states[..., :4])
         phi = np.unwrap(np.arctan2(R[..., 1, 0], R[..., 0, 0]), axis=0)
         theta = np.arctan2(R[..., 2, 1], R[..., 2, 2])

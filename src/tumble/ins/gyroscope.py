@@ -55,7 +55,7 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from typing import cast
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -66,6 +66,9 @@ from tumble.analytic import AxisMotion, HeavyTop, axis_motion
 from tumble.rigid import RigidBodies
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from tumble.kernels.rigid import RigidModel
 
 __all__ = ["Gyroscope"]
 
@@ -190,11 +193,11 @@ class Gyroscope(Model):
                            "rad/s (0: released at rest; gyro.steady_precession_rate: steady precession)",
                            default=0.0),)
 
-    def compile(self, torque, t0: float):
+    def compile(self, torque: torques.TorqueLike, t0: float) -> RigidModel:
         extra = torques.as_torque_model(torque)
         return self._rotor().compile(self.torque_model() if extra is None else extra + self.torque_model(), t0)
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """The rotor at φ = 0, θ = ``tilt``, ψ = 0 with body rate ``(0, φ̇₀ sin θ, ω_s)`` (θ̇ = 0)."""
         phi_dot0 = values["precession_rate0"][:, 0]
         omega0 = np.stack([np.zeros_like(phi_dot0), phi_dot0 * math.sin(self.tilt), np.full_like(phi_dot0, self.spin)],
@@ -202,7 +205,7 @@ class Gyroscope(Model):
         q0 = np.broadcast_to(attitude.from_euler("ZXZ", [0.0, self.tilt, 0.0]), (phi_dot0.size, 4))
         return self._rotor().initial_states(kernel, {"omega0": omega0, "q0": q0}, t0)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         out = self._rotor().outputs(kernel, t, states)
         height = attitude.rotate(cast(np.ndarray, out.q), [0.0, 0.0, 1.0])[..., 2]   # cos θ
         energy = dynamics.kinetic_energy(cast(np.ndarray, out.inertia), cast(np.ndarray, out.omega)) + self.imbalance_torque * height

@@ -286,7 +286,7 @@ class Spacecraft(Model):
         return _thrusters.program(torques_, axis.astype(float), sign, gain=p.gain, time_constant=p.time_constant,
                                   on=p.on, off=p.off, min_on_time=p.min_on_time, axis_torque=scale)
 
-    def compile(self, torque, t0: float) -> _kernel.SpacecraftModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.SpacecraftModel:
         """The compiled model (:class:`tumble.kernels.spacecraft.SpacecraftModel`) under the external ``torque``
         (a :mod:`tumble.torques` model, a callable ``f(t, q, omega)`` or None), control clock at ``t0`` (s)."""
         law = self._torque_law()
@@ -338,12 +338,12 @@ class Spacecraft(Model):
                                   f"land on the sample times; t[{k + 1}] − t[{k}] = {t[k + 1] - t[k]} s is "
                                   f"{steps[k]:.6g} steps of {dt} s")
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: Any, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         n = values["omega0"].shape[0]
         y0 = np.zeros((n, kernel.size))
         y0[:, :4] = values["q0"]
         y0[:, 4:7] = values["omega0"]
-        where = functools.partial(_kernel.slices, kernel)
+        where: Callable[[str], Any] = functools.partial(_kernel.slices, kernel)  # each part asked for is there
         if self.wheels:
             w = where("wheels")
             axes = np.array([x.axis for x in self.wheels])
@@ -363,7 +363,7 @@ class Spacecraft(Model):
             _kernel.initialise(kernel, float(t0), y)
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: Any, t: np.ndarray, states: np.ndarray) -> Outputs:
         n_t, n_b, _ = states.shape
         aux = np.empty((n_b, n_t, kernel.aux_size))
         for b in range(n_b):

@@ -155,7 +155,7 @@ class Plan:
         parameters = {name: v for name, v in inputs.items() if name not in self.states}
         run = dict(t=self.t, method=self.method, torque=self.torque, **self.options)
         if not _is_builder(self.model):
-            model = self.model
+            model: Any = self.model  # not a builder: anything tumble.simulate takes as a model
             if "inertia" in parameters:
                 model = RigidBodies.of(parameters["inertia"])
             elif not any(np.ndim(v) == 2 for v in state.values()):

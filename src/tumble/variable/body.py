@@ -204,17 +204,17 @@ class VariableBody(Model):
         """Refuse output times outside :attr:`t_span` (the splines are not extrapolated)."""
         self.check_times(t)
 
-    def compile(self, torque, t0: float) -> _kernel.VariableModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.VariableModel:
         """The compiled model (:class:`tumble.kernels.variable.VariableModel`) under an external torque (B axes)."""
         return _kernel.build(self, torques.as_torque_model(torque))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.VariableModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q, L_N, t₀]`` (N, 8), ``L_N = R(q₀) (I(t₀) ω₀ + A(t₀))``: the state of :mod:`tumble.kernels.variable`."""
         q0 = values["q0"]
         momentum = dynamics.angular_momentum(self.inertia(t0), values["omega0"]) + self.shape_momentum(t0)
         return np.concatenate([q0, attitude.rotate(q0, momentum), np.full((q0.shape[0], 1), t0)], axis=1)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.VariableModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         q = states[..., :4]
         momentum_body = attitude.rotate_inverse(q, states[..., 4:7])              # (n, N, 3)
         inertia_t = np.broadcast_to(self.inertia(t)[:, None], momentum_body.shape + (3,))

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -50,6 +50,9 @@ from tumble.body import Part, RigidBody
 from tumble.simulate import Outputs
 from tumble.trajectory import Extra
 from tumble.variable.body import VariableBody
+
+if TYPE_CHECKING:
+    from tumble.kernels.variable import VariableModel
 
 __all__ = ["DE_LEVA_MALE", "Human", "Kinematics", "Motion", "MovingHuman", "Segment"]
 
@@ -332,7 +335,7 @@ class MovingHuman(VariableBody):
         """The joint angles, name → object with ``angle(t)`` and ``rate(t)`` (rad, rad/s)."""
         return dict(self._angles)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: VariableModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         out = super().outputs(kernel, t, states)
         lead = states.shape[:2]
         joints = np.stack([self._angles[name].angle(t) for name in self._human.dofs], axis=-1)
