@@ -76,7 +76,7 @@ class AxisymmetricBody(Model):
     axes: np.ndarray  # (3, 3) R_BP, the symmetry axis third
     q_bp: np.ndarray  # (4,) its quaternion
 
-    def __init__(self, body: RigidBody, *, frame_spin: float = 0.0):
+    def __init__(self, body: RigidBody, *, frame_spin: float = 0.0) -> None:
         if not isinstance(body, RigidBody):
             raise ValidationError(f"body: must be a tumble.RigidBody, got {type(body).__name__}")
         kind = body.symmetry(rtol=AXISYMMETRY_RTOL)

@@ -22,9 +22,11 @@ from __future__ import annotations
 
 import abc
 from collections.abc import Sequence
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from tumble import attitude, limits, torques
 from tumble._inertia import principal_axes
@@ -32,6 +34,9 @@ from tumble._quat import qmul
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import rigid as _kernel
 from tumble.simulate import Model, Outputs, StateField
+
+if TYPE_CHECKING:
+    from tumble.body import RigidBody
 
 __all__ = ["RigidMotion", "RigidBodies"]
 
@@ -119,19 +124,20 @@ class RigidBodies(RigidMotion):
 
     __slots__ = ("inertia", "moments", "axes", "q_bp", "masses")
 
-    def __init__(self, inertia, moments, axes, masses):
+    def __init__(self, inertia: np.ndarray, moments: np.ndarray, axes: np.ndarray, masses: np.ndarray | None) -> None:
         self.inertia, self.moments, self.axes, self.masses = inertia, moments, axes, masses
         self.q_bp = attitude.from_matrix(axes)
 
     @classmethod
-    def of(cls, bodies) -> RigidBodies:
+    def of(cls, bodies: Sequence[RigidBody] | ArrayLike) -> RigidBodies:
         """The batch of ``bodies``: a sequence of RigidBody, or an inertia array (3, 3) or (N, 3, 3)."""
         from tumble.body import RigidBody  # the rigid body's class builds on this module
 
         if isinstance(bodies, Sequence) and bodies and all(isinstance(b, RigidBody) for b in bodies):
-            masses = [b.mass for b in bodies]
-            return cls(np.stack([b.inertia for b in bodies]), np.stack([b.moments for b in bodies]),
-                       np.stack([b.axes for b in bodies]), None if None in masses else np.array(masses))
+            rigid = cast("Sequence[RigidBody]", bodies)
+            masses = [b.mass for b in rigid]
+            return cls(np.stack([b.inertia for b in rigid]), np.stack([b.moments for b in rigid]),
+                       np.stack([b.axes for b in rigid]), None if None in masses else np.array(masses))
         try:
             np.asarray(bodies, dtype=np.float64)
         except (TypeError, ValueError):
