@@ -41,7 +41,7 @@ import signal
 import stat
 import tempfile
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
@@ -307,7 +307,7 @@ class Trajectory:
         return Trajectory(self.t, pick(self.q), pick(self.omega), inertia, self.method, self.info, extras, totals,
                           self.model)
 
-    def at(self, index) -> Trajectory:
+    def at(self, index: int | slice | Sequence[int] | np.ndarray) -> Trajectory:
         """The trajectory at the output samples ``index`` only: a slice or integer indices along time, kept
         in order (an int gives one sample, ``at(-1)`` the last); every sampled array, extra and total is
         cut the same way, the inertia and ``info`` are kept."""
@@ -524,7 +524,7 @@ class Trajectory:
 
     # -- viewer ------------------------------------------------------------------------
 
-    def to_html(self, path: str | os.PathLike, **options) -> None:
+    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
         """Write the offline 3-D viewer of this trajectory to ``path``: one self-contained HTML file, atomically.
 
         ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``) and what the page shows:
