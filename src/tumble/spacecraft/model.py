@@ -492,7 +492,7 @@ def _check_items(values, cls, name):
             raise ValidationError(f"{name}[{i}]: must be a {cls.__name__}, got {type(value).__name__}")
 
 
-def simulate(spacecraft: Spacecraft, omega0, *, t, q0=None, wheel_speeds0=None, gimbal_angles0=None,
+def simulate(spacecraft: Spacecraft, omega0: ArrayLike, *, t: ArrayLike, q0: ArrayLike | None = None, wheel_speeds0: ArrayLike | None = None, gimbal_angles0: ArrayLike | None = None,
              method: str = "rk4", dt: float | None = None, rtol: float | None = None, atol: float | None = None,
              max_steps: int | None = None, progress: Callable[[int, int], None] | None = None) -> Trajectory:
     """Deprecated: ``tumble.simulate(spacecraft, omega0, t=..., method="rk4", dt=..., ...)`` (the same run)."""
@@ -500,7 +500,7 @@ def simulate(spacecraft: Spacecraft, omega0, *, t, q0=None, wheel_speeds0=None, 
                   "method='rk4', dt=..., ...)", DeprecationWarning, stacklevel=2)
     if not isinstance(spacecraft, Spacecraft):
         raise ValidationError(f"spacecraft: must be a Spacecraft, got {type(spacecraft).__name__}")
-    initial = {name: value for name, value in (("q0", q0), ("wheel_speeds0", wheel_speeds0),
+    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("wheel_speeds0", wheel_speeds0),
                                                 ("gimbal_angles0", gimbal_angles0)) if value is not None}
     return _simulate(spacecraft, omega0, t=t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
                      progress=progress, **initial)
