@@ -49,6 +49,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import tumble
 from tumble import attitude
@@ -135,7 +136,7 @@ class GimbaledGyro(Model):
         """Steady precession of a horizontal spin axis, ``(τ_θ + m g l) / (I_s ω₃)`` (rad/s, about +z)."""
         return (self.inner_torque + self.imbalance) / (self.spin_inertia * spin)
 
-    def energy(self, theta, phi_dot, theta_dot, spin) -> np.ndarray:
+    def energy(self, theta: float | np.ndarray, phi_dot: float | np.ndarray, theta_dot: float | np.ndarray, spin: float | np.ndarray) -> np.ndarray:
         """``E = ½ P θ̇² + ½ Q(θ) φ̇² + ½ I_s ω₃² + m g l cos θ`` (J) of rotor and gimbals, broadcast."""
         A, B, C = self.inner_gimbal
         s, c = np.sin(theta), np.cos(theta)
@@ -143,7 +144,7 @@ class GimbaledGyro(Model):
         return (0.5 * (A + self.transverse_inertia) * theta_dot**2 + 0.5 * Q * phi_dot**2
                 + 0.5 * self.spin_inertia * spin**2 + self.imbalance * c)
 
-    def vertical_momentum(self, theta, phi_dot, spin) -> np.ndarray:
+    def vertical_momentum(self, theta: float | np.ndarray, phi_dot: float | np.ndarray, spin: float | np.ndarray) -> np.ndarray:
         """``p_φ = Q(θ) φ̇ + I_s ω₃ cos θ`` (N·m·s): the vertical angular momentum of rotor and gimbals, broadcast."""
         _, B, C = self.inner_gimbal
         s, c = np.sin(theta), np.cos(theta)
@@ -200,8 +201,8 @@ class GimbaledGyro(Model):
                 kept["energy"] = traj.energy
         return kept
 
-    def simulate(self, t, *, spin: float, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
-                 dt: float | None = None, **initial_state) -> Trajectory:
+    def simulate(self, t: ArrayLike, *, spin: float, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
+                 dt: float | None = None, **initial_state: Any) -> Trajectory:
         """Deprecated: ``tumble.simulate(gyro, t=t, spin=spin, method=..., ...)``, which it calls."""
         warnings.warn("GimbaledGyro.simulate is deprecated: call tumble.simulate(gyro, t=..., spin=..., ...)",
                       DeprecationWarning, stacklevel=2)

@@ -58,6 +58,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import tumble
 from tumble import attitude, dynamics, torques
@@ -218,7 +219,7 @@ class Gyroscope(Model):
         return {"energy": traj.energy, "momentum_vertical": traj.momentum_inertial[..., 2],
                 "momentum_axial": traj.momentum_body[..., 2]}
 
-    def simulate(self, t, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
+    def simulate(self, t: ArrayLike, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
         """Deprecated: ``tumble.simulate(gyro, t=t, precession_rate0=..., rtol=rtol, atol=atol)``, which it calls
         (``released=False``: ``precession_rate0=gyro.steady_precession_rate``)."""
         warnings.warn("Gyroscope.simulate is deprecated: call tumble.simulate(gyro, t=..., precession_rate0=...) "
