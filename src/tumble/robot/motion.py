@@ -46,6 +46,7 @@ from tumble.trajectory import Extra
 
 if TYPE_CHECKING:
     from tumble.robot.tree import RobotTree
+    from tumble.trajectory import Trajectory
 
 __all__ = ["ChainMotion"]
 
@@ -212,7 +213,7 @@ class ChainMotion(Model):
             "linear_momentum": Extra(h[..., 3:6], vector, "N s", "total linear momentum, world axes"),
         }
 
-    def invariants(self, traj) -> dict[str, np.ndarray]:
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """``E − W``, J (n, [N]): the energy ``T + V`` less the work of the joint torques, ``E(0)`` along the
         exact motion under any torque law (gravity is conservative, the joints frictionless)."""
         return {"energy_minus_work": traj.energy - traj.work}
