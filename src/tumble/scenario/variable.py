@@ -24,9 +24,10 @@ The body takes no external torque.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import ClassVar, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 from pydantic import model_validator
 
 from tumble.scenario._base import Scenario
@@ -59,7 +60,7 @@ class VariableTable(_InertiaOrMoments):
         return self
 
     def build(self) -> VariableBody:
-        inertia = self.inertia if self.moments is None else [np.diag(m) for m in self.moments]
+        inertia = cast(ArrayLike, self.inertia if self.moments is None else [np.diag(m) for m in self.moments])  # one given
         return VariableBody(self.times, inertia, self.shape_momentum, check_triangle=self.check_triangle)
 
 
