@@ -47,6 +47,9 @@ from tumble.variable import Human, Motion
 from tumble.variable.demo import figure_dive
 from tumble.variable.diver import Dive, orientation_angles
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 __all__ = ["HumanScenario"]
 
 # figure_dive draws the poses seen along inertial x, the somersault axis of tumble.variable.diver: it is
@@ -127,7 +130,7 @@ class HumanScenario(Scenario):
             return Run(model, initial, self.time.times(), self.solver.method, self.solver.options(), keys=keys,
                        source=self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:func:`tumble.variable.demo.figure_dive` (poses seen along ``L``, somersault and twist, tilt, arms,
         energy) when the angular momentum lies along inertial x, the somersault axis of
         :mod:`tumble.variable.diver`; else :meth:`tumble.Trajectory.plot`."""

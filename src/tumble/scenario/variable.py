@@ -24,7 +24,7 @@ The body takes no external torque.
 
 from __future__ import annotations
 
-from typing import ClassVar, cast
+from typing import TYPE_CHECKING, ClassVar, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -37,6 +37,9 @@ from tumble.scenario._values import _Bool, _InertiaOrMoments, _Matrix, _Number, 
 from tumble.scenario.tables import Initial, Solver, Time
 from tumble.trajectory import Trajectory
 from tumble.variable import VariableBody
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["VariableScenario", "rate_and_energy_rows"]
 
@@ -83,7 +86,7 @@ class VariableScenario(Scenario):
             return Run(model, initial, self.time.times(), self.solver.method, self.solver.options(), keys=keys,
                        source=self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:meth:`tumble.Trajectory.plot` of the run, titled with the scenario's name."""
         return traj.plot(title=self.name)
 
