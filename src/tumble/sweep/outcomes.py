@@ -24,6 +24,7 @@ Angles are in rad, times in s.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import cast
 
@@ -37,7 +38,7 @@ __all__ = ["PointingError", "NutationAngle", "Component", "Max", "Final", "Settl
            "describe"]
 
 
-def describe(function) -> str:
+def describe(function: Callable[[Trajectory], np.ndarray]) -> str:
     """How a sweep's store records an outcome or series: its repr for the built-in ones (their parameters),
     ``module:qualname`` for a Python function."""
     if isinstance(function, (PointingError, NutationAngle, Component, Max, Final, SettlingTime, CrossingTime)):
