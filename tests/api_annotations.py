@@ -20,8 +20,8 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src"
 
 
-def _module_name(path: Path) -> str:
-    parts = list(path.relative_to(SRC).with_suffix("").parts)
+def _module_name(path: Path, src: Path) -> str:
+    parts = list(path.relative_to(src).with_suffix("").parts)
     if parts[-1] == "__init__":
         parts.pop()
     return ".".join(parts)
@@ -84,7 +84,7 @@ def public_functions(src: Path = SRC) -> dict[str, list[str]]:
     """Every public function of the package, with what its annotations lack (an empty list: complete)."""
     found: dict[str, list[str]] = {}
     for path in sorted((src / "tumble").rglob("*.py")):
-        module = _module_name(path)
+        module = _module_name(path, src)
         if not _is_public_module(module):
             continue
         tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
