@@ -121,7 +121,8 @@ class RigidBody(RigidMotion):
     _name: str | None
     _q_bp: np.ndarray | None
 
-    def __init__(self, inertia: ArrayLike, *, mass: float | None = None, com: ArrayLike | None = None, check_triangle: bool = True, name: str | None = None) -> None:
+    def __init__(self, inertia: ArrayLike, *, mass: float | None = None, com: ArrayLike | None = None,
+                 check_triangle: bool = True, name: str | None = None) -> None:
         inertia, moments, axes = check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)
         set_ = object.__setattr__
         set_(self, "_inertia", frozen(inertia))
@@ -241,7 +242,8 @@ class RigidBody(RigidMotion):
         return Part(mass=self._mass, com=com, inertia=self._inertia).placed(position, rotation=rotation)
 
     @classmethod
-    def composite(cls, parts: Iterable[Part | RigidBody], *, check_triangle: bool = True, name: str | None = None) -> RigidBody:
+    def composite(cls, parts: Iterable[Part | RigidBody], *, check_triangle: bool = True,
+                  name: str | None = None) -> RigidBody:
         """Rigid union of parts (:class:`Part`, or a body placed at the origin).
 
         ``m = Σ mₖ``; ``c = Σ mₖ cₖ / m``;
@@ -292,7 +294,8 @@ class RigidBody(RigidMotion):
         return cls(inertia, mass=m, com=np.zeros(3))
 
     @classmethod
-    def hollow_cylinder(cls, *, mass: float, inner_radius: float, outer_radius: float, length: float, axis: str = "z") -> RigidBody:
+    def hollow_cylinder(cls, *, mass: float, inner_radius: float, outer_radius: float, length: float,
+                        axis: str = "z") -> RigidBody:
         """Thick-walled uniform tube centred on the origin, its axis along ``axis``.
 
         Axial ``m (r₁² + r₂²)/2``; transverse ``m (3 (r₁² + r₂²) + L²)/12``.

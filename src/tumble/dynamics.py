@@ -103,7 +103,8 @@ def euler_coefficients(i1: Real, i2: Real, i3: Real) -> tuple[Real, Real, Real, 
 
 
 @njit(cache=True)
-def euler_principal(c1: float, c2: float, c3: float, r1: float, r2: float, r3: float, w1: float, w2: float, w3: float, t1: float, t2: float, t3: float) -> tuple[float, float, float]:
+def euler_principal(c1: float, c2: float, c3: float, r1: float, r2: float, r3: float, w1: float, w2: float, w3: float,
+                    t1: float, t2: float, t3: float) -> tuple[float, float, float]:
     """Principal-axes Euler equations for one body: returns ``(ω̇₁, ω̇₂, ω̇₃)`` (rad/s²).
 
     ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic, with ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``
@@ -118,7 +119,9 @@ def euler_principal(c1: float, c2: float, c3: float, r1: float, r2: float, r3: f
 
 
 @register_jitable
-def rigid_rates(c1: float, c2: float, c3: float, r1: float, r2: float, r3: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float, t1: float, t2: float, t3: float) -> tuple[float, float, float, float, float, float, float]:
+def rigid_rates(c1: float, c2: float, c3: float, r1: float, r2: float, r3: float, qw: float, qx: float, qy: float,
+                qz: float, w1: float, w2: float, w3: float, t1: float, t2: float,
+                t3: float) -> tuple[float, float, float, float, float, float, float]:
     """``dy/dt`` of one rigid body from its state ``(q, ω)`` and torque ``τ`` (N·m, principal axes):
     ``(½ q ⊗ [0, ω], ω̇)`` with ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic (:func:`euler_principal`,
     coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``).
@@ -165,7 +168,8 @@ def omega_dot_principal(moments: ArrayLike, omega: ArrayLike, torque: ArrayLike 
 
 
 @register_jitable
-def euler_frame(ratio: Real, r_t: Real, r_s: Real, w1: Real, w2: Real, w3: Real, frame3: Real, n1: Real, n2: Real, n3: Real) -> tuple[Real, Real, Real]:
+def euler_frame(ratio: Real, r_t: Real, r_s: Real, w1: Real, w2: Real, w3: Real, frame3: Real, n1: Real, n2: Real,
+                n3: Real) -> tuple[Real, Real, Real]:
     """Euler's equations of an axisymmetric body in a principal frame F turning at ``(ω₁, ω₂, Ω₃)``.
 
     The body rate is ``ω = ω₁e₁ + ω₂e₂ + ω₃e₃`` and the frame's rate
@@ -197,7 +201,8 @@ def euler_frame(ratio: Real, r_t: Real, r_s: Real, w1: Real, w2: Real, w3: Real,
     return n1 * r_t - gyro * w2, n2 * r_t + gyro * w1, n3 * r_s
 
 
-def omega_dot_frame(moments: ArrayLike, omega: ArrayLike, frame_rate: ArrayLike, torque: ArrayLike | None = None) -> np.ndarray:
+def omega_dot_frame(moments: ArrayLike, omega: ArrayLike, frame_rate: ArrayLike,
+                    torque: ArrayLike | None = None) -> np.ndarray:
     """Rates of change of the body-rate components in a principal frame F of an axisymmetric body (rad/s²).
 
     ``moments`` (…, 2) are ``(I_t, I_s)``: the transverse and the axial

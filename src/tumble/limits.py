@@ -90,7 +90,8 @@ def relativistic_corrections(moments: ArrayLike, omega: ArrayLike, mass: ArrayLi
     return {"speed": beta, "energy": energy, "momentum": excess}
 
 
-def check_rigid_motion(moments: ArrayLike, omega: ArrayLike, mass: ArrayLike | None = None, *, stacklevel: int = 2) -> None:
+def check_rigid_motion(moments: ArrayLike, omega: ArrayLike, mass: ArrayLike | None = None, *,
+                       stacklevel: int = 2) -> None:
     """Warn (:class:`RigidityWarning`) where rigid bodies in the states ``omega`` leave the model's domain.
 
     moments : (..., 3) principal moments, kg·m² (ascending, as ``RigidBody.moments``)

@@ -396,7 +396,8 @@ def _tabulated(t, P, row, o):
 
 
 @register_jitable
-def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float, P: np.ndarray, row: int, codes: np.ndarray) -> tuple[float, float, float]:
+def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float,
+                      P: np.ndarray, row: int, codes: np.ndarray) -> tuple[float, float, float]:
     """The compiled terms of the torque program in row ``row`` of ``P`` (all but Python callbacks):
     the torque (N·m) in the axes it was compiled for.
 
@@ -445,7 +446,8 @@ def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: 
 
 
 @njit(cache=True)
-def evaluate(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float, P: np.ndarray, row: int, codes: np.ndarray) -> tuple[float, float, float]:
+def evaluate(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float, P: np.ndarray,
+             row: int, codes: np.ndarray) -> tuple[float, float, float]:
     """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
 
     The compiled terms (:func:`evaluate_compiled`), then the Python callbacks.

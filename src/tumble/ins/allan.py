@@ -79,7 +79,8 @@ class AllanDeviation:
         return np.exp(np.mean(np.log(self.sigma[keep]) - 0.5 * np.log(tau / 3.0), axis=0))
 
 
-def allan_deviation(samples: ArrayLike, dt: float, *, kind: str = "rate", m: ArrayLike | None = None, per_decade: int = 10) -> AllanDeviation:
+def allan_deviation(samples: ArrayLike, dt: float, *, kind: str = "rate", m: ArrayLike | None = None,
+                    per_decade: int = 10) -> AllanDeviation:
     """Overlapping Allan deviation of a record of rates or of angle increments.
 
     Parameters

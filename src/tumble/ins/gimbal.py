@@ -136,7 +136,8 @@ class GimbaledGyro(Model):
         """Steady precession of a horizontal spin axis, ``(τ_θ + m g l) / (I_s ω₃)`` (rad/s, about +z)."""
         return (self.inner_torque + self.imbalance) / (self.spin_inertia * spin)
 
-    def energy(self, theta: float | np.ndarray, phi_dot: float | np.ndarray, theta_dot: float | np.ndarray, spin: float | np.ndarray) -> np.ndarray:
+    def energy(self, theta: float | np.ndarray, phi_dot: float | np.ndarray, theta_dot: float | np.ndarray,
+               spin: float | np.ndarray) -> np.ndarray:
         """``E = ½ P θ̇² + ½ Q(θ) φ̇² + ½ I_s ω₃² + m g l cos θ`` (J) of rotor and gimbals, broadcast."""
         A, B, C = self.inner_gimbal
         s, c = np.sin(theta), np.cos(theta)
@@ -144,7 +145,8 @@ class GimbaledGyro(Model):
         return (0.5 * (A + self.transverse_inertia) * theta_dot**2 + 0.5 * Q * phi_dot**2
                 + 0.5 * self.spin_inertia * spin**2 + self.imbalance * c)
 
-    def vertical_momentum(self, theta: float | np.ndarray, phi_dot: float | np.ndarray, spin: float | np.ndarray) -> np.ndarray:
+    def vertical_momentum(self, theta: float | np.ndarray, phi_dot: float | np.ndarray,
+                          spin: float | np.ndarray) -> np.ndarray:
         """``p_φ = Q(θ) φ̇ + I_s ω₃ cos θ`` (N·m·s): the vertical angular momentum of rotor and gimbals, broadcast."""
         _, B, C = self.inner_gimbal
         s, c = np.sin(theta), np.cos(theta)

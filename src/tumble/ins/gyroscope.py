@@ -209,7 +209,8 @@ class Gyroscope(Model):
     def outputs(self, kernel: RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         out = self._rotor().outputs(kernel, t, states)
         height = attitude.rotate(cast(np.ndarray, out.q), [0.0, 0.0, 1.0])[..., 2]   # cos θ
-        energy = dynamics.kinetic_energy(cast(np.ndarray, out.inertia), cast(np.ndarray, out.omega)) + self.imbalance_torque * height
+        energy = (dynamics.kinetic_energy(cast(np.ndarray, out.inertia), cast(np.ndarray, out.omega))
+                  + self.imbalance_torque * height)
         return out._replace(totals={"energy": energy})
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:

@@ -144,7 +144,8 @@ class Imu:
     gyro: SensorErrors = field(default_factory=SensorErrors)
     accel: SensorErrors = field(default_factory=SensorErrors)
 
-    def measure(self, truth: Increments, *, seed: int | np.random.SeedSequence | np.random.Generator | None = None) -> Increments:
+    def measure(self, truth: Increments, *,
+                seed: int | np.random.SeedSequence | np.random.Generator | None = None) -> Increments:
         """Measured increments from true ones; gyro draws first, then accelerometer draws.
 
         ``seed`` (int, SeedSequence or Generator) seeds ``numpy.random.default_rng``:
@@ -157,7 +158,8 @@ class Imu:
         delta_v = None if truth.delta_v is None else self.accel.apply(truth.delta_v, truth.dt, rng)
         return Increments(t0=truth.t0, dt=truth.dt, delta_theta=delta_theta, delta_v=delta_v)
 
-    def sample(self, trajectory: Trajectory, *, oversample: int = 2, specific_force: ArrayLike | None = None, lever_arm: ArrayLike | None = None,
+    def sample(self, trajectory: Trajectory, *, oversample: int = 2, specific_force: ArrayLike | None = None,
+               lever_arm: ArrayLike | None = None,
                seed: int | np.random.SeedSequence | np.random.Generator | None = None) -> Increments:
         """Measure a true motion: :func:`~tumble.ins.increments.from_trajectory`, then :meth:`measure`.
 

@@ -102,8 +102,9 @@ class Navigation:
     algorithm: str
 
 
-def strapdown(increments: Increments, *, q0: ArrayLike | None = None, algorithm: str = "three-sample", v0: ArrayLike = (0.0, 0.0, 0.0),
-              g: ArrayLike = (0.0, 0.0, 0.0), sculling: bool = True, inertia: ArrayLike | None = None) -> Navigation:
+def strapdown(increments: Increments, *, q0: ArrayLike | None = None, algorithm: str = "three-sample",
+              v0: ArrayLike = (0.0, 0.0, 0.0), g: ArrayLike = (0.0, 0.0, 0.0), sculling: bool = True,
+              inertia: ArrayLike | None = None) -> Navigation:
     """Integrate gyro (and accelerometer) increments into attitude (and velocity).
 
     Parameters

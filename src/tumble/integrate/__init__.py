@@ -214,7 +214,8 @@ class Solution:
         return {"n_steps": self.n_steps, "n_rejected": self.n_rejected, "n_rhs": self.n_rhs}
 
 
-def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float | None = None, rtol: float | None = None, atol: float | None = None, max_steps: int = MAX_STEPS, progress: Callable[[int, int], None] | None = None,
+def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float | None = None, rtol: float | None = None,
+          atol: float | None = None, max_steps: int = MAX_STEPS, progress: Callable[[int, int], None] | None = None,
           device: str = "cpu") -> Solution:
     """Integrate the compiled ``model`` (:mod:`tumble._protocol`) for a batch of states ``y0`` (N, n) through ``t``.
 

@@ -61,8 +61,10 @@ __all__ = [
 ]
 
 
-def simulate(chain: RobotTree, q0: ArrayLike, qd0: ArrayLike, *, t: ArrayLike, torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None = None, method: str = "rk4", dt: float | None = None, rtol: float = 1e-10, atol: float = 1e-12, gravity: ArrayLike | None = None,
-             max_steps: int | None = None) -> Trajectory:
+def simulate(chain: RobotTree, q0: ArrayLike, qd0: ArrayLike, *, t: ArrayLike,
+             torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None = None,
+             method: str = "rk4", dt: float | None = None, rtol: float = 1e-10, atol: float = 1e-12,
+             gravity: ArrayLike | None = None, max_steps: int | None = None) -> Trajectory:
     """Deprecated: use ``tumble.simulate(chain, q0=q0, qd0=qd0, t=t, ...)``, which this forwards to.
 
     ``gravity`` (m/s², base frame) runs ``chain.with_gravity(gravity)``; of

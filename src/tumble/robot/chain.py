@@ -144,7 +144,8 @@ class SerialChain(RobotTree):
 
     @classmethod
     def from_urdf(  # type: ignore[override]  # a chain has no floating base and no mimic joints to ask for
-            cls, source: str | os.PathLike[str], *, check_triangle: bool = True, gravity: ArrayLike = DEFAULT_GRAVITY) -> SerialChain:
+            cls, source: str | os.PathLike[str], *, check_triangle: bool = True,
+            gravity: ArrayLike = DEFAULT_GRAVITY) -> SerialChain:
         """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         Refused when the URDF describes a tree or has mimic joints (use :meth:`RobotTree.from_urdf`)."""

@@ -160,7 +160,8 @@ def _loads(model: RobotTree, q: np.ndarray, gravity: ArrayLike | None, f_ext: Ar
     return g, _wrench(model, f_ext, q)
 
 
-def rnea(model: RobotTree, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, gravity: ArrayLike | None = None, f_ext: ArrayLike | None = None) -> np.ndarray:
+def rnea(model: RobotTree, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, gravity: ArrayLike | None = None,
+         f_ext: ArrayLike | None = None) -> np.ndarray:
     """Inverse dynamics ``τ = M(q) q̈ + C(q, q̇) q̇ + g(q) − J(q)ᵀ w_ext`` (recursive Newton–Euler).
 
     ``q`` (rad or m), ``qd`` (rad/s or m/s), ``qdd`` (rad/s² or m/s²) of shape
@@ -221,7 +222,8 @@ def mass_matrix(model: RobotTree, q: ArrayLike) -> np.ndarray:
     return M
 
 
-def forward_dynamics(model: RobotTree, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, *, gravity: ArrayLike | None = None, f_ext: ArrayLike | None = None) -> np.ndarray:
+def forward_dynamics(model: RobotTree, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, *, gravity: ArrayLike | None = None,
+                     f_ext: ArrayLike | None = None) -> np.ndarray:
     """Forward dynamics ``q̈ = M(q)⁻¹ (τ + J(q)ᵀ w_ext − C(q, q̇) q̇ − g(q))``, articulated-body algorithm.
 
     O(n) in the number of joints: Featherstone (2008) Table 7.1. Shapes and

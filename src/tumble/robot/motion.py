@@ -134,7 +134,8 @@ class ChainMotion(Model):
                                             "(default 0)", default=np.zeros(3)),
         )
 
-    def compile(self, torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None, t0: float) -> _kernel.RobotModel:
+    def compile(self, torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None,
+                t0: float) -> _kernel.RobotModel:
         law, slot, constant = self._torque_law(torque)
         return _kernel.RobotModel(params=self._params, sizes=np.array([self.nq, self.nv], dtype=np.int64),
                                   gravity=self._gravity, law=np.array([law, slot], dtype=np.int64),

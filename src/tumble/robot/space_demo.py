@@ -55,7 +55,8 @@ def space_arm() -> RobotTree:
     """The hub and arm of the module's constants as one floating-base :class:`~tumble.robot.RobotTree`."""
     links = [Link(joint="revolute", axis=np.array((0.0, 0.0, 1.0)),
                   origin_position=np.array((0.0 if k == 0 else ARM[k - 1]["length"], 0.0, 0.0)),
-                  mass=a["mass"], com=np.array((a["com"], 0.0, 0.0)), inertia=np.diag([0.01, a["inertia"], a["inertia"]]),
+                  mass=a["mass"], com=np.array((a["com"], 0.0, 0.0)),
+                  inertia=np.diag([0.01, a["inertia"], a["inertia"]]),
                   name=("shoulder", "elbow")[k]) for k, a in enumerate(ARM)]
     hub = RigidBody(HUB["inertia"], mass=HUB["mass"])
     return space_manipulator(hub, SerialChain(links), mount_position=MOUNT, name="two-link arm on a free hub")

@@ -127,8 +127,8 @@ class RobotTree(ChainMotion):
         set_(self, "_workspace", _kernels.workspace(len(links), nv))
 
     @classmethod
-    def from_urdf(cls, source: str | os.PathLike[str], *, floating_base: bool = False, mimic: bool = True, check_triangle: bool = True,
-                  gravity: ArrayLike = DEFAULT_GRAVITY) -> RobotTree:
+    def from_urdf(cls, source: str | os.PathLike[str], *, floating_base: bool = False, mimic: bool = True,
+                  check_triangle: bool = True, gravity: ArrayLike = DEFAULT_GRAVITY) -> RobotTree:
         """A tree from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         ``floating_base=True`` makes the root link a free body (configuration ``[r, quat, joints]``);

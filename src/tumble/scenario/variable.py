@@ -63,7 +63,8 @@ class VariableTable(_InertiaOrMoments):
         return self
 
     def build(self) -> VariableBody:
-        inertia = cast(ArrayLike, self.inertia if self.moments is None else [np.diag(m) for m in self.moments])  # one given
+        # exactly one is given
+        inertia = cast(ArrayLike, self.inertia if self.moments is None else [np.diag(m) for m in self.moments])
         return VariableBody(self.times, inertia, self.shape_momentum, check_triangle=self.check_triangle)
 
 

@@ -194,7 +194,8 @@ class CMGCluster:
         set_(self, "dither_phases", tuple(float(x) for x in phases))
 
     @classmethod
-    def pyramid(cls, momentum: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options: Any) -> CMGCluster:
+    def pyramid(cls, momentum: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))),
+                **options: Any) -> CMGCluster:
         """The four-CMG pyramid: gimbal axes normal to the faces of a pyramid whose faces are
         inclined by the skew angle ``β`` (degrees from the base plane; default 54.74°,
         ``atan √2``, for a nearly spherical momentum envelope), spin axes in the faces
@@ -307,7 +308,8 @@ class Magnetorquers:
         return _magnetorquers.program(self.max_dipole)
 
 
-def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options: Any) -> list[ReactionWheel]:
+def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))),
+                   **options: Any) -> list[ReactionWheel]:
     """Four identical reaction wheels in a pyramid about the body z axis: wheel ``i`` spins about
     ``(cos β cos ψ_i, cos β sin ψ_i, sin β)``, ``ψ_i = 90° i``, with ``β`` the elevation ``skew``
     (degrees; default 54.74°, equal control authority about the three axes). ``options`` go

@@ -99,9 +99,10 @@ class SphericalDamper:
         return _kernel.program(self.inertia, self.damping)
 
 
-def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0: ArrayLike, *, t: ArrayLike, q0: ArrayLike | None = None, damper_omega0: ArrayLike | None = None,
-                    method: str = "dop853", rtol: float | None = None, atol: float | None = None,
-                    dt: float | None = None, torque: TorqueLike = None, max_steps: int | None = None,
+def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0: ArrayLike, *, t: ArrayLike,
+                    q0: ArrayLike | None = None, damper_omega0: ArrayLike | None = None, method: str = "dop853",
+                    rtol: float | None = None, atol: float | None = None, dt: float | None = None,
+                    torque: TorqueLike = None, max_steps: int | None = None,
                     progress: Callable[[int, int], None] | None = None) -> Trajectory:
     """Deprecated: ``tumble.simulate(Spacecraft(hub=body, damper=damper), omega0, ...)`` (the same run).
 
@@ -114,7 +115,8 @@ def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0: ArrayLike,
 
     if not isinstance(body, RigidBody):
         raise ValidationError(f"body: must be a RigidBody (the hub, without the damper), got {type(body).__name__}")
-    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("damper_omega0", damper_omega0)) if value is not None}
+    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("damper_omega0", damper_omega0))
+                               if value is not None}
     return simulate(Spacecraft(hub=body, damper=damper), omega0, t=t, method=method, rtol=rtol, atol=atol, dt=dt,
                     max_steps=max_steps, torque=torque, progress=progress, **initial)
 

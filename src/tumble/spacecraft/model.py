@@ -492,8 +492,9 @@ def _check_items(values, cls, name):
             raise ValidationError(f"{name}[{i}]: must be a {cls.__name__}, got {type(value).__name__}")
 
 
-def simulate(spacecraft: Spacecraft, omega0: ArrayLike, *, t: ArrayLike, q0: ArrayLike | None = None, wheel_speeds0: ArrayLike | None = None, gimbal_angles0: ArrayLike | None = None,
-             method: str = "rk4", dt: float | None = None, rtol: float | None = None, atol: float | None = None,
+def simulate(spacecraft: Spacecraft, omega0: ArrayLike, *, t: ArrayLike, q0: ArrayLike | None = None,
+             wheel_speeds0: ArrayLike | None = None, gimbal_angles0: ArrayLike | None = None, method: str = "rk4",
+             dt: float | None = None, rtol: float | None = None, atol: float | None = None,
              max_steps: int | None = None, progress: Callable[[int, int], None] | None = None) -> Trajectory:
     """Deprecated: ``tumble.simulate(spacecraft, omega0, t=..., method="rk4", dt=..., ...)`` (the same run)."""
     warnings.warn("tumble.spacecraft.simulate is deprecated: use tumble.simulate(spacecraft, omega0, t=..., "

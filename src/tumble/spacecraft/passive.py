@@ -210,8 +210,8 @@ def gravity_gradient_stability(inertia: RigidBody | ArrayLike) -> GravityGradien
                                     pitch_frequency=pitch_frequency, roll_yaw_frequencies=freqs)
 
 
-def gravity_gradient_stability_figure(spacecraft_inertia: RigidBody | ArrayLike | None = None, *, label: str = "spacecraft",
-                                      resolution: int = 801) -> Figure:
+def gravity_gradient_stability_figure(spacecraft_inertia: RigidBody | ArrayLike | None = None, *,
+                                      label: str = "spacecraft", resolution: int = 801) -> Figure:
     """The gravity-gradient stability regions in the (k_R, k_Y) plane, with a spacecraft placed on it.
 
     Shaded: the Lagrange region (stable, also with dissipation) and the

@@ -186,8 +186,10 @@ def _is_scenario(model) -> bool:
     return isinstance(model, Scenario)
 
 
-def sweep_scenario(scenario: Scenario | str | os.PathLike[str], *, samples: int | None = None, store: str | os.PathLike[str] | None = None, client: Client | None = None, workers: int | None = None,
-                   progress: Callable[[int, int], None] | None = None, retries: int = 2) -> xarray.Dataset:
+def sweep_scenario(scenario: Scenario | str | os.PathLike[str], *, samples: int | None = None,
+                   store: str | os.PathLike[str] | None = None, client: Client | None = None,
+                   workers: int | None = None, progress: Callable[[int, int], None] | None = None,
+                   retries: int = 2) -> xarray.Dataset:
     """:func:`sweep` of a scenario (a :class:`tumble.scenario.Scenario` or the path of its file) as its
     ``[sweep]`` table describes (:mod:`tumble.scenario.sweep`); ``samples`` overrides the table's."""
     from tumble.scenario import load

@@ -241,8 +241,11 @@ def _stack(members: list[Trajectory]) -> Trajectory:
                       method=first.method, info=first.info, extras=extras, totals=totals, model=first.model)
 
 
-def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, samples: int | None, seed: int, chunk: int | None, t: np.ndarray, method: str, options: dict[str, Any], torque: TorqueLike | ArrayLike, outcomes: dict[str, Callable[[Trajectory], np.ndarray]], series: dict[str, Callable[[Trajectory], np.ndarray]],
-              fixed: Mapping[str, ArrayLike], trajectories: bool = False) -> Plan:
+def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, samples: int | None, seed: int,
+              chunk: int | None, t: np.ndarray, method: str, options: dict[str, Any], torque: TorqueLike | ArrayLike,
+              outcomes: dict[str, Callable[[Trajectory], np.ndarray]],
+              series: dict[str, Callable[[Trajectory], np.ndarray]], fixed: Mapping[str, ArrayLike],
+              trajectories: bool = False) -> Plan:
     """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")

@@ -60,7 +60,8 @@ def _chunk_of(model, lo: int, hi: int):
     return RigidBodies(model.inertia[lo:hi], model.moments[lo:hi], model.axes[lo:hi], masses)
 
 
-def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike, store: str | os.PathLike[str], *, t: ArrayLike, initial_state: dict, options: dict, chunk: int | None = None,
+def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike, store: str | os.PathLike[str], *,
+                      t: ArrayLike, initial_state: dict, options: dict, chunk: int | None = None,
                       progress: Callable[[int, int], None] | None = None) -> xarray.Dataset:
     """Run ``simulate(model, t=t, **options, **initial_state)`` in chunks of ``chunk`` members, written to the
     Zarr store ``store`` (a directory that must not exist); return the run as a lazily opened

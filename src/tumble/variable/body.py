@@ -97,7 +97,8 @@ class VariableBody(Model):
 
     __slots__ = ("_t", "_inertia", "_shape_momentum", "_spline")
 
-    def __init__(self, t: ArrayLike, inertia: ArrayLike, shape_momentum: ArrayLike | None = None, *, check_triangle: bool = True) -> None:
+    def __init__(self, t: ArrayLike, inertia: ArrayLike, shape_momentum: ArrayLike | None = None, *,
+                 check_triangle: bool = True) -> None:
         t = increasing_times(t, what="sample times", at_least=4)
         inertia = as_array(inertia, "inertia", tail=(3, 3))
         if inertia.shape != (t.size, 3, 3):

@@ -95,7 +95,8 @@ def orientation_angles(q: ArrayLike, momentum_inertial: ArrayLike) -> Orientatio
     return OrientationAngles(np.unwrap(angles[:, 0]), angles[:, 1], np.unwrap(angles[:, 2]))
 
 
-def twist_rule(tilt: float | np.ndarray, somersault_inertia: float | np.ndarray, long_inertia: float | np.ndarray) -> float | np.ndarray:
+def twist_rule(tilt: float | np.ndarray, somersault_inertia: float | np.ndarray,
+               long_inertia: float | np.ndarray) -> float | np.ndarray:
     """Twists per somersault of the rule of thumb, ``sin θ (I_s/I_l − 1)`` (exact for an axisymmetric body)."""
     return np.sin(tilt) * (somersault_inertia / long_inertia - 1.0)
 

@@ -318,7 +318,8 @@ class MovingHuman(VariableBody):
 
     __slots__ = ("_human", "_angles")
 
-    def __init__(self, human: Human, angles: Mapping | None = None, *, t_span: tuple[float, float], dt: float = 2e-3) -> None:
+    def __init__(self, human: Human, angles: Mapping | None = None, *, t_span: tuple[float, float],
+                 dt: float = 2e-3) -> None:
         if not isinstance(human, Human):
             raise ValidationError(f"human: must be a tumble.variable.Human, got {type(human).__name__}")
         profiles = human.profiles(angles)

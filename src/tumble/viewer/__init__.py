@@ -78,7 +78,8 @@ def _axis(axis, traj: Trajectory) -> int:
     return _AXES[axis]
 
 
-def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | None = None, frames: int = DEFAULT_FRAMES, axis: str | None = None, shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
+def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | None = None, frames: int = DEFAULT_FRAMES,
+          axis: str | None = None, shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
     """The :class:`~tumble.viewer._scene.Scene` of a trajectory (what the page draws), refusing what it cannot show.
 
     traj   : a :class:`tumble.Trajectory` (one run, not a batch: ``traj.body(i)`` picks one) or the path of one

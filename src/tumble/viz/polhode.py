@@ -37,7 +37,8 @@ _COLOURS = {"minor": "tab:blue", "major": "tab:orange", "separatrix": "black", "
 _HIDDEN_ALPHA = 0.18         # opacity of the parts of curves behind the ellipsoid
 
 
-def polhode_figure(body: RigidBody, omega: ArrayLike, trajectory: Trajectory | None = None, *, n_curves: int = 5) -> Figure:
+def polhode_figure(body: RigidBody, omega: ArrayLike, trajectory: Trajectory | None = None, *,
+                   n_curves: int = 5) -> Figure:
     """A matplotlib figure of the polhodes and the herpolhode of the motion with body rate ``omega``.
 
     ``omega`` (3,) rad/s in body axes, at the start of the motion. Panels:

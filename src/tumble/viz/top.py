@@ -41,8 +41,8 @@ _MAX_EXACT_SAMPLES = 50_000
 _MAX_MARKERS = 400               # simulated samples drawn as markers, at most, per panel
 
 
-def top_figure(top: HeavyTop, trajectory: Trajectory | None = None, *, com: ArrayLike | None = None, g: ArrayLike | None = None,
-               duration: float | None = None) -> Figure:
+def top_figure(top: HeavyTop, trajectory: Trajectory | None = None, *, com: ArrayLike | None = None,
+               g: ArrayLike | None = None, duration: float | None = None) -> Figure:
     """A matplotlib figure of the heavy top's symmetry axis (nothing is shown or saved).
 
     Panels: (a) the axis seen from above, at distance θ (deg) from the centre
