@@ -43,6 +43,7 @@ from tumble.viewer.scenes import BUILDERS, Options
 
 if TYPE_CHECKING:
     from tumble.simulate import Model
+    from tumble.variable.human import Human
 
 __all__ = ["DEFAULT_FRAMES", "Box", "Cylinder", "html_page", "notebook_html", "scene", "write_html"]
 
@@ -78,8 +79,9 @@ def _axis(axis, traj: Trajectory) -> int:
     return _AXES[axis]
 
 
-def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | None = None, frames: int = DEFAULT_FRAMES,
-          axis: str | None = None, shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
+def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | Human | None = None,
+          frames: int = DEFAULT_FRAMES, axis: str | None = None,
+          shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
     """The :class:`~tumble.viewer._scene.Scene` of a trajectory (what the page draws), refusing what it cannot show.
 
     traj   : a :class:`tumble.Trajectory` (one run, not a batch: ``traj.body(i)`` picks one) or the path of one
