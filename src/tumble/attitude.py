@@ -35,12 +35,17 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from ._quat import qexp, qfrom_matrix, qlog, qmul, qnorm, qrotate, qrotate_inv, qto_matrix
 from ._validate import ValidationError, as_array, require_positive
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation
 
 __all__ = [
     "GIMBAL_LOCK_THRESHOLD",
@@ -277,7 +282,7 @@ def identity(shape: int | tuple[int, ...] = ()) -> np.ndarray:
     return q
 
 
-def multiply(p, q) -> np.ndarray:
+def multiply(p: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Hamilton product ``p ⊗ q`` (…, 4), batch axes broadcast.
 
     For unit quaternions, ``R(p ⊗ q) = R(p) R(q)``: ``q`` is applied first.
@@ -290,12 +295,12 @@ def multiply(p, q) -> np.ndarray:
     return out.reshape((*batch, 4))
 
 
-def conjugate(q) -> np.ndarray:
+def conjugate(q: ArrayLike) -> np.ndarray:
     """Conjugate ``q* = [w, -x, -y, -z]`` (…, 4); for a unit ``q`` it is the inverse rotation."""
     return _as_quat(q, nonzero=False) * np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def normalize(q) -> np.ndarray:
+def normalize(q: ArrayLike) -> np.ndarray:
     """Unit quaternion ``q / |q|`` (…, 4); a zero quaternion raises :class:`ValidationError`."""
     return _normalized(_as_quat(q))
 
@@ -320,7 +325,7 @@ def _rotate(q, v, inverse: bool) -> np.ndarray:
     return out.reshape((*batch, 3))
 
 
-def rotate(q, v) -> np.ndarray:
+def rotate(q: ArrayLike, v: ArrayLike) -> np.ndarray:
     """Rotate body-axis vectors into inertial axes: ``v_I = q ⊗ v_B ⊗ q* = R(q) v_B``.
 
     ``q`` (…, 4) is used as ``q / |q|``; ``v`` (…, 3) in any unit; batch axes broadcast.
@@ -328,7 +333,7 @@ def rotate(q, v) -> np.ndarray:
     return _rotate(q, v, False)
 
 
-def rotate_inverse(q, v) -> np.ndarray:
+def rotate_inverse(q: ArrayLike, v: ArrayLike) -> np.ndarray:
     """Rotate inertial-axis vectors into body axes: ``v_B = q* ⊗ v_I ⊗ q = R(q)ᵀ v_I``.
 
     ``q`` (…, 4) is used as ``q / |q|``; ``v`` (…, 3) in any unit; batch axes broadcast.
@@ -336,7 +341,7 @@ def rotate_inverse(q, v) -> np.ndarray:
     return _rotate(q, v, True)
 
 
-def to_matrix(q) -> np.ndarray:
+def to_matrix(q: ArrayLike) -> np.ndarray:
     """Rotation matrix ``R(q)`` (…, 3, 3), body → inertial (``v_I = R v_B``), of ``q / |q|``.
 
     ``R = (w² - |u|²) 1 + 2 u uᵀ + 2 w [u]×`` with ``q = [w, u]``.
@@ -347,7 +352,7 @@ def to_matrix(q) -> np.ndarray:
     return out.reshape((*q.shape[:-1], 3, 3))
 
 
-def from_matrix(R, *, tol: float = 1e-6) -> np.ndarray:
+def from_matrix(R: ArrayLike, *, tol: float = 1e-6) -> np.ndarray:
     """Unit quaternion (…, 4), with ``w ≥ 0``, of body → inertial rotation matrices ``R`` (…, 3, 3).
 
     ``R`` must be orthonormal, ``max |RᵀR - 1| ≤ tol``, and proper,
@@ -382,7 +387,7 @@ def from_matrix(R, *, tol: float = 1e-6) -> np.ndarray:
 # --------------------------------------------------------------------------
 
 
-def from_rotvec(r) -> np.ndarray:
+def from_rotvec(r: ArrayLike) -> np.ndarray:
     """Unit quaternion (…, 4) of rotation vectors ``r`` (…, 3, rad).
 
     ``q = exp(r/2) = [cos(θ/2), sin(θ/2) r/θ]`` with ``θ = |r|`` (a Taylor
@@ -404,7 +409,7 @@ def from_rotvec(r) -> np.ndarray:
     return out.reshape((*r.shape[:-1], 4))
 
 
-def to_rotvec(q) -> np.ndarray:
+def to_rotvec(q: ArrayLike) -> np.ndarray:
     """Rotation vector (…, 3, rad) of ``q / |q|``, angle ``θ = 2 atan2(|u|, |w|)`` in [0, π]."""
     q = _scaled(_as_quat(q))
     out = np.empty((math.prod(q.shape[:-1]), 3))
@@ -412,7 +417,7 @@ def to_rotvec(q) -> np.ndarray:
     return out.reshape((*q.shape[:-1], 3))
 
 
-def angle(q) -> np.ndarray:
+def angle(q: ArrayLike) -> np.ndarray:
     """Rotation angle θ ∈ [0, π] (rad, shape (…)) of ``q / |q|``.
 
     ``θ = 2 atan2(|u|, |w|)`` with ``q = [w, u]``: accurate near 0 and near π.
@@ -423,7 +428,7 @@ def angle(q) -> np.ndarray:
     return out.reshape(q.shape[:-1])
 
 
-def relative_angle(p, q) -> np.ndarray:
+def relative_angle(p: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Angle θ ∈ [0, π] (rad, shape (…)) of ``p* ⊗ q``, the rotation from attitude ``p`` to ``q``.
 
     It is the geodesic distance between the two attitudes on SO(3), the usual
@@ -454,7 +459,7 @@ def _parse_seq(seq) -> tuple[tuple[int, int, int], bool]:
     return (i, j, k), seq.isupper()
 
 
-def from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
+def from_euler(seq: str, angles: ArrayLike, *, degrees: bool = False) -> np.ndarray:
     """Unit quaternion (…, 4) of Euler angles (…, 3) about the axes ``seq``.
 
     Intrinsic ``"IJK"`` (body axes): ``q = q_I(a) ⊗ q_J(b) ⊗ q_K(c)``;
@@ -463,17 +468,17 @@ def from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
     Angles in rad, or degrees with ``degrees=True``.
     """
     axes, intrinsic = _parse_seq(seq)
-    angles = as_array(angles, "angles", tail=(3,))
+    rad: np.ndarray = as_array(angles, "angles", tail=(3,))
     if degrees:
-        angles = np.deg2rad(angles)
+        rad = np.deg2rad(rad)
     if not intrinsic:  # extrinsic ijk (a, b, c) = intrinsic KJI (c, b, a)
-        axes, angles = axes[::-1], angles[..., ::-1]
-    out = np.empty((math.prod(angles.shape[:-1]), 4))
-    _from_euler_loop(_flat(angles, angles.shape[:-1], (3,)), *axes, out)
-    return out.reshape((*angles.shape[:-1], 4))
+        axes, rad = axes[::-1], rad[..., ::-1]
+    out = np.empty((math.prod(rad.shape[:-1]), 4))
+    _from_euler_loop(_flat(rad, rad.shape[:-1], (3,)), *axes, out)
+    return out.reshape((*rad.shape[:-1], 4))
 
 
-def to_euler(q, seq: str, *, degrees: bool = False) -> np.ndarray:
+def to_euler(q: ArrayLike, seq: str, *, degrees: bool = False) -> np.ndarray:
     """Euler angles (…, 3) about the axes ``seq`` of the rotations ``q / |q|``; inverts :func:`from_euler`.
 
     First and third angles in (-π, π]; second in [-π/2, π/2] for Tait–Bryan
@@ -517,14 +522,14 @@ def to_euler(q, seq: str, *, degrees: bool = False) -> np.ndarray:
 # --------------------------------------------------------------------------
 
 
-def to_scipy(q):
+def to_scipy(q: ArrayLike) -> Rotation:
     """``scipy.spatial.transform.Rotation`` of the (batch of) quaternions ``q`` (…, 4), scalar first."""
     from scipy.spatial.transform import Rotation
 
     return Rotation.from_quat(_as_quat(q), scalar_first=True)
 
 
-def from_scipy(rot) -> np.ndarray:
+def from_scipy(rot: Rotation) -> np.ndarray:
     """Scalar-first unit quaternion(s) (…, 4) of a ``scipy.spatial.transform.Rotation``."""
     from scipy.spatial.transform import Rotation
 

@@ -19,9 +19,11 @@ moments of inertia" (Wikipedia).
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude
 from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes  # noqa: F401 (re-exported: tumble.body.principal_axes)
@@ -76,7 +78,7 @@ class Part:
         object.__setattr__(self, "com", frozen(as_shape(self.com, "com", (3,))))
         object.__setattr__(self, "inertia", frozen(inertia))
 
-    def placed(self, position=(0.0, 0.0, 0.0), *, rotation=None) -> Part:
+    def placed(self, position: ArrayLike = (0.0, 0.0, 0.0), *, rotation: ArrayLike | None = None) -> Part:
         """This part placed in a new parent: ``com' = p + R com``, ``inertia' = R inertia Rᵀ``.
 
         ``position`` ``p`` (m) is where this part's origin sits, and
@@ -119,7 +121,8 @@ class RigidBody(RigidMotion):
     _name: str | None
     _q_bp: np.ndarray | None
 
-    def __init__(self, inertia, *, mass=None, com=None, check_triangle: bool = True, name: str | None = None):
+    def __init__(self, inertia: ArrayLike, *, mass: float | None = None, com: ArrayLike | None = None,
+                 check_triangle: bool = True, name: str | None = None) -> None:
         inertia, moments, axes = check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)
         set_ = object.__setattr__
         set_(self, "_inertia", frozen(inertia))
@@ -194,7 +197,7 @@ class RigidBody(RigidMotion):
             np.diag(self._moments), mass=self._mass, com=com, check_triangle=self._check_triangle, name=self._name
         )
 
-    def rotated(self, rotation) -> RigidBody:
+    def rotated(self, rotation: ArrayLike) -> RigidBody:
         """The same body described in axes rotated by ``R``.
 
         ``R`` maps new-axes components to old-axes components
@@ -208,7 +211,7 @@ class RigidBody(RigidMotion):
             r.T @ self._inertia @ r, mass=self._mass, com=com, check_triangle=self._check_triangle, name=self._name
         )
 
-    def inertia_about(self, point) -> np.ndarray:
+    def inertia_about(self, point: ArrayLike) -> np.ndarray:
         """(3, 3) inertia about ``point`` (m, body axes), in body axes (kg·m²).
 
         Parallel-axis theorem: ``I_P = I + m (|d|² E − d dᵀ)``, ``d = com − point``.
@@ -223,7 +226,7 @@ class RigidBody(RigidMotion):
 
     # -- composites ---------------------------------------------------------
 
-    def placed(self, position=(0.0, 0.0, 0.0), *, rotation=None) -> Part:
+    def placed(self, position: ArrayLike = (0.0, 0.0, 0.0), *, rotation: ArrayLike | None = None) -> Part:
         """This body as a :class:`Part` of a composite, its reference origin at ``position``.
 
         ``position`` (m) is in the composite's axes; ``rotation`` ``R`` maps
@@ -239,7 +242,8 @@ class RigidBody(RigidMotion):
         return Part(mass=self._mass, com=com, inertia=self._inertia).placed(position, rotation=rotation)
 
     @classmethod
-    def composite(cls, parts, *, check_triangle: bool = True, name: str | None = None) -> RigidBody:
+    def composite(cls, parts: Iterable[Part | RigidBody], *, check_triangle: bool = True,
+                  name: str | None = None) -> RigidBody:
         """Rigid union of parts (:class:`Part`, or a body placed at the origin).
 
         ``m = Σ mₖ``; ``c = Σ mₖ cₖ / m``;
@@ -267,19 +271,19 @@ class RigidBody(RigidMotion):
     # -- shapes ---------------------------------------------------------------
 
     @classmethod
-    def sphere(cls, *, mass, radius) -> RigidBody:
+    def sphere(cls, *, mass: float, radius: float) -> RigidBody:
         """Solid uniform sphere centred on the origin: ``I = (2/5) m r²`` about every axis."""
         m, r = require_positive(mass, "mass"), require_positive(radius, "radius")
         return cls(np.eye(3) * (0.4 * m * r * r), mass=m, com=np.zeros(3))
 
     @classmethod
-    def hollow_sphere(cls, *, mass, radius) -> RigidBody:
+    def hollow_sphere(cls, *, mass: float, radius: float) -> RigidBody:
         """Thin uniform spherical shell centred on the origin: ``I = (2/3) m r²`` about every axis."""
         m, r = require_positive(mass, "mass"), require_positive(radius, "radius")
         return cls(np.eye(3) * (2.0 / 3.0 * m * r * r), mass=m, com=np.zeros(3))
 
     @classmethod
-    def cylinder(cls, *, mass, radius, length, axis: str = "z") -> RigidBody:
+    def cylinder(cls, *, mass: float, radius: float, length: float, axis: str = "z") -> RigidBody:
         """Solid uniform circular cylinder centred on the origin, its axis along ``axis``.
 
         Axial ``m r²/2``; transverse ``m (3 r² + L²)/12``.
@@ -290,7 +294,8 @@ class RigidBody(RigidMotion):
         return cls(inertia, mass=m, com=np.zeros(3))
 
     @classmethod
-    def hollow_cylinder(cls, *, mass, inner_radius, outer_radius, length, axis: str = "z") -> RigidBody:
+    def hollow_cylinder(cls, *, mass: float, inner_radius: float, outer_radius: float, length: float,
+                        axis: str = "z") -> RigidBody:
         """Thick-walled uniform tube centred on the origin, its axis along ``axis``.
 
         Axial ``m (r₁² + r₂²)/2``; transverse ``m (3 (r₁² + r₂²) + L²)/12``.
@@ -306,7 +311,7 @@ class RigidBody(RigidMotion):
         return cls(_axisymmetric(m * s / 2.0, m * (3.0 * s + L * L) / 12.0, axis), mass=m, com=np.zeros(3))
 
     @classmethod
-    def box(cls, *, mass, size) -> RigidBody:
+    def box(cls, *, mass: float, size: ArrayLike) -> RigidBody:
         """Solid uniform cuboid centred on the origin, edges ``size = (a, b, c)`` (m) along x, y, z.
 
         ``Ixx = m (b² + c²)/12``, ``Iyy = m (a² + c²)/12``, ``Izz = m (a² + b²)/12``.
@@ -316,7 +321,7 @@ class RigidBody(RigidMotion):
         return cls(np.diag(m * (sq.sum() - sq) / 12.0), mass=m, com=np.zeros(3))
 
     @classmethod
-    def ellipsoid(cls, *, mass, semi_axes) -> RigidBody:
+    def ellipsoid(cls, *, mass: float, semi_axes: ArrayLike) -> RigidBody:
         """Solid uniform ellipsoid centred on the origin, semi-axes ``(a, b, c)`` (m) along x, y, z.
 
         ``Ixx = m (b² + c²)/5``, ``Iyy = m (a² + c²)/5``, ``Izz = m (a² + b²)/5``.
@@ -326,7 +331,7 @@ class RigidBody(RigidMotion):
         return cls(np.diag(m * (sq.sum() - sq) / 5.0), mass=m, com=np.zeros(3))
 
     @classmethod
-    def rod(cls, *, mass, length, axis: str = "z") -> Part:
+    def rod(cls, *, mass: float, length: float, axis: str = "z") -> Part:
         """Thin uniform rod centred on the origin along ``axis``, as a :class:`Part`.
 
         Transverse ``m L²/12``; zero about its own axis. Because that makes
@@ -338,7 +343,7 @@ class RigidBody(RigidMotion):
         return Part(mass=m, com=np.zeros(3), inertia=_axisymmetric(0.0, m * L * L / 12.0, axis))
 
     @classmethod
-    def point_masses(cls, masses, positions, *, check_triangle: bool = True) -> RigidBody:
+    def point_masses(cls, masses: ArrayLike, positions: ArrayLike, *, check_triangle: bool = True) -> RigidBody:
         """Rigid cloud of point masses ``mₖ`` (kg) at ``positions`` ``rₖ`` (m), shape (n,) and (n, 3).
 
         ``com = Σ mₖ rₖ / Σ mₖ``; ``inertia = Σ mₖ (|dₖ|² E − dₖ dₖᵀ)``,

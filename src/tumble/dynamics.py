@@ -37,9 +37,12 @@ broadcasts against ``omega`` of shape (…, 3).
 
 from __future__ import annotations
 
+from typing import TypeVar
+
 import numpy as np
 from numba import njit
 from numba.extending import register_jitable
+from numpy.typing import ArrayLike
 
 from tumble import _quat
 from tumble._validate import as_array
@@ -55,20 +58,23 @@ __all__ = [
     "angular_momentum_inertial",
 ]
 
+# A scalar or an array of them: the functions compiled into kernels (float arguments) that also work on arrays
+Real = TypeVar("Real", float, np.ndarray)
 
-def _inertia_omega(inertia, omega):
+
+def _inertia_omega(inertia: ArrayLike, omega: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     inertia = as_array(inertia, "inertia", tail=(3, 3))
     omega = as_array(omega, "omega", tail=(3,))
     return inertia, omega
 
 
-def _torque(torque, omega):
+def _torque(torque: ArrayLike | None, omega: np.ndarray) -> np.ndarray:
     if torque is None:
         return np.zeros_like(omega)
     return as_array(torque, "torque", tail=(3,))
 
 
-def omega_dot(inertia, omega, torque=None) -> np.ndarray:
+def omega_dot(inertia: ArrayLike, omega: ArrayLike, torque: ArrayLike | None = None) -> np.ndarray:
     """Angular acceleration from the full-tensor Euler equations, body axes (rad/s²).
 
     ``ω̇ = I⁻¹ (τ − ω × (I ω))``, with ``inertia`` (…, 3, 3) in kg·m² about the
@@ -86,7 +92,7 @@ def omega_dot(inertia, omega, torque=None) -> np.ndarray:
 
 
 @register_jitable
-def euler_coefficients(i1, i2, i3):
+def euler_coefficients(i1: Real, i2: Real, i3: Real) -> tuple[Real, Real, Real, Real, Real, Real]:
     """Coefficients of Euler's equations in principal axes, computed once per body.
 
     Returns ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)`` with ``c₁ = (I₂ − I₃)/I₁`` and
@@ -97,7 +103,8 @@ def euler_coefficients(i1, i2, i3):
 
 
 @njit(cache=True)
-def euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3):
+def euler_principal(c1: float, c2: float, c3: float, r1: float, r2: float, r3: float, w1: float, w2: float, w3: float,
+                    t1: float, t2: float, t3: float) -> tuple[float, float, float]:
     """Principal-axes Euler equations for one body: returns ``(ω̇₁, ω̇₂, ω̇₃)`` (rad/s²).
 
     ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic, with ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``
@@ -112,7 +119,9 @@ def euler_principal(c1, c2, c3, r1, r2, r3, w1, w2, w3, t1, t2, t3):
 
 
 @register_jitable
-def rigid_rates(c1, c2, c3, r1, r2, r3, qw, qx, qy, qz, w1, w2, w3, torque):
+def rigid_rates(c1: float, c2: float, c3: float, r1: float, r2: float, r3: float, qw: float, qx: float, qy: float,
+                qz: float, w1: float, w2: float, w3: float,
+                torque: tuple[float, float, float] | None) -> tuple[float, float, float, float, float, float, float]:
     """``dy/dt`` of one rigid body from its state ``(q, ω)`` and torque ``τ`` (N·m, principal axes):
     ``(½ q ⊗ [0, ω], ω̇)`` with ``ω̇₁ = c₁ ω₂ ω₃ + τ₁/I₁`` and cyclic (:func:`euler_principal`,
     coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``).
@@ -143,7 +152,7 @@ def _omega_dot_principal_batch(moments, omega, torque, out):
         )
 
 
-def omega_dot_principal(moments, omega, torque=None) -> np.ndarray:
+def omega_dot_principal(moments: ArrayLike, omega: ArrayLike, torque: ArrayLike | None = None) -> np.ndarray:
     """Angular acceleration from Euler's equations in principal axes (rad/s²).
 
     ``I₁ ω̇₁ = τ₁ + (I₂ − I₃) ω₂ ω₃`` and cyclic, with ``moments`` (…, 3) the
@@ -166,7 +175,8 @@ def omega_dot_principal(moments, omega, torque=None) -> np.ndarray:
 
 
 @register_jitable
-def euler_frame(ratio, r_t, r_s, w1, w2, w3, frame3, n1, n2, n3):
+def euler_frame(ratio: Real, r_t: Real, r_s: Real, w1: Real, w2: Real, w3: Real, frame3: Real, n1: Real, n2: Real,
+                n3: Real) -> tuple[Real, Real, Real]:
     """Euler's equations of an axisymmetric body in a principal frame F turning at ``(ω₁, ω₂, Ω₃)``.
 
     The body rate is ``ω = ω₁e₁ + ω₂e₂ + ω₃e₃`` and the frame's rate
@@ -198,7 +208,8 @@ def euler_frame(ratio, r_t, r_s, w1, w2, w3, frame3, n1, n2, n3):
     return n1 * r_t - gyro * w2, n2 * r_t + gyro * w1, n3 * r_s
 
 
-def omega_dot_frame(moments, omega, frame_rate, torque=None) -> np.ndarray:
+def omega_dot_frame(moments: ArrayLike, omega: ArrayLike, frame_rate: ArrayLike,
+                    torque: ArrayLike | None = None) -> np.ndarray:
     """Rates of change of the body-rate components in a principal frame F of an axisymmetric body (rad/s²).
 
     ``moments`` (…, 2) are ``(I_t, I_s)``: the transverse and the axial
@@ -227,7 +238,7 @@ def _quaternion_rate_batch(q, omega, out):
             out[k, j] = 0.5 * d[j]
 
 
-def quaternion_rate(q, omega) -> np.ndarray:
+def quaternion_rate(q: ArrayLike, omega: ArrayLike) -> np.ndarray:
     """Time derivative of the attitude quaternion: ``q̇ = ½ q ⊗ [0, ω]`` (1/s).
 
     ``q`` (…, 4) maps body to inertial axes (scalar first); ``omega`` (…, 3)
@@ -243,19 +254,19 @@ def quaternion_rate(q, omega) -> np.ndarray:
     return out.reshape(shape + (4,))
 
 
-def angular_momentum(inertia, omega) -> np.ndarray:
+def angular_momentum(inertia: ArrayLike, omega: ArrayLike) -> np.ndarray:
     """Angular momentum in body axes, ``L_B = I ω`` (N·m·s)."""
     inertia, omega = _inertia_omega(inertia, omega)
     return np.einsum("...ij,...j->...i", inertia, omega)
 
 
-def kinetic_energy(inertia, omega) -> np.ndarray:
+def kinetic_energy(inertia: ArrayLike, omega: ArrayLike) -> np.ndarray:
     """Rotational kinetic energy ``T = ½ ω·(I ω)`` (J)."""
     inertia, omega = _inertia_omega(inertia, omega)
     return 0.5 * np.einsum("...i,...ij,...j->...", omega, inertia, omega)
 
 
-def angular_momentum_inertial(inertia, omega, q) -> np.ndarray:
+def angular_momentum_inertial(inertia: ArrayLike, omega: ArrayLike, q: ArrayLike) -> np.ndarray:
     """Angular momentum in inertial axes, ``L_N = R(q) I ω`` (N·m·s).
 
     ``q`` (…, 4) is the body → inertial attitude (scalar-first unit quaternion).

@@ -18,13 +18,18 @@ the chunk size beyond rounding, and the memory is that of one chunk.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array
 from tumble.body import RigidBody
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    import xarray
 
 __all__ = ["ensemble_statistics", "DEFAULT_QUANTITIES", "SAMPLES_PER_CHUNK", "STATISTICS"]
 
@@ -52,16 +57,16 @@ DEFAULT_QUANTITIES: dict[str, tuple[Callable[[Trajectory], np.ndarray], str, str
 
 
 def ensemble_statistics(
-    body,
-    omega0,
+    body: RigidBody | Sequence[RigidBody] | ArrayLike,
+    omega0: ArrayLike,
     *,
-    t,
-    q0=None,
+    t: ArrayLike,
+    q0: ArrayLike | None = None,
     quantities: Mapping[str, Callable[[Trajectory], np.ndarray]] | None = None,
     chunk: int | None = None,
     progress: Callable[[int, int], None] | None = None,
-    **options,
-):
+    **options: Any,
+) -> xarray.Dataset:
     """Per-time mean, standard deviation, minimum and maximum over a batch of bodies, streamed by chunks.
 
     Parameters

@@ -56,8 +56,10 @@ import os
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import tumble
 from tumble import attitude, dynamics, torques
@@ -66,6 +68,9 @@ from tumble.body import RigidBody
 from tumble.kernels import flexible as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory, write_atomic
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["Mode", "FlexibleBody", "simulate", "energy", "momentum_body", "slew_torque", "demo_flexible"]
 
@@ -183,7 +188,7 @@ class FlexibleBody(Model):
             StateField("eta_rate0", m, f"initial modal rates dη/dt ({m}), kg^½·m/s", default=np.zeros(m)),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.FlexibleModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.FlexibleModel:
         """The compiled model (:class:`tumble.kernels.flexible.FlexibleModel`) under a torque on the hub (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         w = self.frequencies
@@ -197,11 +202,11 @@ class FlexibleBody(Model):
             codes=codes,
         )
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.FlexibleModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q, ω, η, η̇]`` (N, 7 + 2m): the state of :mod:`tumble.kernels.flexible`."""
         return np.concatenate([values["q0"], values["omega0"], values["eta0"], values["eta_rate0"]], axis=1)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.FlexibleModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         m = len(self.modes)
         omega, eta, rate = states[..., 4:7], states[..., 7:7 + m], states[..., 7 + m:]
         extras = {
@@ -223,7 +228,7 @@ class FlexibleBody(Model):
         return kept
 
 
-def simulate(fbody: FlexibleBody, omega0=None, **options) -> Trajectory:
+def simulate(fbody: FlexibleBody, omega0: ArrayLike | None = None, **options: Any) -> Trajectory:
     """Deprecated: ``tumble.simulate(fbody, omega0, **options)``, which it calls (see :class:`FlexibleBody`)."""
     warnings.warn("tumble.flexible.simulate is deprecated: call tumble.simulate(fbody, omega0, t=..., ...)",
                   DeprecationWarning, stacklevel=2)
@@ -258,7 +263,7 @@ def energy(fbody: FlexibleBody, trajectory: Trajectory) -> np.ndarray:
     return _energy(fbody, trajectory.omega, trajectory.modal_coordinate, trajectory.modal_rate)
 
 
-def slew_torque(axis, angle: float, *, duration: float, inertia: float, ramp: float = 0.0,
+def slew_torque(axis: ArrayLike, angle: float, *, duration: float, inertia: float, ramp: float = 0.0,
                 start: float = 0.0) -> torques.Tabulated:
     """Rest-to-rest bang-bang torque that turns a rigid body by ``angle`` (rad) about ``axis`` in ``duration`` (s).
 
@@ -311,7 +316,7 @@ def slew_angle(q: np.ndarray) -> np.ndarray:
     return 2.0 * np.arctan2(q[..., 3], q[..., 0])
 
 
-def demo_flexible(out_dir) -> dict:
+def demo_flexible(out_dir: str | os.PathLike[str]) -> dict:
     """A 30° rest-to-rest slew of :data:`DEMO_BODY` (40 s, bang-bang with 0.4 s ramps), flexible vs rigid.
 
     Integrates with dop853 (rtol = atol = 1e-11) through the manoeuvre and 60 s after it,
@@ -356,7 +361,7 @@ def demo_flexible(out_dir) -> dict:
     return {**summary, "nc": nc_path, "png": png_path, "html": html_path}
 
 
-def slew_figure(flexible: Trajectory, rigid: Trajectory, end: float, target: float):
+def slew_figure(flexible: Trajectory, rigid: Trajectory, end: float, target: float) -> Figure:
     """Four panels: slew angle and rate (flexible vs rigid), modal coordinates, and the pointing error
     from the ``target`` angle (rad) after the manoeuvre ends at ``end`` (s)."""
     from matplotlib.figure import Figure

@@ -76,7 +76,7 @@ class AxisymmetricBody(Model):
     axes: np.ndarray  # (3, 3) R_BP, the symmetry axis third
     q_bp: np.ndarray  # (4,) its quaternion
 
-    def __init__(self, body: RigidBody, *, frame_spin: float = 0.0):
+    def __init__(self, body: RigidBody, *, frame_spin: float = 0.0) -> None:
         if not isinstance(body, RigidBody):
             raise ValidationError(f"body: must be a tumble.RigidBody, got {type(body).__name__}")
         kind = body.symmetry(rtol=AXISYMMETRY_RTOL)
@@ -118,12 +118,12 @@ class AxisymmetricBody(Model):
                        default=attitude.identity(), quaternion=True),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.FrameModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.FrameModel:
         """The compiled model (:class:`tumble.kernels.frame.FrameModel`) under a torque (body axes)."""
         return _kernel.build(self.transverse, self.axial, self.frame_spin, self.axes,
                              torques.as_torque_model(torque))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.FrameModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q_NF, ω, ψ]`` (N, 8): the frame on the principal axes, ``q_NF = q_NB ⊗ q_BP``, ``ω = R_BPᵀ ω_B``, ψ = 0."""
         n = values["omega0"].shape[0]
         y0 = np.zeros((n, _kernel.STATE_SIZE))
@@ -132,7 +132,7 @@ class AxisymmetricBody(Model):
         self._check_limits(y0[:, 4:7])
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.FrameModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         q_nf, omega_f, psi = states[..., :4], states[..., 4:7], states[..., 7]
         half = 0.5 * psi
         q_z = np.stack([np.cos(half), np.zeros_like(psi), np.zeros_like(psi), np.sin(half)], axis=-1)

@@ -48,6 +48,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 __all__ = ["RigidityWarning", "check_rigid_motion", "relativistic_corrections", "SPEED_OF_LIGHT", "RELATIVISTIC_SPEED",
            "BURST_SPEED", "THIN_RATIO"]
@@ -66,7 +67,7 @@ class RigidityWarning(UserWarning):
     """The data are valid for a rigid body, but a real body would not behave like one (see :mod:`tumble.limits`)."""
 
 
-def relativistic_corrections(moments, omega, mass) -> dict[str, np.ndarray]:
+def relativistic_corrections(moments: ArrayLike, omega: ArrayLike, mass: ArrayLike) -> dict[str, np.ndarray]:
     """Lower bounds of the relative corrections the Newtonian model neglects, from the RMS particle speed.
 
     moments : (..., 3) principal moments, kg·m²; omega : (..., 3) body rates in principal axes, rad/s;
@@ -89,7 +90,8 @@ def relativistic_corrections(moments, omega, mass) -> dict[str, np.ndarray]:
     return {"speed": beta, "energy": energy, "momentum": excess}
 
 
-def check_rigid_motion(moments, omega, mass=None, *, stacklevel: int = 2) -> None:
+def check_rigid_motion(moments: ArrayLike, omega: ArrayLike, mass: ArrayLike | None = None, *,
+                       stacklevel: int = 2) -> None:
     """Warn (:class:`RigidityWarning`) where rigid bodies in the states ``omega`` leave the model's domain.
 
     moments : (..., 3) principal moments, kg·m² (ascending, as ``RigidBody.moments``)

@@ -46,15 +46,20 @@ small β; there (β ≤ ½) the same integrals are summed as the series
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.integrate import quad
 from scipy.special import beta as beta_function
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.limits import SPEED_OF_LIGHT
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["SHAPES", "SpinningMatter"]
 
@@ -108,7 +113,7 @@ class SpinningMatter:
         """``I₀``, kg·m²: the moment of inertia at rest (ring m R², disk ½ m R², shell ⅔ m R², sphere ⅖ m R²)."""
         return SHAPES[self.shape] * self.mass * self.radius**2
 
-    def rim_speed(self, omega) -> np.ndarray:
+    def rim_speed(self, omega: ArrayLike) -> np.ndarray:
         """``β = |ω| R / c`` (1), refused (``omega``) unless below 1."""
         omega = as_array(omega, "omega")
         beta = np.abs(omega) * self.radius / SPEED_OF_LIGHT
@@ -117,19 +122,19 @@ class SpinningMatter:
                                   f"{beta.max():.6g} c (|omega| = {np.abs(omega).max():.6g} rad/s, R = {self.radius:g} m)")
         return beta
 
-    def moment(self, omega) -> np.ndarray:
+    def moment(self, omega: ArrayLike) -> np.ndarray:
         """``I(ω) = ∫ γ(ω r⊥) r⊥² dm``, kg·m²."""
         return self._ratios(self.rim_speed(omega))[0] * self.mass * self.radius**2
 
-    def angular_momentum(self, omega) -> np.ndarray:
+    def angular_momentum(self, omega: ArrayLike) -> np.ndarray:
         """``L = I(ω) ω``, N·m·s (the sign of ω)."""
         return self.moment(omega) * as_array(omega, "omega")
 
-    def kinetic_energy(self, omega) -> np.ndarray:
+    def kinetic_energy(self, omega: ArrayLike) -> np.ndarray:
         """``T = ∫ (γ(ω r⊥) − 1) c² dm``, J."""
         return self._ratios(self.rim_speed(omega))[1] * self.mass * SPEED_OF_LIGHT**2
 
-    def corrections(self, omega) -> dict[str, np.ndarray]:
+    def corrections(self, omega: ArrayLike) -> dict[str, np.ndarray]:
         """What the Newtonian figures miss, relative to them: ``"moment"`` ``I(ω)/I₀ − 1`` (also that of
         ``L``) and ``"energy"`` ``T/(½ I₀ ω²) − 1``, both computed without cancellation (0 at ω = 0)."""
         beta = self.rim_speed(omega)
@@ -138,7 +143,7 @@ class SpinningMatter:
         return {"moment": moment / SHAPES[self.shape],
                 "energy": np.divide(energy, newtonian_energy, out=np.zeros_like(energy), where=beta > 0.0)}
 
-    def quadrature(self, quantity: str, omega) -> float:
+    def quadrature(self, quantity: str, omega: float) -> float:
         """``"moment"`` I(ω) (kg·m²) or ``"energy"`` T (J) by adaptive quadrature of the definition
         (``scipy.integrate.quad``, relative tolerance 2e-14), for one ``omega``: the check of the closed forms.
 
@@ -210,7 +215,7 @@ def _closed_form(shape: str, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 NEUTRON_STAR = {"radius": 12e3, "mass": 1.4 * 1.98847e30, "period": 1.4e-3}
 
 
-def inertia_figure(betas=None):
+def inertia_figure(betas: ArrayLike | None = None) -> Figure:
     """``I(ω)/I₀`` of the four shapes against the rim speed ωR/c (0 to γ = 10 at the rim; log scale);
     a matplotlib ``Figure`` (object-oriented API, nothing shown)."""
     from matplotlib.figure import Figure
@@ -230,7 +235,7 @@ def inertia_figure(betas=None):
     return fig
 
 
-def demo_lorentz(out_dir) -> dict:
+def demo_lorentz(out_dir: str | os.PathLike[str]) -> dict:
     """The Lorentz-factor correction for a neutron star (:data:`NEUTRON_STAR`) taken as each shape of uniform
     incoherent matter, and the figure :func:`inertia_figure` written atomically to ``out_dir/lorentz.png``.
 

@@ -22,9 +22,11 @@ from __future__ import annotations
 
 import abc
 from collections.abc import Sequence
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from tumble import attitude, limits, torques
 from tumble._inertia import principal_axes
@@ -32,6 +34,9 @@ from tumble._quat import qmul
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import rigid as _kernel
 from tumble.simulate import Model, Outputs, StateField
+
+if TYPE_CHECKING:
+    from tumble.body import RigidBody
 
 __all__ = ["RigidMotion", "RigidBodies"]
 
@@ -74,18 +79,18 @@ class RigidMotion(Model):
     def state_fields(self) -> tuple[StateField, ...]:
         return _STATE_FIELDS
 
-    def compile(self, torque, t0: float) -> _kernel.RigidModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.RigidModel:
         moments, axes, _ = self._principal()
         return _kernel.from_principal(moments, axes, torques.as_torque_model(torque))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         moments, axes, q_bp = self._principal()
         y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
         _to_principal_axes(values["q0"], values["omega0"], q_bp, axes, y0)
         limits.check_rigid_motion(moments, y0[:, 4:], self._masses(), stacklevel=_STACKLEVEL)
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         moments, axes, q_bp = self._principal()
         if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
             limits.check_rigid_motion(moments, states[-1, :, 4:], self._masses(), stacklevel=_STACKLEVEL)
@@ -137,19 +142,20 @@ class RigidBodies(RigidMotion):
 
     __slots__ = ("inertia", "moments", "axes", "q_bp", "masses")
 
-    def __init__(self, inertia, moments, axes, masses):
+    def __init__(self, inertia: np.ndarray, moments: np.ndarray, axes: np.ndarray, masses: np.ndarray | None) -> None:
         self.inertia, self.moments, self.axes, self.masses = inertia, moments, axes, masses
         self.q_bp = attitude.from_matrix(axes)
 
     @classmethod
-    def of(cls, bodies) -> RigidBodies:
+    def of(cls, bodies: Sequence[RigidBody] | ArrayLike) -> RigidBodies:
         """The batch of ``bodies``: a sequence of RigidBody, or an inertia array (3, 3) or (N, 3, 3)."""
         from tumble.body import RigidBody  # the rigid body's class builds on this module
 
         if isinstance(bodies, Sequence) and bodies and all(isinstance(b, RigidBody) for b in bodies):
-            masses = [b.mass for b in bodies]
-            return cls(np.stack([b.inertia for b in bodies]), np.stack([b.moments for b in bodies]),
-                       np.stack([b.axes for b in bodies]), None if None in masses else np.array(masses))
+            rigid = cast("Sequence[RigidBody]", bodies)
+            masses = [b.mass for b in rigid]
+            return cls(np.stack([b.inertia for b in rigid]), np.stack([b.moments for b in rigid]),
+                       np.stack([b.axes for b in rigid]), None if None in masses else np.array(masses))
         try:
             np.asarray(bodies, dtype=np.float64)
         except (TypeError, ValueError):

@@ -30,15 +30,23 @@ from __future__ import annotations
 
 import abc
 import difflib
-from collections.abc import Callable, Mapping
+import os
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, NamedTuple, TypedDict
+from typing import TYPE_CHECKING, Any, NamedTuple, TypedDict, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import _callback, attitude, integrate
 from tumble._validate import ValidationError, as_array, output_times, require_finite
 from tumble.trajectory import Extra, Trajectory
+
+if TYPE_CHECKING:
+    import xarray
+
+    from tumble.body import RigidBody
+    from tumble.torques import TorqueLike
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
 
@@ -129,7 +137,7 @@ class Model(abc.ABC):
         """The named parts of the initial state, in the order their defaults may depend on."""
 
     @abc.abstractmethod
-    def compile(self, torque, t0: float):
+    def compile(self, torque: Any, t0: float) -> Any:
         """The compiled kernel (a NamedTuple of :mod:`tumble.kernels`) under ``torque`` (None: none), clock at ``t0`` (s).
 
         The kernel's ``provides`` says which methods apply; its ``calls_python``
@@ -137,12 +145,12 @@ class Model(abc.ABC):
         """
 
     @abc.abstractmethod
-    def initial_states(self, kernel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
+    def initial_states(self, kernel: Any, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """The state vectors (N, n) from the validated initial values (name → (N, size)): a new array, which
         the run integrates in place."""
 
     @abc.abstractmethod
-    def outputs(self, kernel, t: np.ndarray, states: np.ndarray) -> Outputs:
+    def outputs(self, kernel: Any, t: np.ndarray, states: np.ndarray) -> Outputs:
         """The trajectory's fields from the states (len(t), N, n) at the output times ``t`` (s)."""
 
     def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:  # noqa: B027
@@ -160,7 +168,7 @@ class Model(abc.ABC):
         return {"energy": traj.energy, "momentum_inertial": traj.momentum_inertial}
 
 
-def as_model(model) -> Model:
+def as_model(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike) -> Model:
     """``model`` itself when it is a :class:`Model`; a rigid body, a sequence of them or an inertia array
     (3, 3) or (N, 3, 3) (kg·m², body axes) as the rigid-body model."""
     if isinstance(model, Model):
@@ -170,22 +178,60 @@ def as_model(model) -> Model:
     return RigidBodies.of(model)
 
 
+@overload
 def simulate(
-    model,
-    omega0=None,
+    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
+    omega0: ArrayLike | None = None,
     *,
-    t,
+    t: ArrayLike,
     method: str = "dop853",
     dt: float | None = None,
     rtol: float | None = None,
     atol: float | None = None,
     max_steps: int | None = None,
-    torque=None,
+    torque: TorqueLike | ArrayLike = None,
     progress: Callable[[int, int], None] | None = None,
     device: str = "cpu",
-    store=None,
-    **initial_state,
-) -> Trajectory:
+    store: None = None,
+    **initial_state: ArrayLike | None,
+) -> Trajectory: ...
+
+
+@overload
+def simulate(
+    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
+    omega0: ArrayLike | None = None,
+    *,
+    t: ArrayLike,
+    method: str = "dop853",
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
+    torque: TorqueLike | ArrayLike = None,
+    progress: Callable[[int, int], None] | None = None,
+    device: str = "cpu",
+    store: str | os.PathLike[str],
+    **initial_state: ArrayLike | None,
+) -> xarray.Dataset: ...
+
+
+def simulate(
+    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
+    omega0: ArrayLike | None = None,
+    *,
+    t: ArrayLike,
+    method: str = "dop853",
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
+    torque: TorqueLike | ArrayLike = None,
+    progress: Callable[[int, int], None] | None = None,
+    device: str = "cpu",
+    store: str | os.PathLike[str] | None = None,
+    **initial_state: ArrayLike | None,
+) -> Trajectory | xarray.Dataset:
     """Integrate any model through the output times ``t``: the one front door.
 
     For a rigid body it solves Euler's equations ``I ω̇ + ω × (I ω) = τ``
@@ -386,7 +432,7 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
     return _broadcast(arrays, sizes), n
 
 
-def _checked_value(f: StateField, value) -> np.ndarray:
+def _checked_value(f: StateField, value: ArrayLike) -> np.ndarray:
     """The value of the field ``f`` as a float64 array (size,) or (N, size): finite, at most
     :data:`_LARGEST_STATE` in magnitude, a quaternion non-zero and normalised."""
     scalar = f.size == 1 and np.ndim(value) == 0  # a number for a field of one component
@@ -443,5 +489,5 @@ def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: di
     extras = {name: Extra(e.data[:, 0] if single else e.data, e.dims, e.units, e.description)
               for name, e in out.extras.items()}
     totals = {name: value[:, 0] if single else value for name, value in out.totals.items()}
-    return Trajectory._of_run(np.array(t), pick(out.q, "q"), pick(out.omega, "omega"), inertia, method, info, extras, totals,
-                              type(model).__name__)
+    return Trajectory._of_run(np.array(t), pick(out.q, "q"), pick(out.omega, "omega"), inertia, method, info,
+                              extras, totals, type(model).__name__)

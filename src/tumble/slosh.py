@@ -61,8 +61,10 @@ import math
 import os
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import tumble
 from tumble import attitude, dynamics, torques
@@ -71,6 +73,9 @@ from tumble.body import RigidBody
 from tumble.kernels import slosh as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory, write_atomic
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["Pendulum", "SloshBody", "simulate", "energy", "momentum_body", "nutation_angle",
            "in_plane_frequency", "flat_spin_energy", "growth_time_constant", "steady_spin_eigenvalues", "demo_slosh"]
@@ -151,7 +156,7 @@ class SloshBody(Model):
                        "(its component along the rod is removed)", default=np.zeros(3)),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.SloshModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.SloshModel:
         """The compiled model (:class:`tumble.kernels.slosh.SloshModel`) under a torque on the hub (body axes)."""
         codes, params = torques.compile_program(torques.as_torque_model(torque), np.eye(3), offset=0)
         p = self.pendulum
@@ -161,7 +166,7 @@ class SloshBody(Model):
             params=params[None, :], codes=codes,
         )
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.SloshModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q, ω, s, ν]`` (N, 13) with ``s`` normalised and ``ν ⊥ s``: the state of :mod:`tumble.kernels.slosh`."""
         direction = values["direction0"]
         norm = np.linalg.norm(direction, axis=-1, keepdims=True)
@@ -172,7 +177,7 @@ class SloshBody(Model):
         nu0 = rate - np.sum(rate * s0, axis=-1, keepdims=True) * s0
         return np.concatenate([values["q0"], values["omega0"], s0, nu0], axis=1)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.SloshModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         omega, s, nu = states[..., 4:7], states[..., 7:10], states[..., 10:13]
         extras = {
             "pendulum_direction": Extra(s, ("body_axis",), "1",
@@ -194,7 +199,7 @@ class SloshBody(Model):
         return kept
 
 
-def simulate(sbody: SloshBody, omega0=None, **options) -> Trajectory:
+def simulate(sbody: SloshBody, omega0: ArrayLike | None = None, **options: Any) -> Trajectory:
     """Deprecated: ``tumble.simulate(sbody, omega0, **options)``, which it calls (see :class:`SloshBody`)."""
     warnings.warn("tumble.slosh.simulate is deprecated: call tumble.simulate(sbody, omega0, t=..., direction0=..., "
                   "...)", DeprecationWarning, stacklevel=2)
@@ -231,7 +236,7 @@ def energy(sbody: SloshBody, trajectory: Trajectory) -> np.ndarray:
     return _totals(sbody, trajectory.omega, trajectory.pendulum_direction, trajectory.pendulum_rate)[0]
 
 
-def nutation_angle(sbody: SloshBody, trajectory: Trajectory, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
+def nutation_angle(sbody: SloshBody, trajectory: Trajectory, axis: ArrayLike = (0.0, 0.0, 1.0)) -> np.ndarray:
     """Angle (rad) between the body ``axis`` (the nominal spin axis) and the total angular momentum."""
     axis = as_array(axis, "axis", tail=(3,))
     h = momentum_body(sbody, trajectory)
@@ -251,7 +256,7 @@ def in_plane_frequency(spin: float, hinge_radius: float, length: float, axial_in
     return abs(spin) * math.sqrt(hinge_radius / length * (C + reduced_mass * (hinge_radius + length) ** 2) / C)
 
 
-def steady_spin_eigenvalues(sbody: SloshBody, omega, direction) -> np.ndarray:
+def steady_spin_eigenvalues(sbody: SloshBody, omega: ArrayLike, direction: ArrayLike) -> np.ndarray:
     """Eigenvalues (1/s) of the torque-free motion linearised about a steady spin, largest real part first.
 
     The steady spin (a relative equilibrium) has the hub rate ``omega`` (rad/s, body axes) and the
@@ -300,7 +305,7 @@ _DEMO_TOLERANCE = 1e-11  # rtol = atol of the demo run
 _FIT_RANGE = (math.radians(2.0), math.radians(20.0))  # nutation angles of the exponential fit (rad)
 
 
-def growth_time_constant(t: np.ndarray, angle: np.ndarray, bounds=_FIT_RANGE) -> float:
+def growth_time_constant(t: np.ndarray, angle: np.ndarray, bounds: tuple[float, float] = _FIT_RANGE) -> float:
     """Time constant ``τ`` (s) of ``angle ∝ exp(t/τ)``: a least-squares line through ``log(angle)``
     over the samples with ``bounds[0] ≤ angle ≤ bounds[1]`` (rad), before the angle first exceeds ``bounds[1]``."""
     end = np.argmax(angle > bounds[1]) if np.any(angle > bounds[1]) else angle.size
@@ -322,7 +327,7 @@ def flat_spin_energy(sbody: SloshBody, momentum_norm: float) -> float:
     return float(momentum_norm**2 / (2.0 * np.linalg.eigvalsh(frozen)[-1]))
 
 
-def demo_slosh(out_dir) -> dict:
+def demo_slosh(out_dir: str | os.PathLike[str]) -> dict:
     """Slosh-induced nutation growth of a minor-axis spinner (:data:`DEMO_BODY`).
 
     Spins the hub at 2 rad/s about its minor axis z with a small wobble, integrates 600 s
@@ -366,7 +371,7 @@ def demo_slosh(out_dir) -> dict:
 
 
 def nutation_figure(trajectory: Trajectory, angle: np.ndarray, momentum_norm: np.ndarray, total_energy: np.ndarray,
-                    time_constant: float | None = None, flat_spin: float | None = None):
+                    time_constant: float | None = None, flat_spin: float | None = None) -> Figure:
     """Three panels: nutation angle (log scale; with ``angle[0] exp(t/time_constant)`` (s) dashed, up to
     90°, when given), energy (with the ``flat_spin`` energy (J) dashed, when given), and the relative
     change of ``|H|``."""

@@ -34,15 +34,22 @@ principal axes, where the integrators work; :func:`evaluate` runs a program.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 from numba import njit, objmode
 from numba.extending import register_jitable
+from numpy.typing import ArrayLike
 
 from tumble import _callback, _gravity, _quat
 from tumble._validate import ValidationError, as_array, increasing_times, require_positive
 from tumble.attitude import rotate_inverse
 from tumble._inertia import principal_axes
+
+if TYPE_CHECKING:
+    from tumble.body import RigidBody
+    from tumble.spacecraft.orbit import Orbit
 
 __all__ = [
     "TorqueModel",
@@ -91,7 +98,7 @@ class TorqueModel:
         """(program code, parameters) of this model in the principal axes ``axes`` (R_BP)."""
         raise NotImplementedError
 
-    def __call__(self, t, q, omega) -> np.ndarray:
+    def __call__(self, t: float, q: ArrayLike, omega: ArrayLike) -> np.ndarray:
         q = as_array(q, "q", tail=(4,))
         omega = as_array(omega, "omega", tail=(3,))
         if q.ndim != 1 or omega.ndim != 1:
@@ -103,11 +110,11 @@ class TorqueModel:
 class Sum(TorqueModel):
     """Sum of torque models (built by ``+``)."""
 
-    def __init__(self, parts):
+    def __init__(self, parts: Iterable[TorqueModel]) -> None:
         self.parts = tuple(parts)
         self.needs_python = any(p.needs_python for p in self.parts)
 
-    def terms(self):
+    def terms(self) -> tuple[TorqueModel, ...]:
         return self.parts
 
     def __repr__(self):
@@ -117,7 +124,7 @@ class Sum(TorqueModel):
 class ConstantBody(TorqueModel):
     """A torque fixed in the body: ``τ_B = torque`` (N·m, body axes)."""
 
-    def __init__(self, torque):
+    def __init__(self, torque: ArrayLike) -> None:
         self.torque = as_array(torque, "torque", tail=(3,))
         if self.torque.ndim != 1:
             raise ValidationError(f"torque: must have shape (3,), got {self.torque.shape}")
@@ -135,7 +142,7 @@ class ConstantInertial(TorqueModel):
     The inertial angular momentum then grows linearly: ``L_N(t) = L_N(0) + τ_N t``.
     """
 
-    def __init__(self, torque):
+    def __init__(self, torque: ArrayLike) -> None:
         self.torque = as_array(torque, "torque", tail=(3,))
         if self.torque.ndim != 1:
             raise ValidationError(f"torque: must have shape (3,), got {self.torque.shape}")
@@ -159,7 +166,7 @@ class Tabulated(TorqueModel):
     lands on the jumps when that matters.
     """
 
-    def __init__(self, t, torque, *, frame: str = "body", interpolation: str = "linear"):
+    def __init__(self, t: ArrayLike, torque: ArrayLike, *, frame: str = "body", interpolation: str = "linear") -> None:
         t = increasing_times(t, what="sample times")
         torque = as_array(torque, "torque", tail=(3,))
         if torque.shape != (t.size, 3):
@@ -189,7 +196,7 @@ class Gravity(TorqueModel):
     (``RigidBody.inertia_about(pivot)``), since the pivot is the fixed point.
     """
 
-    def __init__(self, mass, com, g=(0.0, 0.0, -9.80665)):
+    def __init__(self, mass: float, com: ArrayLike, g: ArrayLike = (0.0, 0.0, -9.80665)) -> None:
         self.mass = require_positive(mass, "mass")
         self.com = as_array(com, "com", tail=(3,))
         self.g = as_array(g, "g", tail=(3,))
@@ -224,7 +231,7 @@ class GravityGradient(TorqueModel):
     attitude does not act back on the orbit.
     """
 
-    def __init__(self, orbit, inertia):
+    def __init__(self, orbit: Orbit, inertia: RigidBody | ArrayLike) -> None:
         if not callable(getattr(orbit, "elements", None)):
             raise ValidationError(f"orbit: must be a tumble.spacecraft.orbit.Orbit, got {type(orbit).__name__}")
         self.orbit = orbit
@@ -254,7 +261,7 @@ class PythonTorque(TorqueModel):
 
     needs_python = True
 
-    def __init__(self, function):
+    def __init__(self, function: Callable[[float, np.ndarray, np.ndarray], ArrayLike]) -> None:
         if not callable(function):
             raise ValidationError(f"torque: must be a torque model or a callable f(t, q, omega), got {function!r}")
         self.function = function
@@ -277,7 +284,7 @@ class FunctionOfTime(PythonTorque):
     compiled speed.
     """
 
-    def __init__(self, function, *, frame: str = "body"):
+    def __init__(self, function: Callable[[float], ArrayLike], *, frame: str = "body") -> None:
         if not callable(function):
             raise ValidationError(f"function: must be callable f(t) -> torque, got {function!r}")
         if frame not in ("body", "inertial"):
@@ -293,7 +300,12 @@ class FunctionOfTime(PythonTorque):
         return f"FunctionOfTime({getattr(self.time_function, '__name__', self.time_function)!r}, frame={self.frame!r})"
 
 
-def as_torque_model(torque) -> TorqueModel | None:
+#: What a ``torque=`` argument takes: a torque model, a Python function ``f(t, q, omega) -> (3,)`` (N·m, body
+#: axes), or None (no torque)
+TorqueLike = Union[TorqueModel, Callable[[float, np.ndarray, np.ndarray], ArrayLike], None]
+
+
+def as_torque_model(torque: TorqueLike) -> TorqueModel | None:
     """``None`` for no torque, a model as is, a callable as :class:`PythonTorque`."""
     if torque is None or isinstance(torque, TorqueModel):
         return torque
@@ -305,7 +317,7 @@ def calls_python(codes: np.ndarray | None) -> bool:
     return codes is not None and bool(np.any(np.asarray(codes)[0::2] == _PYTHON))
 
 
-def program_calls_python(kernel) -> bool:
+def program_calls_python(kernel: Any) -> bool:
     """``calls_python`` of a compiled model whose torque program is its field ``codes``."""
     return calls_python(kernel.codes)
 
@@ -384,7 +396,8 @@ def _tabulated(t, P, row, o):
 
 
 @register_jitable
-def evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float,
+                      P: np.ndarray, row: int, codes: np.ndarray) -> tuple[float, float, float]:
     """The compiled terms of the torque program in row ``row`` of ``P`` (all but Python callbacks):
     the torque (N·m) in the axes it was compiled for.
 
@@ -433,7 +446,8 @@ def evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
 
 
 @njit(cache=True)
-def evaluate(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+def evaluate(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float, P: np.ndarray,
+             row: int, codes: np.ndarray) -> tuple[float, float, float]:
     """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
 
     The compiled terms (:func:`evaluate_compiled`), then the Python callbacks.

@@ -41,10 +41,10 @@ import signal
 import stat
 import tempfile
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Final, NamedTuple
+from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
 
 import filelock
 import numpy as np
@@ -337,7 +337,7 @@ class Trajectory:
         return Trajectory(self.t, pick(self.q), pick(self.omega), inertia, self.method, self.info, extras, totals,
                           self.model)
 
-    def at(self, index) -> Trajectory:
+    def at(self, index: int | slice | Sequence[int] | np.ndarray) -> Trajectory:
         """The trajectory at the output samples ``index`` only: a slice or integer indices along time, kept
         in order (an int gives one sample, ``at(-1)`` the last); every sampled array, extra and total is
         cut the same way, the inertia and ``info`` are kept."""
@@ -372,7 +372,7 @@ class Trajectory:
         """
         if "energy" in self.totals:
             return self.totals["energy"]
-        return _readonly(kinetic_energy(self.inertia, self.omega))
+        return _readonly(kinetic_energy(cast(np.ndarray, self.inertia), cast(np.ndarray, self.omega)))
 
     @cached_property
     def momentum_body(self) -> np.ndarray:
@@ -386,7 +386,7 @@ class Trajectory:
         if self.q is None:
             raise ValidationError(f"momentum_body: this {self.model or 'model'} trajectory has no angular momentum "
                                   "(no single attitude; see its extras and energy)")
-        return _readonly(angular_momentum(self.inertia, self.omega))
+        return _readonly(angular_momentum(cast(np.ndarray, self.inertia), cast(np.ndarray, self.omega)))
 
     @cached_property
     def momentum_inertial(self) -> np.ndarray:
@@ -395,7 +395,7 @@ class Trajectory:
         Constant when no external torque acts.
         """
         body = self.momentum_body
-        return _readonly(rotate(self.q, body))
+        return _readonly(rotate(cast(np.ndarray, self.q), body))
 
     @cached_property
     def momentum_norm(self) -> np.ndarray:
@@ -554,7 +554,7 @@ class Trajectory:
 
     # -- viewer ------------------------------------------------------------------------
 
-    def to_html(self, path: str | os.PathLike, **options) -> None:
+    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
         """Write the offline 3-D viewer of this trajectory to ``path``: one self-contained HTML file, atomically.
 
         ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``) and what the page shows:

@@ -36,6 +36,7 @@ contact is ``ω``; its path on the plane is the *herpolhode*.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -331,7 +332,7 @@ def herpolhode(trajectory: Trajectory) -> Herpolhode:
         raise ValidationError("trajectory: a body at rest (|L| = 0) has no herpolhode")
     normal = momentum / norm
     basis = _plane_basis(normal)
-    omega_inertial = rotate(trajectory.q, trajectory.omega)
+    omega_inertial = rotate(cast(np.ndarray, trajectory.q), cast(np.ndarray, trajectory.omega))
     return Herpolhode(
         points=omega_inertial @ basis.T,
         omega_inertial=omega_inertial,

@@ -27,10 +27,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["FLICKER_FACTOR", "AllanDeviation", "allan_deviation", "allan_figure", "gauss_markov_adev"]
 
@@ -74,7 +79,8 @@ class AllanDeviation:
         return np.exp(np.mean(np.log(self.sigma[keep]) - 0.5 * np.log(tau / 3.0), axis=0))
 
 
-def allan_deviation(samples, dt: float, *, kind: str = "rate", m=None, per_decade: int = 10) -> AllanDeviation:
+def allan_deviation(samples: ArrayLike, dt: float, *, kind: str = "rate", m: ArrayLike | None = None,
+                    per_decade: int = 10) -> AllanDeviation:
     """Overlapping Allan deviation of a record of rates or of angle increments.
 
     Parameters
@@ -115,7 +121,7 @@ def allan_deviation(samples, dt: float, *, kind: str = "rate", m=None, per_decad
     return AllanDeviation(tau=m * dt, sigma=sigma)
 
 
-def gauss_markov_adev(tau, sigma: float, correlation_time: float) -> np.ndarray:
+def gauss_markov_adev(tau: ArrayLike, sigma: float, correlation_time: float) -> np.ndarray:
     """Allan deviation of a first-order Gauss–Markov rate of standard deviation ``sigma`` and correlation time ``T``.
 
     Autocorrelation ``σ² exp(−|t|/T)``; with ``x = τ/T`` (IEEE 952, Annex C.6)::
@@ -127,7 +133,7 @@ def gauss_markov_adev(tau, sigma: float, correlation_time: float) -> np.ndarray:
 
 
 def allan_figure(curves: dict, *, white_noise: float | None = None, bias_instability: float | None = None,
-                 units: str = "rad/s", title: str | None = None):
+                 units: str = "rad/s", title: str | None = None) -> Figure:
     """Log-log figure of Allan deviations: ``curves`` maps a label to an :class:`AllanDeviation`.
 
     With ``white_noise`` (N) and ``bias_instability`` (B) the model lines

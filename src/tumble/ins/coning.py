@@ -26,8 +26,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude
 from tumble._validate import ValidationError, require_positive
@@ -52,21 +54,21 @@ class Coning:
         object.__setattr__(self, "half_angle", alpha)
         object.__setattr__(self, "frequency", require_positive(self.frequency, "frequency"))
 
-    def attitude(self, t) -> np.ndarray:
+    def attitude(self, t: ArrayLike) -> np.ndarray:
         """``q(t)`` (body → inertial, scalar first), shape (n, 4)."""
         phase = self.frequency * np.asarray(t, dtype=np.float64)
         s = math.sin(self.half_angle / 2)
         return np.stack([np.full_like(phase, math.cos(self.half_angle / 2)), s * np.cos(phase),
                          s * np.sin(phase), np.zeros_like(phase)], axis=-1)
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> np.ndarray:
         """Body rate ``ω(t)`` (rad/s, body axes), shape (n, 3)."""
         phase = self.frequency * np.asarray(t, dtype=np.float64)
         a = self.frequency * math.sin(self.half_angle)
         return np.stack([-a * np.sin(phase), a * np.cos(phase),
                          np.full_like(phase, -self.frequency * (1.0 - math.cos(self.half_angle)))], axis=-1)
 
-    def trajectory(self, t) -> Trajectory:
+    def trajectory(self, t: ArrayLike) -> Trajectory:
         """The exact motion at times ``t`` as a Trajectory (inertia: identity, the motion is kinematic)."""
         t = np.asarray(t, dtype=np.float64)
         return Trajectory(t=t, q=self.attitude(t), omega=self.rate(t), inertia=np.eye(3), method="coning")
@@ -81,7 +83,7 @@ class Coning:
         return Increments(t0=t0, dt=dt, delta_theta=dtheta)
 
 
-def drift_law(algorithm: str, half_angle: float, frequency: float, update_interval) -> np.ndarray:
+def drift_law(algorithm: str, half_angle: float, frequency: float, update_interval: ArrayLike) -> np.ndarray:
     """Predicted coning drift rate about the cone axis (rad/s) of a strapdown algorithm.
 
     ``T`` = ``update_interval`` (s), ``x = ΩT``, ``α`` = ``half_angle``:
@@ -151,7 +153,7 @@ def measure_drift(coning: Coning, algorithm: str, update_interval: float, update
     increments = coning.increments(T / n, n * int(updates))
     result = strapdown(increments, q0=coning.attitude(0.0), algorithm=algorithm)
     t = result.attitude.t
-    error = attitude.multiply(result.attitude.q, attitude.conjugate(coning.attitude(t)))
+    error = attitude.multiply(cast(np.ndarray, result.attitude.q), attitude.conjugate(coning.attitude(t)))
     change = attitude.to_rotvec(attitude.multiply(error[1:], attitude.conjugate(error[:-1])))[:, 2]
     accumulated = np.concatenate([[0.0], np.cumsum(change)])
     return float(np.polyfit(t[1:], accumulated[1:], 1)[0])

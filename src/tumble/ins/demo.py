@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -85,7 +85,7 @@ def _steady(gyro: Gyroscope, t):
                     atol=_GYRO_TOLERANCE)
 
 
-def demo_gyroscope(out_dir) -> dict:
+def demo_gyroscope(out_dir: str | os.PathLike[str]) -> dict:
     """Simulate :data:`DEMO_GYRO` released with its axis horizontal, and its drift mechanisms.
 
     Writes ``ins_gyro_precession.png`` (azimuth and tilt of the axis over
@@ -168,7 +168,7 @@ def demo_gyroscope(out_dir) -> dict:
     }
 
 
-def demo_coning(out_dir, *, points: int = 12) -> dict:
+def demo_coning(out_dir: str | os.PathLike[str], *, points: int = 12) -> dict:
     """Coning drift (α = 0.01 rad, Ω = 2π rad/s) of every algorithm over Ω T from 0.05 to 1.
 
     Writes ``ins_coning.png`` (measured |drift| and the laws of
@@ -212,7 +212,7 @@ def demo_coning(out_dir, *, points: int = 12) -> dict:
     return summary
 
 
-def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
+def demo_ins(out_dir: str | os.PathLike[str], *, duration: float = 60.0, seed: int = 2026) -> dict:
     """Tumbling body → gyro with :data:`DEMO_GYRO_ERRORS` → three-sample strapdown → attitude error.
 
     The body (inertia diag(0.05, 0.1, 0.12) kg·m², ω₀ = (0.5, 2, 0.3) rad/s)
@@ -248,7 +248,7 @@ def demo_ins(out_dir, *, duration: float = 60.0, seed: int = 2026) -> dict:
     summary: dict[str, Any] = {"duration_s": float(t[-1]), "sample_rate_hz": 1.0 / dt}
     for name, increments in cases.items():
         nav = strapdown(increments, q0=truth.q[0], algorithm="three-sample")
-        error = attitude.relative_angle(nav.attitude.q, truth.q[::6])
+        error = attitude.relative_angle(cast(np.ndarray, nav.attitude.q), truth.q[::6])
         ax.loglog(nav.attitude.t[1:], error[1:], lw=1, label=name)
         summary[name] = {"final_rad": float(error[-1]), "max_rad": float(error.max())}
     span = np.geomspace(3 * dt, t[-1], 50)

@@ -49,6 +49,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import tumble
 from tumble import attitude
@@ -57,6 +58,7 @@ from tumble.integrate import METHODS
 from tumble.kernels import gimbal as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory
+from tumble.torques import TorqueLike
 
 __all__ = ["GimbaledGyro"]
 
@@ -134,7 +136,8 @@ class GimbaledGyro(Model):
         """Steady precession of a horizontal spin axis, ``(τ_θ + m g l) / (I_s ω₃)`` (rad/s, about +z)."""
         return (self.inner_torque + self.imbalance) / (self.spin_inertia * spin)
 
-    def energy(self, theta, phi_dot, theta_dot, spin) -> np.ndarray:
+    def energy(self, theta: float | np.ndarray, phi_dot: float | np.ndarray, theta_dot: float | np.ndarray,
+               spin: float | np.ndarray) -> np.ndarray:
         """``E = ½ P θ̇² + ½ Q(θ) φ̇² + ½ I_s ω₃² + m g l cos θ`` (J) of rotor and gimbals, broadcast."""
         A, B, C = self.inner_gimbal
         s, c = np.sin(theta), np.cos(theta)
@@ -142,7 +145,8 @@ class GimbaledGyro(Model):
         return (0.5 * (A + self.transverse_inertia) * theta_dot**2 + 0.5 * Q * phi_dot**2
                 + 0.5 * self.spin_inertia * spin**2 + self.imbalance * c)
 
-    def vertical_momentum(self, theta, phi_dot, spin) -> np.ndarray:
+    def vertical_momentum(self, theta: float | np.ndarray, phi_dot: float | np.ndarray,
+                          spin: float | np.ndarray) -> np.ndarray:
         """``p_φ = Q(θ) φ̇ + I_s ω₃ cos θ`` (N·m·s): the vertical angular momentum of rotor and gimbals, broadcast."""
         _, B, C = self.inner_gimbal
         s, c = np.sin(theta), np.cos(theta)
@@ -160,13 +164,13 @@ class GimbaledGyro(Model):
             StateField("theta_dot0", 1, "initial inner gimbal rate, rad/s", default=0.0),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.GimbalModel:
+    def compile(self, torque: TorqueLike, t0: float) -> _kernel.GimbalModel:
         A, B, C = self.inner_gimbal
         return _kernel.GimbalModel(np.array([[self.transverse_inertia, self.spin_inertia, A, B, C, self.outer_gimbal,
                                               self.imbalance, self.inner_torque, self.outer_torque,
                                               self.outer_friction, self.spin_friction]]))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.GimbalModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q_G, φ̇, θ̇, ω₃, ψ = 0]`` (N, 8) with ``q_G`` the z-x-z rotation (0, θ₀, 0)."""
         spin = values["spin"][:, 0]
         if not np.all(np.isfinite(spin) & (spin != 0.0)):
@@ -177,7 +181,7 @@ class GimbaledGyro(Model):
         y0[:, 4], y0[:, 5], y0[:, 6] = values["phi_dot0"][:, 0], values["theta_dot0"][:, 0], spin
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.GimbalModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         R = attitude.to_matrix(states[..., :4])
         phi = np.unwrap(np.arctan2(R[..., 1, 0], R[..., 0, 0]), axis=0)
         theta = np.arctan2(R[..., 2, 1], R[..., 2, 2])
@@ -199,8 +203,8 @@ class GimbaledGyro(Model):
                 kept["energy"] = traj.energy
         return kept
 
-    def simulate(self, t, *, spin: float, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
-                 dt: float | None = None, **initial_state) -> Trajectory:
+    def simulate(self, t: ArrayLike, *, spin: float, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
+                 dt: float | None = None, **initial_state: Any) -> Trajectory:
         """Deprecated: ``tumble.simulate(gyro, t=t, spin=spin, method=..., ...)``, which it calls."""
         warnings.warn("GimbaledGyro.simulate is deprecated: call tumble.simulate(gyro, t=..., spin=..., ...)",
                       DeprecationWarning, stacklevel=2)

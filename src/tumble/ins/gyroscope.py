@@ -55,8 +55,10 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 import tumble
 from tumble import attitude, dynamics, torques
@@ -65,6 +67,9 @@ from tumble.analytic import AxisMotion, HeavyTop, axis_motion
 from tumble.rigid import RigidBodies
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from tumble.kernels.rigid import RigidModel
 
 __all__ = ["Gyroscope"]
 
@@ -189,11 +194,11 @@ class Gyroscope(Model):
                            "rad/s (0: released at rest; gyro.steady_precession_rate: steady precession)",
                            default=0.0),)
 
-    def compile(self, torque, t0: float):
+    def compile(self, torque: torques.TorqueLike, t0: float) -> RigidModel:
         extra = torques.as_torque_model(torque)
         return self._rotor().compile(self.torque_model() if extra is None else extra + self.torque_model(), t0)
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """The rotor at φ = 0, θ = ``tilt``, ψ = 0 with body rate ``(0, φ̇₀ sin θ, ω_s)`` (θ̇ = 0)."""
         phi_dot0 = values["precession_rate0"][:, 0]
         omega0 = np.stack([np.zeros_like(phi_dot0), phi_dot0 * math.sin(self.tilt), np.full_like(phi_dot0, self.spin)],
@@ -201,10 +206,11 @@ class Gyroscope(Model):
         q0 = np.broadcast_to(attitude.from_euler("ZXZ", [0.0, self.tilt, 0.0]), (phi_dot0.size, 4))
         return self._rotor().initial_states(kernel, {"omega0": omega0, "q0": q0}, t0)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         out = self._rotor().outputs(kernel, t, states)
-        height = attitude.rotate(out.q, [0.0, 0.0, 1.0])[..., 2]   # cos θ
-        energy = dynamics.kinetic_energy(out.inertia, out.omega) + self.imbalance_torque * height
+        height = attitude.rotate(cast(np.ndarray, out.q), [0.0, 0.0, 1.0])[..., 2]   # cos θ
+        energy = (dynamics.kinetic_energy(cast(np.ndarray, out.inertia), cast(np.ndarray, out.omega))
+                  + self.imbalance_torque * height)
         return out._replace(totals={"energy": energy})
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
@@ -214,7 +220,7 @@ class Gyroscope(Model):
         return {"energy": traj.energy, "momentum_vertical": traj.momentum_inertial[..., 2],
                 "momentum_axial": traj.momentum_body[..., 2]}
 
-    def simulate(self, t, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
+    def simulate(self, t: ArrayLike, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
         """Deprecated: ``tumble.simulate(gyro, t=t, precession_rate0=..., rtol=rtol, atol=atol)``, which it calls
         (``released=False``: ``precession_rate0=gyro.steady_precession_rate``)."""
         warnings.warn("Gyroscope.simulate is deprecated: call tumble.simulate(gyro, t=..., precession_rate0=...) "

@@ -34,6 +34,7 @@ import os
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude
 from tumble._validate import ValidationError, as_array, require_positive
@@ -92,8 +93,8 @@ class Increments:
         return self.delta_theta / self.dt
 
 
-def from_trajectory(trajectory: Trajectory, *, oversample: int = 2, specific_force=None,
-                    lever_arm=None) -> Increments:
+def from_trajectory(trajectory: Trajectory, *, oversample: int = 2, specific_force: ArrayLike | None = None,
+                    lever_arm: ArrayLike | None = None) -> Increments:
     """The exact increments of a sampled true motion, one sample per ``oversample`` trajectory steps.
 
     ``trajectory`` (one body, e.g. from ``tumble.simulate``) must be sampled on

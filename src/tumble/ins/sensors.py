@@ -49,6 +49,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.signal import lfilter
 
 from tumble._validate import ValidationError, as_array, require_non_negative
@@ -105,7 +106,7 @@ class SensorErrors:
         count = int(math.floor(math.log(hi / lo) / math.log(FLICKER_SPACING) + 1e-9)) + 1
         return lo * FLICKER_SPACING ** np.arange(count)
 
-    def apply(self, true_increments, dt: float, rng: np.random.Generator) -> np.ndarray:
+    def apply(self, true_increments: ArrayLike, dt: float, rng: np.random.Generator) -> np.ndarray:
         """Measured increments (K, 3) from true ones (K, 3) over sample interval ``dt`` (s), drawing from ``rng``.
 
         Draws, in this order: the white noise (K, 3); for each Gauss–Markov
@@ -143,7 +144,8 @@ class Imu:
     gyro: SensorErrors = field(default_factory=SensorErrors)
     accel: SensorErrors = field(default_factory=SensorErrors)
 
-    def measure(self, truth: Increments, *, seed=None) -> Increments:
+    def measure(self, truth: Increments, *,
+                seed: int | np.random.SeedSequence | np.random.Generator | None = None) -> Increments:
         """Measured increments from true ones; gyro draws first, then accelerometer draws.
 
         ``seed`` (int, SeedSequence or Generator) seeds ``numpy.random.default_rng``:
@@ -156,8 +158,9 @@ class Imu:
         delta_v = None if truth.delta_v is None else self.accel.apply(truth.delta_v, truth.dt, rng)
         return Increments(t0=truth.t0, dt=truth.dt, delta_theta=delta_theta, delta_v=delta_v)
 
-    def sample(self, trajectory: Trajectory, *, oversample: int = 2, specific_force=None, lever_arm=None,
-               seed=None) -> Increments:
+    def sample(self, trajectory: Trajectory, *, oversample: int = 2, specific_force: ArrayLike | None = None,
+               lever_arm: ArrayLike | None = None,
+               seed: int | np.random.SeedSequence | np.random.Generator | None = None) -> Increments:
         """Measure a true motion: :func:`~tumble.ins.increments.from_trajectory`, then :meth:`measure`.
 
         The sample rate is ``1 / (oversample (t[1] − t[0]))`` of the trajectory grid.

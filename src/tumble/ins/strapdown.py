@@ -64,6 +64,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from tumble import _quat, attitude
 from tumble._vec import cross
@@ -101,8 +102,9 @@ class Navigation:
     algorithm: str
 
 
-def strapdown(increments: Increments, *, q0=None, algorithm: str = "three-sample", v0=(0.0, 0.0, 0.0),
-              g=(0.0, 0.0, 0.0), sculling: bool = True, inertia=None) -> Navigation:
+def strapdown(increments: Increments, *, q0: ArrayLike | None = None, algorithm: str = "three-sample",
+              v0: ArrayLike = (0.0, 0.0, 0.0), g: ArrayLike = (0.0, 0.0, 0.0), sculling: bool = True,
+              inertia: ArrayLike | None = None) -> Navigation:
     """Integrate gyro (and accelerometer) increments into attitude (and velocity).
 
     Parameters

@@ -38,7 +38,9 @@ runs every model.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 
@@ -66,7 +68,7 @@ class Diverged(SolverError):
     member, ``states`` the output samples, ``method`` the method's name (:func:`tumble.simulate` turns it into
     a message naming the time and the body rate)."""
 
-    def __init__(self, message: str, index: int, member: int, states: np.ndarray, method: str):
+    def __init__(self, message: str, index: int, member: int, states: np.ndarray, method: str) -> None:
         super().__init__(message)
         self.index, self.member, self.states, self.method = index, member, states, method
 
@@ -138,11 +140,12 @@ _SCHEMES = {
 _CHUNKS = 100
 
 
-def check_options(method: str, *, dt, rtol, atol, max_steps) -> Method:
+def check_options(method: str, *, dt: Any, rtol: Any, atol: Any, max_steps: Any) -> Method:
     """Validate the options that ``method`` reads; returns the :class:`Method`.
 
     Options the method does not read are not looked at here (:func:`tumble.simulate`
-    refuses them when they are given).
+    refuses them when they are given). The options are taken as given (``Any``): this is where a value that
+    is not a positive number, or a ``max_steps`` that is not a whole number, is refused.
     """
     if method not in METHODS:
         raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
@@ -172,7 +175,7 @@ def _check_max_steps(max_steps) -> None:
                               f"got {max_steps!r}")
 
 
-def check_method(method: str, provides, who: str) -> Method:
+def check_method(method: str, provides: Collection[str], who: str) -> Method:
     """Refuse ``method`` unless the model provides every capability it needs; returns the :class:`Method`.
 
     ``provides`` is the set of capabilities of the compiled model and ``who``
@@ -211,8 +214,9 @@ class Solution:
         return {"n_steps": self.n_steps, "n_rejected": self.n_rejected, "n_rhs": self.n_rhs}
 
 
-def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_STEPS, progress=None,
-          device="cpu", overwrite_y0=False) -> Solution:
+def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float | None = None, rtol: float | None = None,
+          atol: float | None = None, max_steps: int = MAX_STEPS, progress: Callable[[int, int], None] | None = None,
+          device: str = "cpu", overwrite_y0: bool = False) -> Solution:
     """Integrate the compiled ``model`` (:mod:`tumble._protocol`) for a batch of states ``y0`` (N, n) through ``t``.
 
     ``t`` (s) must be strictly increasing (:func:`tumble._validate.output_times`).
@@ -241,7 +245,7 @@ def solve(model, y0, t, *, method, dt=None, rtol=None, atol=None, max_steps=MAX_
         states, n_steps = _cuda.solve_cuda(model, y, t, dt, max_steps)
         _raise_on_divergence(states, method)
         return Solution(states, n_steps, 0, 4 * n_steps)
-    steps = _fixed.landing_steps(t, dt, max_steps) if method in _SCHEMES else None
+    steps = _fixed.landing_steps(t, cast(float, dt), max_steps) if method in _SCHEMES else None  # dt checked
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     stats = np.zeros((y.shape[0], 5))
     bounds = [0, n_out - 1]

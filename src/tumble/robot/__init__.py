@@ -16,7 +16,11 @@ compiled and batched::
 See ``docs/robot.md`` for the conventions (frames, DH variants, units).
 """
 
+from __future__ import annotations
+
 import warnings
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
 
 from tumble.robot.chain import SerialChain, load
 from tumble.robot.dynamics import (
@@ -41,6 +45,12 @@ from tumble.robot.link import Frame, Link
 from tumble.robot.space import space_manipulator
 from tumble.robot.tree import RobotTree
 
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import ArrayLike
+
+    from tumble.trajectory import Trajectory
+
 __all__ = [
     "Link", "Frame", "RobotTree", "SerialChain", "load", "space_manipulator",
     "frame_poses", "frame_pose", "frame_jacobian", "center_of_mass", "centroidal_momentum_matrix",
@@ -51,8 +61,10 @@ __all__ = [
 ]
 
 
-def simulate(chain, q0, qd0, *, t, torque=None, method="rk4", dt=None, rtol=1e-10, atol=1e-12, gravity=None,
-             max_steps=None):
+def simulate(chain: RobotTree, q0: ArrayLike, qd0: ArrayLike, *, t: ArrayLike,
+             torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None = None,
+             method: str = "rk4", dt: float | None = None, rtol: float = 1e-10, atol: float = 1e-12,
+             gravity: ArrayLike | None = None, max_steps: int | None = None) -> Trajectory:
     """Deprecated: use ``tumble.simulate(chain, q0=q0, qd0=qd0, t=t, ...)``, which this forwards to.
 
     ``gravity`` (m/s², base frame) runs ``chain.with_gravity(gravity)``; of
@@ -66,7 +78,7 @@ def simulate(chain, q0, qd0, *, t, torque=None, method="rk4", dt=None, rtol=1e-1
                   DeprecationWarning, stacklevel=2)
     if gravity is not None:
         chain = chain.with_gravity(gravity)
-    given = {"dt": dt, "rtol": rtol, "atol": atol, "max_steps": max_steps}
+    given: dict[str, Any] = {"dt": dt, "rtol": rtol, "atol": atol, "max_steps": max_steps}
     reads = METHODS[method].options if method in METHODS else ()
     return tumble.simulate(chain, q0=q0, qd0=qd0, t=t, torque=torque, method=method,
                            **{name: given[name] for name in reads})

@@ -20,11 +20,13 @@ with ``θᵢ = qᵢ + theta`` (revolute) or ``dᵢ = qᵢ + d`` (prismatic).
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._inertia import as_shape
 from tumble._validate import ValidationError, as_array
@@ -107,8 +109,8 @@ class SerialChain(RobotTree):
 
     __slots__ = ()
 
-    def __init__(self, links: Sequence[Link], *, gravity=DEFAULT_GRAVITY, name: str | None = None,
-                 frames: Sequence[Frame] = ()):
+    def __init__(self, links: Sequence[Link], *, gravity: ArrayLike = DEFAULT_GRAVITY, name: str | None = None,
+                 frames: Sequence[Frame] = ()) -> None:
         links = tuple(links)
         for k, link in enumerate(links):
             if isinstance(link, Link) and link.joint == "floating":
@@ -119,7 +121,7 @@ class SerialChain(RobotTree):
     # -- constructors ---------------------------------------------------------
 
     @classmethod
-    def from_dh(cls, links: Sequence[Mapping], *, convention: str = "standard", gravity=DEFAULT_GRAVITY,
+    def from_dh(cls, links: Sequence[Mapping], *, convention: str = "standard", gravity: ArrayLike = DEFAULT_GRAVITY,
                 name: str | None = None, check_triangle: bool = True) -> SerialChain:
         """A chain from a Denavit–Hartenberg table, one mapping per joint (base to tip).
 
@@ -142,7 +144,8 @@ class SerialChain(RobotTree):
 
     @classmethod
     def from_urdf(  # type: ignore[override]  # a chain has no floating base and no mimic joints to ask for
-            cls, source, *, check_triangle: bool = True, gravity=DEFAULT_GRAVITY) -> SerialChain:
+            cls, source: str | os.PathLike[str], *, check_triangle: bool = True,
+            gravity: ArrayLike = DEFAULT_GRAVITY) -> SerialChain:
         """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         Refused when the URDF describes a tree or has mimic joints (use :meth:`RobotTree.from_urdf`)."""
@@ -150,7 +153,7 @@ class SerialChain(RobotTree):
         description.require_serial()
         return cls(description.links, gravity=gravity, name=description.name, frames=description.frames)
 
-    def with_gravity(self, gravity) -> SerialChain:
+    def with_gravity(self, gravity: ArrayLike) -> SerialChain:
         """The same chain under the gravitational acceleration ``gravity`` (3,), m/s², base frame.
 
         E.g. ``chain.with_gravity((0, 0, -1.62))`` on the Moon, or ``(0, 0, 0)`` to see the
@@ -167,7 +170,7 @@ class SerialChain(RobotTree):
 _TOML_KEYS = {"name", "convention", "gravity", "check_triangle", "source", "link"}
 
 
-def load(path) -> RobotTree:
+def load(path: str | os.PathLike[str]) -> RobotTree:
     """A robot from a robot file: a DH table in TOML (``.toml``) or a URDF (``.urdf``, ``.xml``).
 
     A URDF gives a :class:`SerialChain` when it describes a serial chain

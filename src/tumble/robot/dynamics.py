@@ -37,6 +37,7 @@ from functools import cached_property
 
 import numba
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import featherstone as _kernels
@@ -95,7 +96,8 @@ class _SingleState:
 _one = _SingleState()
 
 
-def _three(model: RobotTree, a, b, c, names: tuple[str, str, str]):
+def _three(model: RobotTree, a: ArrayLike, b: ArrayLike, c: ArrayLike, names: tuple[str, str, str]
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A configuration (nq,) or (B, nq) and two velocity-like arrays (nv,) or (B, nv), checked and named."""
     a = _joints(model, a, names[0], model._nq)
     return a, _like(model, a, b, names[1]), _like(model, a, c, names[2])
@@ -149,7 +151,8 @@ def _explain(what: str, cause: str, **inputs) -> None:
     raise ValidationError(f"{what}: the result is not finite although the inputs are: {cause}")
 
 
-def _loads(model: RobotTree, q, gravity, f_ext):
+def _loads(model: RobotTree, q: np.ndarray, gravity: ArrayLike | None, f_ext: ArrayLike | None
+           ) -> tuple[np.ndarray, np.ndarray]:
     """The gravity vector (m/s²) and the end-link wrench array of a call (the chain's defaults when None)."""
     g = model._gravity if gravity is None else _gravity(gravity)
     if f_ext is None:
@@ -157,7 +160,8 @@ def _loads(model: RobotTree, q, gravity, f_ext):
     return g, _wrench(model, f_ext, q)
 
 
-def rnea(model: RobotTree, q, qd, qdd, *, gravity=None, f_ext=None) -> np.ndarray:
+def rnea(model: RobotTree, q: ArrayLike, qd: ArrayLike, qdd: ArrayLike, *, gravity: ArrayLike | None = None,
+         f_ext: ArrayLike | None = None) -> np.ndarray:
     """Inverse dynamics ``τ = M(q) q̈ + C(q, q̇) q̇ + g(q) − J(q)ᵀ w_ext`` (recursive Newton–Euler).
 
     ``q`` (rad or m), ``qd`` (rad/s or m/s), ``qdd`` (rad/s² or m/s²) of shape
@@ -181,21 +185,21 @@ def rnea(model: RobotTree, q, qd, qdd, *, gravity=None, f_ext=None) -> np.ndarra
     return tau
 
 
-def gravity_torques(model: RobotTree, q, *, gravity=None) -> np.ndarray:
+def gravity_torques(model: RobotTree, q: ArrayLike, *, gravity: ArrayLike | None = None) -> np.ndarray:
     """``g(q)``: the joint torques that hold the chain still against gravity, ``rnea(q, 0, 0)``."""
     q = _joints(model, q, "q")
     zero = np.zeros((*q.shape[:-1], model._nv))
     return rnea(model, q, zero, zero, gravity=gravity)
 
 
-def coriolis(model: RobotTree, q, qd) -> np.ndarray:
+def coriolis(model: RobotTree, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """``C(q, q̇) q̇``: Coriolis and centrifugal torques, ``rnea(q, q̇, 0)`` without gravity."""
     q = _joints(model, q, "q")
     zero = np.zeros((*q.shape[:-1], model._nv))
     return rnea(model, q, qd, zero, gravity=np.zeros(3))
 
 
-def mass_matrix(model: RobotTree, q) -> np.ndarray:
+def mass_matrix(model: RobotTree, q: ArrayLike) -> np.ndarray:
     """Joint-space inertia matrix ``M(q)``, (n, n) or (B, n, n), symmetric positive definite.
 
     The composite-rigid-body algorithm, Featherstone (2008) Table 6.2. Units
@@ -218,7 +222,8 @@ def mass_matrix(model: RobotTree, q) -> np.ndarray:
     return M
 
 
-def forward_dynamics(model: RobotTree, q, qd, tau, *, gravity=None, f_ext=None) -> np.ndarray:
+def forward_dynamics(model: RobotTree, q: ArrayLike, qd: ArrayLike, tau: ArrayLike, *, gravity: ArrayLike | None = None,
+                     f_ext: ArrayLike | None = None) -> np.ndarray:
     """Forward dynamics ``q̈ = M(q)⁻¹ (τ + J(q)ᵀ w_ext − C(q, q̇) q̇ − g(q))``, articulated-body algorithm.
 
     O(n) in the number of joints: Featherstone (2008) Table 7.1. Shapes and
@@ -241,7 +246,7 @@ def forward_dynamics(model: RobotTree, q, qd, tau, *, gravity=None, f_ext=None) 
     return qdd
 
 
-def link_poses(model: RobotTree, q) -> np.ndarray:
+def link_poses(model: RobotTree, q: ArrayLike) -> np.ndarray:
     """Poses of the link frames in the base frame: (n, 4, 4) or (B, n, 4, 4) homogeneous transforms.
 
     ``T[i] = [[R, p], [0, 1]]``: ``R`` maps link-i axes to base axes, ``p`` is
@@ -265,12 +270,12 @@ def _energies(model, q, qd, gravity):
     return out
 
 
-def kinetic_energy(model: RobotTree, q, qd) -> np.ndarray | float:
+def kinetic_energy(model: RobotTree, q: ArrayLike, qd: ArrayLike) -> np.ndarray | float:
     """Kinetic energy ``T = ½ q̇ᵀ M(q) q̇ = Σᵢ ½ vᵢᵀ Iᵢ vᵢ`` (J), shape () or (B,)."""
     return _energies(model, q, qd, None)[..., 0]
 
 
-def potential_energy(model: RobotTree, q, *, gravity=None) -> np.ndarray | float:
+def potential_energy(model: RobotTree, q: ArrayLike, *, gravity: ArrayLike | None = None) -> np.ndarray | float:
     """Gravitational potential energy ``V = −Σᵢ mᵢ g · cᵢ`` (J), zero at the base origin; shape () or (B,).
 
     ``cᵢ``: centre of mass of link i in the base frame.

@@ -21,6 +21,7 @@ for analysis, not hot loops.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError
 from tumble.kernels import featherstone as _kernels
@@ -56,7 +57,7 @@ def _frame(model: RobotTree, name: str):
     raise ValidationError(f"frame: no frame named {name!r}; this robot has {list(model.frame_names)}")
 
 
-def frame_poses(model: RobotTree, q) -> np.ndarray:
+def frame_poses(model: RobotTree, q: ArrayLike) -> np.ndarray:
     """Poses ``T_WF`` of every named frame (``model.frame_names`` order): (nf, 4, 4) or (B, nf, 4, 4).
 
     ``T = [[R, p], [0, 1]]``: ``R`` maps frame axes to world axes, ``p`` the frame origin (m), world frame.
@@ -75,7 +76,7 @@ def frame_poses(model: RobotTree, q) -> np.ndarray:
     return T
 
 
-def frame_pose(model: RobotTree, q, name: str) -> np.ndarray:
+def frame_pose(model: RobotTree, q: ArrayLike, name: str) -> np.ndarray:
     """Pose ``T_WF`` (4, 4) or (B, 4, 4) of the frame ``name`` (see :func:`frame_poses`)."""
     index = model.frame_names.index(_frame(model, name).name)
     return frame_poses(model, q)[..., index, :, :]
@@ -110,7 +111,7 @@ def _point_jacobian(model: RobotTree, R, p, body: int, x: np.ndarray) -> np.ndar
     return J
 
 
-def frame_jacobian(model: RobotTree, q, name: str) -> np.ndarray:
+def frame_jacobian(model: RobotTree, q: ArrayLike, name: str) -> np.ndarray:
     """Jacobian ``J`` (6, nv) of the frame ``name``: ``(ω_F, v_F) = J(q) q̇``, world axes, ``v_F`` the velocity of
     the frame origin (m/s); one configuration ``q`` (nq,)."""
     q = _joints(model, q, "q", model._nq)
@@ -138,7 +139,7 @@ def _mass_properties(model: RobotTree, R, p):
     return m, com, np.einsum("bij,bjk,blk->bil", R, I_c, R)
 
 
-def center_of_mass(model: RobotTree, q) -> np.ndarray:
+def center_of_mass(model: RobotTree, q: ArrayLike) -> np.ndarray:
     """Centre of mass of the whole robot (3,) or (B, 3), m, world frame: ``Σ mᵢ cᵢ / Σ mᵢ``."""
     R, p = _bodies(model, q)
     P = model._params
@@ -146,7 +147,7 @@ def center_of_mass(model: RobotTree, q) -> np.ndarray:
     return first.sum(axis=-2) / P[:, 17].sum()
 
 
-def centroidal_momentum_matrix(model: RobotTree, q) -> np.ndarray:
+def centroidal_momentum_matrix(model: RobotTree, q: ArrayLike) -> np.ndarray:
     """Orin's centroidal momentum matrix ``A_G`` (6, nv): ``(k_G, l) = A_G(q) q̇``; one configuration.
 
     ``k_G = Σ [I_cᵢ ωᵢ + (cᵢ − c) × mᵢ v_cᵢ]`` (N·m·s) is the angular momentum
@@ -170,7 +171,7 @@ def centroidal_momentum_matrix(model: RobotTree, q) -> np.ndarray:
     return A
 
 
-def centroidal_momentum(model: RobotTree, q, qd) -> np.ndarray:
+def centroidal_momentum(model: RobotTree, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
     """``h_G = (k_G, l) = A_G(q) q̇`` (6,): angular momentum about the centre of mass and linear momentum,
     world axes (N·m·s, N·s); one state."""
     q = _joints(model, q, "q", model._nq)

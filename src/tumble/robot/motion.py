@@ -31,9 +31,11 @@ extra ``beyond_limits`` says, per sample, whether a joint has left its range.
 from __future__ import annotations
 
 import abc
+from collections.abc import Callable
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import _callback, torques
 from tumble._validate import ValidationError, as_array
@@ -44,6 +46,7 @@ from tumble.trajectory import Extra
 
 if TYPE_CHECKING:
     from tumble.robot.tree import RobotTree
+    from tumble.trajectory import Trajectory
 
 __all__ = ["ChainMotion"]
 
@@ -131,7 +134,8 @@ class ChainMotion(Model):
                                             "(default 0)", default=np.zeros(3)),
         )
 
-    def compile(self, torque, t0: float) -> _kernel.RobotModel:
+    def compile(self, torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None,
+                t0: float) -> _kernel.RobotModel:
         law, slot, constant = self._torque_law(torque)
         return _kernel.RobotModel(params=self._params, sizes=np.array([self.nq, self.nv], dtype=np.int64),
                                   gravity=self._gravity, law=np.array([law, slot], dtype=np.int64),
@@ -153,14 +157,14 @@ class ChainMotion(Model):
                                   f"(N·m or N); got shape {tau.shape}")
         return _kernel.CONSTANT, 0, np.array(tau)
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.RobotModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         if not self.floating_base:
             return _kernel.initial_states(values["q0"], values["qd0"])
         q = np.concatenate([values["base_position0"], values["base_q0"], values["q0"]], axis=-1)
         qd = np.concatenate([values["base_omega0"], values["base_velocity0"], values["qd0"]], axis=-1)
         return _kernel.initial_states(q, qd)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.RobotModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         """The joint motion at the samples, the applied torques (the law evaluated there: a Python function
         is called once more per sample), the work ``W`` and the energy ``T + V`` (J)."""
         n, nq, nv = self.dof, self.nq, self.nv
@@ -210,7 +214,7 @@ class ChainMotion(Model):
             "linear_momentum": Extra(h[..., 3:6], vector, "N s", "total linear momentum, world axes"),
         }
 
-    def invariants(self, traj) -> dict[str, np.ndarray]:
+    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """``E − W``, J (n, [N]): the energy ``T + V`` less the work of the joint torques, ``E(0)`` along the
         exact motion under any torque law (gravity is conservative, the joints frictionless)."""
         return {"energy_minus_work": traj.energy - traj.work}

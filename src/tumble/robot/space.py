@@ -22,6 +22,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._inertia import as_rotation, as_shape
 from tumble._validate import ValidationError
@@ -33,8 +34,8 @@ from tumble.robot.tree import RobotTree
 __all__ = ["space_manipulator"]
 
 
-def space_manipulator(hub: RigidBody, arm: SerialChain, *, mount_position=(0.0, 0.0, 0.0), mount_rotation=None,
-                      name: str | None = None) -> RobotTree:
+def space_manipulator(hub: RigidBody, arm: SerialChain, *, mount_position: ArrayLike = (0.0, 0.0, 0.0),
+                      mount_rotation: ArrayLike | None = None, name: str | None = None) -> RobotTree:
     """The hub and the arm as one floating-base tree (see the module docstring), gravity zero."""
     if not isinstance(hub, RigidBody) or hub.mass is None:
         raise ValidationError("hub: must be a tumble.RigidBody with a mass (kg)")

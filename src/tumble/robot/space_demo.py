@@ -22,21 +22,24 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.robot.chain import SerialChain
 from tumble.robot.link import Link
 from tumble.robot.space import space_manipulator
+from tumble.robot.tree import RobotTree
 from tumble.simulate import simulate
 from tumble.trajectory import write_atomic
 
 __all__ = ["demo_space_arm", "space_arm", "reference"]
 
 #: The hub: a 100 kg box 1 × 1 × 0.8 m (inertia about its centre, kg m²).
-HUB = dict(mass=100.0, inertia=np.diag([13.67, 13.67, 16.67]))
+HUB: dict[str, Any] = dict(mass=100.0, inertia=np.diag([13.67, 13.67, 16.67]))
 #: The arm, mounted at MOUNT on the hub's +x face: two links turning about the hub's z axis, each with its
 #: mass (kg), length (m, the next joint's offset), centre of mass along the link (m) and moment about z (kg m²).
 ARM = (dict(mass=12.0, length=1.5, com=0.75, inertia=2.25), dict(mass=8.0, length=1.2, com=0.6, inertia=0.96))
@@ -48,17 +51,18 @@ _SAMPLES = 501
 _TOLERANCE = 1e-11
 
 
-def space_arm():
+def space_arm() -> RobotTree:
     """The hub and arm of the module's constants as one floating-base :class:`~tumble.robot.RobotTree`."""
-    links = [Link(joint="revolute", axis=(0.0, 0.0, 1.0), origin_position=(0.0 if k == 0 else ARM[k - 1]["length"],
-                                                                           0.0, 0.0),
-                  mass=a["mass"], com=(a["com"], 0.0, 0.0), inertia=np.diag([0.01, a["inertia"], a["inertia"]]),
+    links = [Link(joint="revolute", axis=np.array((0.0, 0.0, 1.0)),
+                  origin_position=np.array((0.0 if k == 0 else ARM[k - 1]["length"], 0.0, 0.0)),
+                  mass=a["mass"], com=np.array((a["com"], 0.0, 0.0)),
+                  inertia=np.diag([0.01, a["inertia"], a["inertia"]]),
                   name=("shoulder", "elbow")[k]) for k, a in enumerate(ARM)]
     hub = RigidBody(HUB["inertia"], mass=HUB["mass"])
     return space_manipulator(hub, SerialChain(links), mount_position=MOUNT, name="two-link arm on a free hub")
 
 
-def reference(t):
+def reference(t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """The commanded joint angles (rad) and rates (rad/s) at times ``t`` (s): a quintic from 0 to
     :data:`TARGET` over :data:`MANOEUVRE` s, zero rate and acceleration at both ends, then held."""
     u = np.clip(np.asarray(t, dtype=float) / MANOEUVRE, 0.0, 1.0)
@@ -73,7 +77,7 @@ def _law(t, q, qd):
     return GAINS[0] * (q_ref - q[7:]) + GAINS[1] * (qd_ref - qd[6:])
 
 
-def demo_space_arm(out_dir) -> dict:
+def demo_space_arm(out_dir: str | os.PathLike[str]) -> dict:
     """Run the manoeuvre (dop853, rtol = atol = 1e-11, :data:`DURATION` s from rest) and write
     ``space_arm.nc`` and ``space_arm.png`` in ``out_dir`` (an existing directory).
 

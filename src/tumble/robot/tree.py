@@ -32,8 +32,10 @@ base/world frame). :func:`tumble.robot.frame_poses` and
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Mapping, Sequence
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._inertia import as_rotation, as_shape, frozen, parallel_axis
 from tumble._validate import ValidationError, as_array
@@ -81,8 +83,8 @@ class RobotTree(ChainMotion):
     _coordinate_links: tuple[int, ...]  # the links of the independent joint coordinates
     _workspace: np.ndarray  # scratch of the single-state entries (tumble.robot.dynamics)
 
-    def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity=DEFAULT_GRAVITY,
-                 name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None):
+    def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity: ArrayLike = DEFAULT_GRAVITY,
+                 name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None) -> None:
         links = tuple(links)
         if not links:
             raise ValidationError("links: a robot needs at least one link")
@@ -125,8 +127,8 @@ class RobotTree(ChainMotion):
         set_(self, "_workspace", _kernels.workspace(len(links), nv))
 
     @classmethod
-    def from_urdf(cls, source, *, floating_base: bool = False, mimic: bool = True, check_triangle: bool = True,
-                  gravity=DEFAULT_GRAVITY) -> RobotTree:
+    def from_urdf(cls, source: str | os.PathLike[str], *, floating_base: bool = False, mimic: bool = True,
+                  check_triangle: bool = True, gravity: ArrayLike = DEFAULT_GRAVITY) -> RobotTree:
         """A tree from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         ``floating_base=True`` makes the root link a free body (configuration ``[r, quat, joints]``);
@@ -218,18 +220,18 @@ class RobotTree(ChainMotion):
         """(nb, 45) array the compiled algorithms read (layout in :mod:`tumble.kernels.featherstone`), a copy."""
         return self._params.copy()
 
-    def joint_coordinates(self, q) -> np.ndarray:
+    def joint_coordinates(self, q: ArrayLike) -> np.ndarray:
         """The joint part ``q[..., nq − dof:]`` of configurations (…, nq) (the floating base's 7 dropped)."""
         q = as_array(q, "q", tail=(self._nq,))
         return q[..., self._nq - self.dof:]
 
-    def within_limits(self, q) -> np.ndarray | bool:
+    def within_limits(self, q: ArrayLike) -> np.ndarray | bool:
         """True where ``lower ≤ q ≤ upper`` for every joint; ``q`` of shape (…, nq)."""
         joints = self.joint_coordinates(q)
         ok = np.asarray(((joints >= self._lower) & (joints <= self._upper)).all(axis=-1))
         return bool(ok) if ok.ndim == 0 else ok
 
-    def with_gravity(self, gravity) -> RobotTree:
+    def with_gravity(self, gravity: ArrayLike) -> RobotTree:
         """The same robot under the gravitational acceleration ``gravity`` (3,), m/s², world frame."""
         return RobotTree(self._links, self._parents, gravity=gravity, name=self._name, frames=self._frames,
                          mimic=self._mimic)

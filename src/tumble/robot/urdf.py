@@ -32,6 +32,7 @@ Reference: ROS URDF XML specification, http://wiki.ros.org/urdf/XML.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -155,7 +156,8 @@ class UrdfRobot:
             self.parents == tuple(range(-1, len(self.links) - 1)) and self.links[0].joint != "floating"
 
 
-def read_urdf(source, *, check_triangle: bool = True, floating_base: bool = False, mimic: bool = True) -> UrdfRobot:
+def read_urdf(source: str | os.PathLike[str], *, check_triangle: bool = True, floating_base: bool = False,
+              mimic: bool = True) -> UrdfRobot:
     """The robot described by a URDF file (path) or document (a string starting with ``<``).
 
     ``mimic=False`` reads ``<mimic>`` joints as independent joints (as Pinocchio's parser does by default)."""

@@ -31,7 +31,7 @@ have no table: scenario files are data.
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal, Union, cast
 
 import numpy as np
 from pydantic import Field, field_validator
@@ -79,7 +79,7 @@ class PDTable(Regulator):
     max_rate: _Limit = math.inf
     max_torque: _Limit = math.inf
 
-    def build(self):
+    def build(self) -> control.QuaternionPD:
         return control.QuaternionPD(self.natural_frequency, self.damping_ratio, target=self.target_quaternion(),
                                     max_rate=self.max_rate, max_torque=self.max_torque)
 
@@ -94,7 +94,7 @@ class MRPTable(Regulator):
     P: _FlatOrRows[_Positive, _Matrix]
     Ki: _Positive | None = None
 
-    def build(self):
+    def build(self) -> control.MRPFeedback:
         return control.MRPFeedback(self.K, self.P, Ki=self.Ki, target=self.target_quaternion())
 
 
@@ -103,7 +103,7 @@ class RateDampingTable(_Table):
     time_constant: _Positive
     max_torque: _Limit = math.inf
 
-    def build(self):
+    def build(self) -> control.RateDamping:
         return control.RateDamping(self.time_constant, self.max_torque)
 
 
@@ -111,15 +111,15 @@ class ConstantTorqueTable(_Table):
     kind: Literal["constant_torque"]
     torque: _Vector
 
-    def build(self):
-        return control.ConstantTorque(self.torque)
+    def build(self) -> control.ConstantTorque:
+        return control.ConstantTorque(cast(Any, self.torque))  # array_like: the law converts it
 
 
 class BDotTable(_Table):
     kind: Literal["bdot"]
     gain: _Positive
 
-    def build(self):
+    def build(self) -> control.BDot:
         return control.BDot(self.gain)
 
 
@@ -127,7 +127,7 @@ class DumpingTable(_Table):
     kind: Literal["momentum_dumping"]
     gain: _Positive
 
-    def build(self):
+    def build(self) -> control.MomentumDumping:
         return control.MomentumDumping(self.gain)
 
 
@@ -150,7 +150,7 @@ class WheelTorquesTable(_Table):
             raise ValueError("only with times: constant torques are not interpolated")
         return interpolation
 
-    def build(self):
+    def build(self) -> control.WheelTorques:
         return control.WheelTorques(self.torques, self.times, **({} if self.interpolation is None else
                                                                   {"interpolation": self.interpolation}))
 

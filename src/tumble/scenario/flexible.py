@@ -30,7 +30,7 @@ The external torque on the hub is the shared ``[[torque]]`` list
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 from pydantic import Field
@@ -44,6 +44,9 @@ from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import TabulatedTorque, Torque, build_torque
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["FlexibleScenario"]
 
@@ -106,7 +109,7 @@ class FlexibleScenario(Scenario):
             return Run(model, initial, self.time.times(), self.solver.method, self.solver.options(), torque, keys,
                        self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:func:`tumble.flexible.slew_figure` for a rotation about body z (the figure's slew axis), else
         :meth:`tumble.Trajectory.plot`.
 

@@ -36,7 +36,7 @@ of :func:`tumble.simulate`; a key the chosen rotor does not have is refused.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import TYPE_CHECKING, Annotated, Literal, Union
 
 import numpy as np
 from pydantic import Field
@@ -48,6 +48,9 @@ from tumble.scenario._run import RUN_KEYS, Run
 from tumble.scenario._values import _Number, _Table, _Vector
 from tumble.scenario.tables import ModelState, Solver, Time
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["GyroscopeScenario"]
 
@@ -121,7 +124,7 @@ class GyroscopeScenario(Scenario):
             return Run(model, initial, self.time.times(), self.solver.method, self.solver.options(), keys=keys,
                        source=self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:meth:`tumble.Trajectory.plot` of the rotor, titled with the scenario's name."""
         return traj.plot(title=self.name)
 

@@ -31,7 +31,7 @@ The body takes no external torque (in the air).
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, cast
 
 import numpy as np
 from pydantic import create_model
@@ -46,6 +46,9 @@ from tumble.trajectory import Trajectory
 from tumble.variable import Human, Motion
 from tumble.variable.demo import figure_dive
 from tumble.variable.diver import Dive, orientation_angles
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["HumanScenario"]
 
@@ -127,14 +130,14 @@ class HumanScenario(Scenario):
             return Run(model, initial, self.time.times(), self.solver.method, self.solver.options(), keys=keys,
                        source=self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:func:`tumble.variable.demo.figure_dive` (poses seen along ``L``, somersault and twist, tilt, arms,
         energy) when the angular momentum lies along inertial x, the somersault axis of
         :mod:`tumble.variable.diver`; else :meth:`tumble.Trajectory.plot`."""
         momentum = traj.momentum_inertial[0]
         if not np.linalg.norm(momentum[1:]) <= _ALONG_X * np.linalg.norm(momentum[0]):
             return traj.plot(title=self.name)
-        dive = Dive(traj, orientation_angles(traj.q, momentum), float(momentum[0]))
+        dive = Dive(traj, orientation_angles(cast(np.ndarray, traj.q), momentum), float(momentum[0]))
         return figure_dive(self.human.body(), dive, self.name or "a human body in flight")
 
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
@@ -142,7 +145,7 @@ class HumanScenario(Scenario):
         momentum = traj.momentum_inertial[0]
         rows = rate_and_energy_rows(traj)
         if np.any(momentum):
-            angles = orientation_angles(traj.q, momentum)
+            angles = orientation_angles(cast(np.ndarray, traj.q), momentum)
             rows.insert(0, ("turns", f"{angles.somersaults:+.4g} somersaults, {angles.twists:+.4g} twists "
                                      "(Yeadon's angles about L)"))
         return rows

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,6 +28,9 @@ from tumble.scenario.torques import Torque, build_torque
 from tumble.simulate import SolverOptions, simulate
 from tumble.spacecraft import Spacecraft, SphericalDamper
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["DamperTable", "Problem", "RigidScenario"]
 
@@ -72,7 +75,7 @@ class Problem:
     damper_omega0: np.ndarray | None = None
 
     @property
-    def model(self):
+    def model(self) -> RigidBody | Spacecraft:
         """The tumble model: the body, or with a damper the spacecraft of hub and damper."""
         if self.damper is None:
             return self.body
@@ -125,6 +128,6 @@ class RigidScenario(Scenario):
                            method=self.solver.method, options=self.solver.options(), torque=torque,
                            source=self.source, damper=damper, damper_omega0=damper_omega0)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:meth:`tumble.Trajectory.plot` of the run, titled with the scenario's name."""
         return traj.plot(title=self.name)

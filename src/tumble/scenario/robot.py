@@ -23,7 +23,7 @@ the joint limits of the robot file are not enforced.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import numpy as np
 from pydantic import Field
@@ -35,6 +35,9 @@ from tumble.scenario._run import RUN_KEYS, Run
 from tumble.scenario._values import _Number, _Table, _Text, _Vector
 from tumble.scenario.tables import ModelState, Solver, Time
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["RobotScenario"]
 
@@ -86,7 +89,7 @@ class RobotScenario(Scenario):
             return Run(chain, self.initial.state(chain), self.time.times(), self.solver.method,
                        self.solver.options(), torque, keys, self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:meth:`tumble.Trajectory.plot`: joint coordinates, energy, joint rates; titled with the scenario's name."""
         return traj.plot(title=self.name)
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 from pydantic import field_validator
+from typing import TYPE_CHECKING
 
 from tumble import slosh
 from tumble.scenario._base import Scenario
@@ -40,6 +41,9 @@ from tumble.scenario._values import _Number, _Table, _Vector
 from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import Torque, build_torque
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["SloshScenario"]
 
@@ -110,7 +114,7 @@ class SloshScenario(Scenario):
         (:func:`tumble.slosh.nutation_angle`)."""
         return slosh.nutation_angle(self.model, traj, self.slosh.spin_axis)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:func:`tumble.slosh.nutation_figure`: the nutation angle from ``spin_axis``, the energy and ``|H|``."""
         figure = slosh.nutation_figure(traj, self.nutation_angle(traj), traj.momentum_norm, traj.energy)
         axis = ", ".join(f"{x:g}" for x in self.slosh.spin_axis)

@@ -44,7 +44,7 @@ top of the spacecraft's own environment) are the shared tables
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal, Protocol
+from typing import TYPE_CHECKING, Annotated, Any, Literal, Protocol, cast
 
 import numpy as np
 from pydantic import Field, field_validator, model_validator
@@ -65,6 +65,9 @@ from tumble.spacecraft import actuators
 from tumble.spacecraft.environment import DipoleField
 from tumble.spacecraft.model import Spacecraft
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["SpacecraftScenario"]
 
@@ -89,7 +92,7 @@ class _WheelProperties(_Table):
 class Wheel(_WheelProperties):
     axis: _Vector
 
-    def build(self):
+    def build(self) -> actuators.ReactionWheel:
         return actuators.ReactionWheel(**self.model_dump())
 
 
@@ -99,7 +102,7 @@ class WheelPyramid(_WheelProperties):
 
     skew: _Positive = _MAGIC_SKEW
 
-    def build(self):
+    def build(self) -> list[actuators.ReactionWheel]:
         return actuators.pyramid_wheels(**self.model_dump())
 
 
@@ -121,7 +124,7 @@ class HubTable(_InertiaOrMoments):
 
     def build(self) -> RigidBody:
         inertia = self.inertia if self.moments is None else np.diag(self.moments)  # exactly one is given
-        return RigidBody(inertia, mass=self.mass, com=self.com)
+        return RigidBody(cast(Any, inertia), mass=self.mass, com=self.com)
 
 
 class CMGPyramid(_Table):
@@ -147,7 +150,7 @@ class CMGPyramid(_Table):
             raise ValueError('only with steering = "generalised" (the dither of the generalised SR inverse)')
         return value
 
-    def build(self):
+    def build(self) -> actuators.CMGCluster:
         dither = {"dither", "dither_frequency", "dither_phases"}
         cluster = actuators.CMGCluster.pyramid(**self.model_dump(exclude={"steering", *dither}))
         if self.steering == "singularity_robust":
@@ -160,7 +163,7 @@ class ThrusterTable(_Table):
     direction: _Vector
     force: _Positive
 
-    def build(self):
+    def build(self) -> actuators.Thruster:
         return actuators.Thruster(**self.model_dump())
 
 
@@ -171,15 +174,15 @@ class PWPFTable(_Table):
     off: _Number = 0.15
     min_on_time: _Number = 0.0
 
-    def build(self):
+    def build(self) -> actuators.PWPF:
         return actuators.PWPF(**self.model_dump())
 
 
 class MagnetorquerTable(_Table):
     max_dipole: _Positive
 
-    def build(self):
-        return actuators.Magnetorquers(self.max_dipole)
+    def build(self) -> actuators.Magnetorquers:
+        return actuators.Magnetorquers(cast(Any, self.max_dipole))  # a number or (3,): converted there
 
 
 class FieldTable(_Table):
@@ -194,7 +197,7 @@ class FieldTable(_Table):
             raise ValueError("give exactly one of model = \"dipole\" or uniform")
         return self
 
-    def build(self):
+    def build(self) -> DipoleField | np.ndarray:
         return DipoleField() if self.model == "dipole" else np.array(self.uniform)
 
 
@@ -333,7 +336,7 @@ class SpacecraftScenario(Scenario):
                 return law.target_quaternion()
         return None
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:func:`tumble.spacecraft.figure.spacecraft_figure` of a run of this scenario, titled with its name."""
         from tumble.spacecraft.figure import spacecraft_figure
 

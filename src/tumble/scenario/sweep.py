@@ -40,8 +40,8 @@ Angles are in rad.
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable
-from typing import Literal
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pydantic import model_validator
 
@@ -51,6 +51,14 @@ from tumble.scenario._run import Run
 from tumble.scenario._values import _Bool, _Number, _Table, _Text
 from tumble.sweep import dispersions as _d
 from tumble.sweep import outcomes as _o
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from tumble.scenario._base import Scenario
+    from tumble.scenario.rigid import Problem
+    from tumble.simulate import Model
+    from tumble.trajectory import Trajectory
 
 __all__ = ["SweepTable", "ScenarioModel", "sweep_arguments"]
 
@@ -104,16 +112,16 @@ class SeriesTable(_Table):
     below: _Number | None = None
     above: _Number | None = None
 
-    def series_function(self):
+    def series_function(self) -> Callable[[Trajectory], np.ndarray]:
         if self.series == "pointing_error":
             return _o.PointingError(*(() if self.target is None else (tuple(self.target),)))
         if self.series == "nutation_angle":
             return _o.NutationAngle(*(() if self.axis is None else (tuple(self.axis),)))
         if self.name is None:
             raise ValueError("component: needs name (a field or extra of the trajectory, e.g. 'omega')")
-        return _o.Component(self.name, () if self.index is None else self.index)
+        return _o.Component(self.name, () if self.index is None else cast(Any, self.index))  # made a tuple there
 
-    def outcome_function(self):
+    def outcome_function(self) -> Callable[[Trajectory], np.ndarray]:
         of = self.series_function()
         if self.reduce is None:
             raise ValueError("reduce: an outcome needs one of 'max', 'final', 'settling_time', 'crossing_time'")
@@ -121,7 +129,8 @@ class SeriesTable(_Table):
             return _o.Max(of, -float("inf") if self.after is None else self.after)
         if self.reduce == "final":
             return _o.Final(of)
-        bound = {"settling_time": ("below", _o.SettlingTime), "crossing_time": ("above", _o.CrossingTime)}
+        bound: dict[str, tuple[str, type[_o.SettlingTime] | type[_o.CrossingTime]]] = {
+            "settling_time": ("below", _o.SettlingTime), "crossing_time": ("above", _o.CrossingTime)}
         key, cls = bound[self.reduce]
         if getattr(self, key) is None:
             raise ValueError(f"{key}: reduce = {self.reduce!r} needs it")
@@ -144,11 +153,11 @@ class ScenarioModel:
     """``build(**values) -> model``: the scenario's model with the dotted keys ``values`` replaced, validated
     and built with every rule of the file (the model-side ``build`` of :func:`tumble.sweep`)."""
 
-    def __init__(self, scenario, keys):
+    def __init__(self, scenario: Scenario, keys: Iterable[str]) -> None:
         self.cls, self.data, self.source = type(scenario), scenario._data, scenario.source
         self.parameters = tuple(keys)
 
-    def __call__(self, **values):
+    def __call__(self, **values: Any) -> Model:
         data = copy.deepcopy(self.data)
         for key, value in values.items():
             *tables, last = key.split(".")
@@ -164,12 +173,12 @@ class ScenarioModel:
         return f"ScenarioModel({self.source!r}, keys={list(self.parameters)})"
 
 
-def as_run(problem) -> Run:
+def as_run(problem: Run | Problem) -> Run:
     """The :class:`~tumble.scenario.Run` of a built scenario (the rigid kind's problem converts itself)."""
     return problem if isinstance(problem, Run) else problem.as_run()
 
 
-def sweep_arguments(scenario, samples=None) -> dict:
+def sweep_arguments(scenario: Scenario, samples: int | None = None) -> dict:
     """The arguments of :func:`tumble.sweep` for a scenario with a ``[sweep]`` table (``samples`` overrides
     the file's)."""
     table = scenario.sweep
@@ -198,9 +207,9 @@ def sweep_arguments(scenario, samples=None) -> dict:
         statistics: dict[str, Callable] = {}
         for group, out, make in ((table.outcomes, outcomes, "outcome_function"),
                                  (table.statistics, statistics, "series_function")):
-            for name, entry in group.items():
+            for name, series in group.items():
                 try:
-                    out[name] = getattr(entry, make)()
+                    out[name] = getattr(series, make)()
                 except ValueError as exc:
                     kind = "outcomes" if out is outcomes else "statistics"
                     problems.append((f"sweep.{kind}.{name}", str(exc).partition("\n")[0]))

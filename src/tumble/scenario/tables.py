@@ -20,6 +20,9 @@ from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, 
                                      _Vector)
 from tumble.simulate import SolverOptions
 
+if TYPE_CHECKING:
+    from tumble.simulate import Model
+
 __all__ = ["Body", "EulerAngles", "Initial", "MAX_SAMPLES", "ModelState", "Solver", "Time"]
 
 # Most output times a scenario may ask for (10⁷ samples of t, q and ω are
@@ -216,7 +219,7 @@ class ModelState(_Table):
     has no suffix: a gimbaled gyro's ``spin``). A subclass lists the keys of every model of its kind; the
     model built decides which of them it takes (:meth:`state`)."""
 
-    def state(self, model, prefix: str = "initial") -> dict[str, np.ndarray]:
+    def state(self, model: Model, prefix: str = "initial") -> dict[str, np.ndarray]:
         """The initial state by name, as keywords of :func:`tumble.simulate` for ``model``.
 
         A key the model has no state field for is refused (a

@@ -24,9 +24,10 @@ The body takes no external torque.
 
 from __future__ import annotations
 
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar, cast
 
 import numpy as np
+from numpy.typing import ArrayLike
 from pydantic import model_validator
 
 from tumble.scenario._base import Scenario
@@ -36,6 +37,9 @@ from tumble.scenario._values import _Bool, _InertiaOrMoments, _Matrix, _Number, 
 from tumble.scenario.tables import Initial, Solver, Time
 from tumble.trajectory import Trajectory
 from tumble.variable import VariableBody
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["VariableScenario", "rate_and_energy_rows"]
 
@@ -59,7 +63,8 @@ class VariableTable(_InertiaOrMoments):
         return self
 
     def build(self) -> VariableBody:
-        inertia = self.inertia if self.moments is None else [np.diag(m) for m in self.moments]
+        # exactly one is given
+        inertia = cast(ArrayLike, self.inertia if self.moments is None else [np.diag(m) for m in self.moments])
         return VariableBody(self.times, inertia, self.shape_momentum, check_triangle=self.check_triangle)
 
 
@@ -82,7 +87,7 @@ class VariableScenario(Scenario):
             return Run(model, initial, self.time.times(), self.solver.method, self.solver.options(), keys=keys,
                        source=self.source)
 
-    def figure(self, traj: Trajectory):
+    def figure(self, traj: Trajectory) -> Figure:
         """:meth:`tumble.Trajectory.plot` of the run, titled with the scenario's name."""
         return traj.plot(title=self.name)
 

@@ -12,8 +12,10 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import Part
@@ -192,7 +194,8 @@ class CMGCluster:
         set_(self, "dither_phases", tuple(float(x) for x in phases))
 
     @classmethod
-    def pyramid(cls, momentum: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options):
+    def pyramid(cls, momentum: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))),
+                **options: Any) -> CMGCluster:
         """The four-CMG pyramid: gimbal axes normal to the faces of a pyramid whose faces are
         inclined by the skew angle ``β`` (degrees from the base plane; default 54.74°,
         ``atan √2``, for a nearly spherical momentum envelope), spin axes in the faces
@@ -211,7 +214,7 @@ class CMGCluster:
         return cls(np.array(g), np.array(s), np.full(4, require_positive(momentum, "momentum")), **options)
 
     def generalised(self, dither: float = 0.01, dither_frequency: float = 0.5 * math.pi,
-                    dither_phases=(0.0, 0.5 * math.pi, math.pi)) -> CMGCluster:
+                    dither_phases: tuple[float, float, float] = (0.0, 0.5 * math.pi, math.pi)) -> CMGCluster:
         """The same cluster steered by the generalised singularity-robust inverse, with Wie's dither by default
         (ε₀ = 0.01, ω_ε = π/2 rad/s, φ = (0, π/2, π); Wie 2008, §7.3)."""
         return dataclasses.replace(self, dither=dither, dither_frequency=dither_frequency, dither_phases=dither_phases)
@@ -242,7 +245,7 @@ class Thruster:
         object.__setattr__(self, "direction", _unit(self.direction, "direction"))
         object.__setattr__(self, "force", require_positive(self.force, "force"))
 
-    def torque(self, com=(0.0, 0.0, 0.0)) -> np.ndarray:
+    def torque(self, com: ArrayLike = (0.0, 0.0, 0.0)) -> np.ndarray:
         """``(r − c) × F`` (N·m, body axes)."""
         return np.cross(self.position - np.asarray(com, float), self.force * self.direction)
 
@@ -305,7 +308,8 @@ class Magnetorquers:
         return _magnetorquers.program(self.max_dipole)
 
 
-def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))), **options):
+def pyramid_wheels(inertia: float, *, skew: float = math.degrees(math.atan(math.sqrt(2.0))),
+                   **options: Any) -> list[ReactionWheel]:
     """Four identical reaction wheels in a pyramid about the body z axis: wheel ``i`` spins about
     ``(cos β cos ψ_i, cos β sin ψ_i, sin β)``, ``ψ_i = 90° i``, with ``β`` the elevation ``skew``
     (degrees; default 54.74°, equal control authority about the three axes). ``options`` go

@@ -46,8 +46,10 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
@@ -55,6 +57,9 @@ from tumble.kernels.spacecraft import damper as _kernel
 from tumble.kernels.spacecraft._base import Program
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from tumble.torques import TorqueLike
 
 __all__ = [
     "SphericalDamper",
@@ -94,9 +99,10 @@ class SphericalDamper:
         return _kernel.program(self.inertia, self.damping)
 
 
-def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0, *, t, q0=None, damper_omega0=None,
-                    method: str = "dop853", rtol: float | None = None, atol: float | None = None,
-                    dt: float | None = None, torque=None, max_steps: int | None = None,
+def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0: ArrayLike, *, t: ArrayLike,
+                    q0: ArrayLike | None = None, damper_omega0: ArrayLike | None = None, method: str = "dop853",
+                    rtol: float | None = None, atol: float | None = None, dt: float | None = None,
+                    torque: TorqueLike = None, max_steps: int | None = None,
                     progress: Callable[[int, int], None] | None = None) -> Trajectory:
     """Deprecated: ``tumble.simulate(Spacecraft(hub=body, damper=damper), omega0, ...)`` (the same run).
 
@@ -109,12 +115,13 @@ def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0, *, t, q0=N
 
     if not isinstance(body, RigidBody):
         raise ValidationError(f"body: must be a RigidBody (the hub, without the damper), got {type(body).__name__}")
-    initial = {name: value for name, value in (("q0", q0), ("damper_omega0", damper_omega0)) if value is not None}
+    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("damper_omega0", damper_omega0))
+                               if value is not None}
     return simulate(Spacecraft(hub=body, damper=damper), omega0, t=t, method=method, rtol=rtol, atol=atol, dt=dt,
                     max_steps=max_steps, torque=torque, progress=progress, **initial)
 
 
-def nutation_angle(traj: Trajectory, axis) -> np.ndarray:
+def nutation_angle(traj: Trajectory, axis: ArrayLike) -> np.ndarray:
     """Angle (rad) between the body axis ``axis`` (body axes) and the total angular momentum of the
     trajectory's system (``traj.momentum_body``: hub, sphere, wheels), (n, [N])."""
     a = as_array(axis, "axis", tail=(3,))
@@ -150,7 +157,7 @@ def energy_sink_time_constant(axial: float, transverse: float, damper: Spherical
     return math.inf if rate == 0.0 else 1.0 / rate
 
 
-def measured_time_constant(t, angle, *, window: tuple[float, float]) -> float:
+def measured_time_constant(t: ArrayLike, angle: ArrayLike, *, window: tuple[float, float]) -> float:
     """Time constant ``τ`` (s) of an exponential ``angle ∝ e^{t/τ}``, fitted to the samples in ``window``.
 
     Least-squares line through ``ln angle`` against ``t`` over the samples

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from tumble._gravity import gravity_gradient_torque
 from tumble._validate import ValidationError, as_array, require_finite, require_positive
@@ -101,7 +102,7 @@ class DipoleField:
         return np.concatenate([[self.strength * self.radius**3], self.moment_direction(),
                                [self.earth_rate, self.greenwich_angle]])
 
-    def field(self, t, r) -> np.ndarray:
+    def field(self, t: ArrayLike, r: ArrayLike) -> np.ndarray:
         """Field (…, 3), T, inertial axes, at the times ``t`` (s) and inertial positions ``r`` (…, 3), m
         (broadcast together)."""
         t = as_array(t, "t")

@@ -12,10 +12,13 @@ Matplotlib's object-oriented API (no pyplot state). Panels, top to bottom:
 
 from __future__ import annotations
 
+import os
+
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude
 from tumble.trajectory import Trajectory, write_atomic
@@ -28,7 +31,7 @@ __all__ = ["spacecraft_figure", "save_spacecraft_figure"]
 _COLORS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown")
 
 
-def spacecraft_figure(traj: Trajectory, *, target=None, title: str | None = None) -> Figure:
+def spacecraft_figure(traj: Trajectory, *, target: ArrayLike | None = None, title: str | None = None) -> Figure:
     """The four panels described in the module docstring, for one spacecraft (no batch axis).
 
     ``target`` : unit quaternion ``[w, x, y, z]`` (body → inertial) of the commanded attitude.
@@ -98,7 +101,7 @@ def _actuators(ax, t, extras):
     ax.legend(loc="upper right", ncol=4, fontsize="small")
 
 
-def save_spacecraft_figure(traj: Trajectory, path, **options) -> Path:
+def save_spacecraft_figure(traj: Trajectory, path: str | os.PathLike[str], **options: Any) -> Path:
     """Draw :func:`spacecraft_figure` and write it to ``path`` (PNG) atomically; returns the path."""
     fig = spacecraft_figure(traj, **options)
     write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=110))

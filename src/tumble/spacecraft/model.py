@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
@@ -105,7 +106,7 @@ class Spacecraft(Model):
     torque = ("external torque on the spacecraft, body axes (N·m): a tumble.torques model or f(t, q, omega), "
               "in addition to its own environment")
 
-    inertia: object = None
+    inertia: RigidBody | ArrayLike | None = None
     hub: RigidBody | None = None
     wheels: Sequence[ReactionWheel] = ()
     cmgs: CMGCluster | None = None
@@ -285,7 +286,7 @@ class Spacecraft(Model):
         return _thrusters.program(torques_, axis.astype(float), sign, gain=p.gain, time_constant=p.time_constant,
                                   on=p.on, off=p.off, min_on_time=p.min_on_time, axis_torque=scale)
 
-    def compile(self, torque, t0: float) -> _kernel.SpacecraftModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.SpacecraftModel:
         """The compiled model (:class:`tumble.kernels.spacecraft.SpacecraftModel`) under the external ``torque``
         (a :mod:`tumble.torques` model, a callable ``f(t, q, omega)`` or None), control clock at ``t0`` (s)."""
         law = self._torque_law()
@@ -337,12 +338,12 @@ class Spacecraft(Model):
                                   f"land on the sample times; t[{k + 1}] − t[{k}] = {t[k + 1] - t[k]} s is "
                                   f"{steps[k]:.6g} steps of {dt} s")
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: Any, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         n = values["omega0"].shape[0]
         y0 = np.zeros((n, kernel.size))
         y0[:, :4] = values["q0"]
         y0[:, 4:7] = values["omega0"]
-        where = functools.partial(_kernel.slices, kernel)
+        where: Callable[[str], Any] = functools.partial(_kernel.slices, kernel)  # each part asked for is there
         if self.wheels:
             w = where("wheels")
             axes = np.array([x.axis for x in self.wheels])
@@ -362,7 +363,7 @@ class Spacecraft(Model):
             _kernel.initialise(kernel, float(t0), y)
         return y0
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: Any, t: np.ndarray, states: np.ndarray) -> Outputs:
         n_t, n_b, _ = states.shape
         aux = np.empty((n_b, n_t, kernel.aux_size))
         for b in range(n_b):
@@ -491,15 +492,16 @@ def _check_items(values, cls, name):
             raise ValidationError(f"{name}[{i}]: must be a {cls.__name__}, got {type(value).__name__}")
 
 
-def simulate(spacecraft: Spacecraft, omega0, *, t, q0=None, wheel_speeds0=None, gimbal_angles0=None,
-             method: str = "rk4", dt: float | None = None, rtol: float | None = None, atol: float | None = None,
+def simulate(spacecraft: Spacecraft, omega0: ArrayLike, *, t: ArrayLike, q0: ArrayLike | None = None,
+             wheel_speeds0: ArrayLike | None = None, gimbal_angles0: ArrayLike | None = None, method: str = "rk4",
+             dt: float | None = None, rtol: float | None = None, atol: float | None = None,
              max_steps: int | None = None, progress: Callable[[int, int], None] | None = None) -> Trajectory:
     """Deprecated: ``tumble.simulate(spacecraft, omega0, t=..., method="rk4", dt=..., ...)`` (the same run)."""
     warnings.warn("tumble.spacecraft.simulate is deprecated: use tumble.simulate(spacecraft, omega0, t=..., "
                   "method='rk4', dt=..., ...)", DeprecationWarning, stacklevel=2)
     if not isinstance(spacecraft, Spacecraft):
         raise ValidationError(f"spacecraft: must be a Spacecraft, got {type(spacecraft).__name__}")
-    initial = {name: value for name, value in (("q0", q0), ("wheel_speeds0", wheel_speeds0),
+    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("wheel_speeds0", wheel_speeds0),
                                                 ("gimbal_angles0", gimbal_angles0)) if value is not None}
     return _simulate(spacecraft, omega0, t=t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
                      progress=progress, **initial)

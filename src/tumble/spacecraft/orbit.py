@@ -26,14 +26,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple, cast
 
 import numpy as np
 from numba import njit
+from numpy.typing import ArrayLike
 
 from tumble import _quat, attitude
 from tumble._gravity import eccentric_anomaly, orbit_state
 from tumble._validate import ValidationError, as_array, require_finite, require_positive
+
+if TYPE_CHECKING:
+    from tumble.trajectory import Trajectory
 
 __all__ = [
     "EARTH_MU",
@@ -116,7 +120,7 @@ class Orbit:
         """Orbital period 2π/n, s."""
         return 2.0 * math.pi / self.mean_motion
 
-    def state(self, t) -> tuple[np.ndarray, np.ndarray]:
+    def state(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         """Position (m) and velocity (m/s) in inertial axes at the times ``t`` (s, any shape): two (…, 3) arrays."""
         t = as_array(t, "t")
         out = np.empty((t.size, 6))
@@ -145,7 +149,7 @@ def _lvlh_axes(rx, ry, rz, vx, vy, vz, m):
 
 
 @njit(cache=True)
-def lvlh_quat(rx, ry, rz, vx, vy, vz):
+def lvlh_quat(rx: float, ry: float, rz: float, vx: float, vy: float, vz: float) -> tuple[float, float, float, float]:
     """``q_I_LVLH`` (LVLH → inertial, scalar first) of the position ``r`` and velocity ``v`` (inertial axes).
 
     Axes as in the module docstring; undefined for ``r = 0`` or ``r ∥ v``.
@@ -162,7 +166,7 @@ def _lvlh_matrices(r, v, out):
         _lvlh_axes(r[k, 0], r[k, 1], r[k, 2], v[k, 0], v[k, 1], v[k, 2], out[k])
 
 
-def _checked_rv(r, v):
+def _checked_rv(r: ArrayLike, v: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     r = as_array(r, "r", tail=(3,))
     v = as_array(v, "v", tail=(3,))
     r, v = np.broadcast_arrays(r, v)
@@ -172,7 +176,7 @@ def _checked_rv(r, v):
     return r, v
 
 
-def lvlh_matrix(r, v) -> np.ndarray:
+def lvlh_matrix(r: ArrayLike, v: ArrayLike) -> np.ndarray:
     """``R_I_LVLH`` (…, 3, 3): columns o₁, o₂, o₃ of the LVLH frame in inertial axes, from ``r``, ``v`` (…, 3)
     in inertial axes."""
     r, v = _checked_rv(r, v)
@@ -182,7 +186,7 @@ def lvlh_matrix(r, v) -> np.ndarray:
     return out.reshape((*batch, 3, 3))
 
 
-def lvlh_quaternion(r, v) -> np.ndarray:
+def lvlh_quaternion(r: ArrayLike, v: ArrayLike) -> np.ndarray:
     """``q_I_LVLH`` (…, 4), LVLH → inertial, scalar first, from ``r``, ``v`` (…, 3) in inertial axes."""
     return attitude.from_matrix(lvlh_matrix(r, v))
 
@@ -207,7 +211,7 @@ class LvlhAttitude(NamedTuple):
     yaw: np.ndarray
 
 
-def attitude_in_lvlh(traj, orbit: Orbit) -> LvlhAttitude:
+def attitude_in_lvlh(traj: Trajectory, orbit: Orbit) -> LvlhAttitude:
     """The body attitude of ``traj`` (a :class:`tumble.Trajectory`) relative to the LVLH frame of ``orbit``.
 
     ``q_LVLH_B = q_I_LVLH* ⊗ q_I_B`` at each output time, with the orbit's
@@ -215,8 +219,9 @@ def attitude_in_lvlh(traj, orbit: Orbit) -> LvlhAttitude:
     """
     r, v = orbit.state(traj.t)
     q_i_lvlh = lvlh_quaternion(r, v)
-    if traj.q.ndim == 3:
+    q_i_b = cast(np.ndarray, traj.q)
+    if q_i_b.ndim == 3:
         q_i_lvlh = q_i_lvlh[:, None, :]
-    q = attitude.multiply(attitude.conjugate(q_i_lvlh), traj.q)
+    q = attitude.multiply(attitude.conjugate(q_i_lvlh), q_i_b)
     yaw, pitch, roll = np.moveaxis(attitude.to_euler(q, "ZYX"), -1, 0)
     return LvlhAttitude(q=q, roll=roll, pitch=pitch, yaw=yaw)

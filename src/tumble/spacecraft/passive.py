@@ -43,6 +43,7 @@ import os
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import attitude
 from tumble._validate import ValidationError, as_array
@@ -103,7 +104,7 @@ def _as_body(body) -> RigidBody:
     return RigidBody(as_array(body, "body", tail=(3, 3)), check_triangle=False)
 
 
-def spin_stability(body, axis) -> SpinStability:
+def spin_stability(body: RigidBody | ArrayLike, axis: ArrayLike) -> SpinStability:
     """Is a spin about ``axis`` (body axes, any length) stable, as a rigid body and with energy dissipation?
 
     ``body``: a :class:`~tumble.RigidBody` or a (3, 3) inertia tensor (kg·m²,
@@ -181,7 +182,7 @@ def _moments(inertia) -> np.ndarray:
     return m
 
 
-def gravity_gradient_stability(inertia) -> GravityGradientStability:
+def gravity_gradient_stability(inertia: RigidBody | ArrayLike) -> GravityGradientStability:
     """Classify the gravity-gradient stability of a body held on the LVLH axes of a circular orbit.
 
     ``inertia``: the moments ``(I₁, I₂, I₃)`` about roll (along-track), pitch
@@ -209,8 +210,8 @@ def gravity_gradient_stability(inertia) -> GravityGradientStability:
                                     pitch_frequency=pitch_frequency, roll_yaw_frequencies=freqs)
 
 
-def gravity_gradient_stability_figure(spacecraft_inertia=None, *, label: str = "spacecraft",
-                                      resolution: int = 801) -> Figure:
+def gravity_gradient_stability_figure(spacecraft_inertia: RigidBody | ArrayLike | None = None, *,
+                                      label: str = "spacecraft", resolution: int = 801) -> Figure:
     """The gravity-gradient stability regions in the (k_R, k_Y) plane, with a spacecraft placed on it.
 
     Shaded: the Lagrange region (stable, also with dissipation) and the
@@ -266,7 +267,7 @@ GG_SATELLITE = (120.0, 125.0, 10.0)
 GG_ORBIT = Orbit.circular(700e3, inclination=math.radians(98.19))
 
 
-def gravity_gradient_libration(moments, orbit: Orbit, angles, *, orbits: float = 10.0,
+def gravity_gradient_libration(moments: ArrayLike, orbit: Orbit, angles: ArrayLike, *, orbits: float = 10.0,
                                samples_per_orbit: int = 200) -> Trajectory:
     """Simulate a body released at roll/pitch/yaw ``angles`` (rad) from the LVLH attitude, at rest in LVLH.
 
@@ -313,7 +314,7 @@ def _save_png(fig, path) -> None:
     write_atomic(path, lambda tmp_path: fig.savefig(tmp_path, format="png", dpi=120))
 
 
-def demo_gravity_gradient(out_dir) -> dict:
+def demo_gravity_gradient(out_dir: str | os.PathLike[str]) -> dict:
     """A boom satellite (:data:`GG_SATELLITE`) released 5° pitch, 3° roll, 2° yaw off LVLH, 10 orbits.
 
     Writes ``gravity_gradient.nc`` (the trajectory), ``gravity_gradient.png``
@@ -438,7 +439,7 @@ def explorer1_figure(traj: Trajectory, spacecraft: Explorer1 = EXPLORER1) -> Fig
     return fig
 
 
-def demo_explorer1(out_dir, spacecraft: Explorer1 = EXPLORER1) -> dict:
+def demo_explorer1(out_dir: str | os.PathLike[str], spacecraft: Explorer1 = EXPLORER1) -> dict:
     """Simulate the Explorer 1 flat spin and compare its nutation time constant with the energy-sink estimate.
 
     Integrates hub + damper (:meth:`Explorer1.spacecraft` through :func:`tumble.simulate`,

@@ -22,9 +22,11 @@ See ``docs/sweeps.md``.
 
 from __future__ import annotations
 
+import os
 import sys
 import types
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, cast
 
 from tumble._validate import ValidationError, output_times
 from tumble.simulate import _solver_options, as_model
@@ -52,6 +54,16 @@ from tumble.sweep.plan import _is_builder, make_plan
 from tumble.sweep.runner import local_cluster, run_chunks
 from tumble.sweep.store import SweepStore
 
+if TYPE_CHECKING:
+    import xarray
+    from distributed import Client
+    from numpy.typing import ArrayLike
+
+    from tumble.body import RigidBody
+    from tumble.scenario import Scenario
+    from tumble.simulate import Model
+    from tumble.torques import TorqueLike
+
 __all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
            "Component", "Max", "Final", "SettlingTime", "CrossingTime"]
@@ -61,30 +73,30 @@ PERCENTILES = (1.0, 5.0, 50.0, 95.0, 99.0)
 
 
 def sweep(
-    model,
+    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike | Callable[..., Any],
     dispersions: Mapping | None = None,
     *,
     samples: int | None = None,
     seed: int = 0,
-    t,
+    t: ArrayLike,
     method: str = "dop853",
     dt: float | None = None,
     rtol: float | None = None,
     atol: float | None = None,
     max_steps: int | None = None,
-    torque=None,
+    torque: TorqueLike | ArrayLike = None,
     outcomes: Mapping[str, Callable] | None = None,
     statistics: Mapping[str, Callable] | None = None,
-    percentiles=PERCENTILES,
+    percentiles: Iterable[float] = PERCENTILES,
     trajectories: bool = False,
     chunk: int | None = None,
-    store=None,
-    client=None,
+    store: str | os.PathLike[str] | None = None,
+    client: Client | None = None,
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     retries: int = 2,
-    **initial_state,
-):
+    **initial_state: ArrayLike,
+) -> xarray.Dataset:
     """Run ``samples`` simulations of ``model`` with dispersed inputs on Dask; return their outcomes.
 
     Parameters
@@ -148,8 +160,8 @@ def sweep(
         raise ValidationError("model: a scenario sweeps with sweep_scenario(scenario, ...) (its [sweep] table "
                               "gives the dispersions, times and solver)")
     if not _is_builder(model):
-        as_model(model)  # refuse what is not a model before anything else
-    m, options = _solver_options(as_model(model) if not _is_builder(model) else None, method,
+        as_model(cast(Any, model))  # refuse what is not a model before anything else
+    m, options = _solver_options(as_model(cast(Any, model)) if not _is_builder(model) else None, method,
                                  dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if workers is not None and int(workers) < 0:
         raise ValidationError(f"workers: must be >= 0 (0: in this process), got {workers}")
@@ -174,8 +186,10 @@ def _is_scenario(model) -> bool:
     return isinstance(model, Scenario)
 
 
-def sweep_scenario(scenario, *, samples: int | None = None, store=None, client=None, workers: int | None = None,
-                   progress: Callable[[int, int], None] | None = None, retries: int = 2):
+def sweep_scenario(scenario: Scenario | str | os.PathLike[str], *, samples: int | None = None,
+                   store: str | os.PathLike[str] | None = None, client: Client | None = None,
+                   workers: int | None = None, progress: Callable[[int, int], None] | None = None,
+                   retries: int = 2) -> xarray.Dataset:
     """:func:`sweep` of a scenario (a :class:`tumble.scenario.Scenario` or the path of its file) as its
     ``[sweep]`` table describes (:mod:`tumble.scenario.sweep`); ``samples`` overrides the table's."""
     from tumble.scenario import load
@@ -183,12 +197,12 @@ def sweep_scenario(scenario, *, samples: int | None = None, store=None, client=N
 
     if not _is_scenario(scenario):
         scenario = load(scenario)
-    arguments = sweep_arguments(scenario, samples=samples)
+    arguments = sweep_arguments(cast("Scenario", scenario), samples=samples)  # loaded above when a path
     return sweep(arguments.pop("model"), arguments.pop("dispersions"), store=store, client=client,
                  workers=workers, progress=progress, retries=retries, **arguments)
 
 
-def open_sweep(path):
+def open_sweep(path: str | os.PathLike[str]) -> xarray.Dataset:
     """The sweep stored at ``path`` as an :class:`xarray.Dataset`, opened lazily (Dask arrays)."""
     import xarray as xr
 

@@ -30,6 +30,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy import special
 
 from tumble import attitude
@@ -97,10 +98,10 @@ class Normal(Dispersion):
         _set_broadcast(self, mean=mean, std=std)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return self.mean.shape
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         return self.mean + self.std * special.ndtri(u).reshape((-1, *self.shape))
 
     def __repr__(self):
@@ -121,10 +122,10 @@ class Uniform(Dispersion):
         _set_broadcast(self, low=low, high=high)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return self.low.shape
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         return self.low + (self.high - self.low) * u.reshape((-1, *self.shape))
 
     def __repr__(self):
@@ -154,10 +155,10 @@ class TruncatedNormal(Dispersion):
         _set_broadcast(self, mean=mean, std=std, low=low, high=high)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return self.mean.shape
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         a, b = special.ndtr((self.low - self.mean) / self.std), special.ndtr((self.high - self.mean) / self.std)
         x = self.mean + self.std * special.ndtri(a + u.reshape((-1, *self.shape)) * (b - a))
         return np.clip(x, self.low, self.high)  # Φ⁻¹ rounding at the ends stays inside the bounds
@@ -181,13 +182,13 @@ class Grid(Dispersion):
         object.__setattr__(self, "points", points)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return self.points.shape[1:]
 
     def __len__(self):
         return self.points.shape[0]
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         return self.points[points]
 
     def __repr__(self):
@@ -203,10 +204,10 @@ class UniformAttitude(Dispersion):
     n_raw: int = field(default=4, init=False, repr=False)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return (4,)
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         z = special.ndtri(u)
         return z / np.linalg.norm(z, axis=-1, keepdims=True)
 
@@ -266,10 +267,10 @@ class Inertia(Dispersion):
             object.__setattr__(self, name, value)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return (3, 3)
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         std = np.where(self.std > 0, self.std, 1.0)  # a fixed moment (std 0): any unit, the box is a point
         box = self.truncation * std
         moments = TruncatedNormal(self.moments, std, self.moments - box, self.moments + box).values(u[:, :3], points)
@@ -310,10 +311,10 @@ class Misalignment(Dispersion):
         object.__setattr__(self, "n_raw", 2 * axes.shape[0])
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return self.axes.shape
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         # two unit vectors across each axis: e1 ⟂ a from the coordinate axis least along a, e2 = a × e1
         a = self.axes
         helper = np.eye(3)[np.abs(a).argmin(axis=-1)]
@@ -337,17 +338,17 @@ class NoiseSeed(Dispersion):
     n_raw: int = field(default=1, init=False, repr=False)
 
     @property
-    def shape(self):
+    def shape(self) -> tuple[int, ...]:
         return ()
 
-    def values(self, u, points):
+    def values(self, u: np.ndarray, points: np.ndarray) -> np.ndarray:
         return np.floor(u[:, 0] * 2.0**53).astype(np.int64)  # ⌊2⁵³ u⌋
 
     def __repr__(self):
         return "NoiseSeed()"
 
 
-def as_dispersion(value, name: str) -> Dispersion:
+def as_dispersion(value: Dispersion | ArrayLike, name: str) -> Dispersion:
     """A :class:`Dispersion`, or a fixed value (any array-like) as a one-point :class:`Grid`."""
     if isinstance(value, Dispersion):
         return value

@@ -3,14 +3,20 @@ each series (matplotlib's object-oriented API; nothing is shown or saved here)."
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    import xarray
+    from matplotlib.figure import Figure
 
 __all__ = ["sweep_figure"]
 
 _BINS = 40
 
 
-def sweep_figure(ds, *, title: str | None = None, units: dict[str, str] | None = None):
+def sweep_figure(ds: xarray.Dataset, *, title: str | None = None, units: dict[str, str] | None = None) -> Figure:
     """A :class:`matplotlib.figure.Figure` of the sweep ``ds`` (what :func:`tumble.sweep` returns).
 
     One panel per scalar outcome: a histogram of the samples, the stored

@@ -24,7 +24,9 @@ Angles are in rad, times in s.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -36,7 +38,7 @@ __all__ = ["PointingError", "NutationAngle", "Component", "Max", "Final", "Settl
            "describe"]
 
 
-def describe(function) -> str:
+def describe(function: Callable[[Trajectory], np.ndarray]) -> str:
     """How a sweep's store records an outcome or series: its repr for the built-in ones (their parameters),
     ``module:qualname`` for a Python function."""
     if isinstance(function, (PointingError, NutationAngle, Component, Max, Final, SettlingTime, CrossingTime)):
@@ -61,7 +63,7 @@ class PointingError:
         object.__setattr__(self, "target", tuple((q / np.linalg.norm(q)).tolist()))
 
     def __call__(self, traj: Trajectory) -> np.ndarray:
-        return attitude.relative_angle(np.array(self.target), traj.q)
+        return attitude.relative_angle(np.array(self.target), cast(np.ndarray, traj.q))
 
 
 @dataclass(frozen=True)

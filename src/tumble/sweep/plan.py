@@ -31,9 +31,10 @@ import json
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, TypeGuard
+from typing import TYPE_CHECKING, Any, TypeGuard
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._inertia import principal_axes
 from tumble._validate import ValidationError
@@ -43,6 +44,9 @@ from tumble.simulate import Model, as_model, simulate
 from tumble.sweep.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_uniforms
 from tumble.sweep.outcomes import describe
 from tumble.trajectory import Extra, Trajectory
+
+if TYPE_CHECKING:
+    from tumble.torques import TorqueLike
 
 __all__ = ["Plan", "ChunkResult", "make_plan"]
 
@@ -155,7 +159,7 @@ class Plan:
         parameters = {name: v for name, v in inputs.items() if name not in self.states}
         run = dict(t=self.t, method=self.method, torque=self.torque, **self.options)
         if not _is_builder(self.model):
-            model = self.model
+            model: Any = self.model  # not a builder: anything tumble.simulate takes as a model
             if "inertia" in parameters:
                 model = RigidBodies.of(parameters["inertia"])
             elif not any(np.ndim(v) == 2 for v in state.values()):
@@ -237,36 +241,39 @@ def _stack(members: list[Trajectory]) -> Trajectory:
                       method=first.method, info=first.info, extras=extras, totals=totals, model=first.model)
 
 
-def make_plan(model, dispersions, *, samples, seed, chunk, t, method, options, torque, outcomes, series,
-              fixed, trajectories=False) -> Plan:
+def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, samples: int | None, seed: int,
+              chunk: int | None, t: np.ndarray, method: str, options: dict[str, Any], torque: TorqueLike | ArrayLike,
+              outcomes: dict[str, Callable[[Trajectory], np.ndarray]],
+              series: dict[str, Callable[[Trajectory], np.ndarray]], fixed: Mapping[str, ArrayLike],
+              trajectories: bool = False) -> Plan:
     """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
-    dispersions = {str(name): as_dispersion(d, name) for name, d in dispersions.items()}
-    samples, chunk = _sizes(dispersions, samples, chunk, len(t))
+    drawn = {str(name): as_dispersion(d, name) for name, d in dispersions.items()}
+    samples, chunk = _sizes(drawn, samples, chunk, len(t))
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
     builder = _is_builder(model)
-    parameters = _parameters(model, dispersions)
+    parameters = _parameters(model, drawn)
     probe = model(**{n: d.values(np.full((1, d.n_raw), 0.5), np.zeros(1, dtype=int))[0]
-                     for n, d in dispersions.items() if n in parameters}) if builder else model
+                     for n, d in drawn.items() if n in parameters}) if builder else model
     fields = {f.name: f for f in as_model(probe).state_fields()}
-    for name in list(dispersions) + list(fixed):
+    for name in list(drawn) + list(fixed):
         if name not in fields and name not in parameters:
             known = ", ".join(sorted(fields) + sorted(parameters))
             raise ValidationError(f"dispersions[{name!r}]: not an initial state or a parameter of the "
                                   f"{'model built by ' + describe(model) if builder else type(probe).__name__}; "
                                   f"it takes {known}")
-        if name in fixed and name in dispersions:
+        if name in fixed and name in drawn:
             raise ValidationError(f"{name}: given both as a dispersion and as a fixed value")
-    states = tuple(n for n in dispersions if n in fields and n not in parameters)
+    states = tuple(n for n in drawn if n in fields and n not in parameters)
     for name in states:
-        _check_state(name, dispersions[name], fields[name])
-    if "inertia" in dispersions and not builder:
-        _check_inertia(dispersions["inertia"])
-    _check_reductions(outcomes, series, dispersions, trajectories)
-    return Plan(model=model if builder or "inertia" in dispersions else as_model(model),
-                dispersions=dispersions, states=states, fixed=dict(fixed), seed=int(seed), samples=samples,
+        _check_state(name, drawn[name], fields[name])
+    if "inertia" in drawn and not builder:
+        _check_inertia(drawn["inertia"])
+    _check_reductions(outcomes, series, drawn, trajectories)
+    return Plan(model=model if builder or "inertia" in drawn else as_model(model),
+                dispersions=drawn, states=states, fixed=dict(fixed), seed=int(seed), samples=samples,
                 chunk=chunk, t=np.asarray(t, dtype=np.float64), method=method, options=options, torque=torque,
                 outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
 

@@ -20,15 +20,19 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from tumble._validate import ValidationError
 from tumble.sweep.plan import Plan
 from tumble.sweep.store import SweepStore
 
+if TYPE_CHECKING:
+    from distributed import Client, LocalCluster
+
 __all__ = ["local_cluster", "run_chunks"]
 
 
-def local_cluster(workers: int | None = None):
+def local_cluster(workers: int | None = None) -> LocalCluster:
     """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: one per core),
     every server on 127.0.0.1 (the scheduler's HTTP endpoint on a free port there)."""
     from distributed import LocalCluster
@@ -64,7 +68,7 @@ def _numba_settings_from_environment() -> None:
     numba.set_num_threads(max(1, min(int(limit), parallel.NUM_THREADS)))
 
 
-def run_chunks(plan: Plan, store: SweepStore, *, client=None, workers: int | None = None,
+def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, workers: int | None = None,
                progress: Callable[[int, int], None] | None = None, retries: int = 2) -> int:
     """Compute the chunks missing from ``store`` on Dask and write each as it completes; return how many
     were computed. ``progress(done, total)`` counts chunks (those already in the store included)."""

@@ -46,11 +46,13 @@ import os
 import shutil
 import tempfile
 import warnings
+from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 if TYPE_CHECKING:
+    import xarray
     import zarr
 
 from tumble._validate import ValidationError
@@ -69,7 +71,7 @@ _BLOCK_WORDS = 2**25
 class SweepStore:
     """The results of one sweep in a Zarr store at ``path`` (a directory), or in memory when ``path`` is None."""
 
-    def __init__(self, path, plan: Plan):
+    def __init__(self, path: str | os.PathLike[str] | None, plan: Plan) -> None:
         self.path = None if path is None else os.fspath(path)
         self.plan = plan
         self._memory: zarr.storage.MemoryStore | None = None  # the store when path is None, once made
@@ -117,7 +119,7 @@ class SweepStore:
     def complete(self) -> bool:
         return self.exists and bool(dict(self._group("r").attrs).get(COMPLETE_ATTR, False))
 
-    def has_percentiles(self, percentiles) -> bool:
+    def has_percentiles(self, percentiles: Iterable[float]) -> bool:
         """Whether the store's statistics are those of ``percentiles``."""
         group = self._group("r")
         return "percentile" in group and np.array_equal(group["percentile"][:], np.asarray(percentiles, float))
@@ -188,7 +190,7 @@ class SweepStore:
 
     # -- statistics -------------------------------------------------------------------
 
-    def finalize(self, percentiles) -> None:
+    def finalize(self, percentiles: Iterable[float]) -> None:
         """Write the per-time statistics and the percentiles once every chunk is done (idempotent)."""
         import xarray as xr
 
@@ -220,7 +222,7 @@ class SweepStore:
         ds.to_zarr(self._memory if self.path is None else self.path, mode="a", consolidated=False, zarr_format=3)
         group.attrs[COMPLETE_ATTR] = True
 
-    def dataset(self):
+    def dataset(self) -> xarray.Dataset:
         """The store as an :class:`xarray.Dataset`: lazily (Dask arrays) for a store on disk, loaded for one in
         memory."""
         import xarray as xr

@@ -19,8 +19,8 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
-from collections.abc import Callable
-from typing import Any
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,6 +28,13 @@ from tumble._validate import ValidationError
 from tumble.ensemble import SAMPLES_PER_CHUNK
 from tumble.rigid import RigidBodies
 from tumble.simulate import as_model, simulate
+
+if TYPE_CHECKING:
+    import xarray
+    from numpy.typing import ArrayLike
+
+    from tumble.body import RigidBody
+    from tumble.simulate import Model
 
 __all__ = ["simulate_to_store"]
 
@@ -53,8 +60,9 @@ def _chunk_of(model, lo: int, hi: int):
     return RigidBodies(model.inertia[lo:hi], model.moments[lo:hi], model.axes[lo:hi], masses)
 
 
-def simulate_to_store(model, store, *, t, initial_state: dict, options: dict, chunk: int | None = None,
-                      progress: Callable[[int, int], None] | None = None):
+def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike, store: str | os.PathLike[str], *,
+                      t: ArrayLike, initial_state: dict, options: dict, chunk: int | None = None,
+                      progress: Callable[[int, int], None] | None = None) -> xarray.Dataset:
     """Run ``simulate(model, t=t, **options, **initial_state)`` in chunks of ``chunk`` members, written to the
     Zarr store ``store`` (a directory that must not exist); return the run as a lazily opened
     :class:`xarray.Dataset`.

@@ -39,8 +39,10 @@ has more energy.
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.interpolate import CubicSpline
 
 from tumble import attitude, dynamics, torques
@@ -49,6 +51,9 @@ from tumble._validate import ValidationError, as_array, increasing_times, requir
 from tumble.kernels import variable as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory
+
+if TYPE_CHECKING:
+    from tumble import integrate
 
 __all__ = ["VariableBody", "angular_velocity", "shape_power"]
 
@@ -92,7 +97,8 @@ class VariableBody(Model):
 
     __slots__ = ("_t", "_inertia", "_shape_momentum", "_spline")
 
-    def __init__(self, t, inertia, shape_momentum=None, *, check_triangle: bool = True):
+    def __init__(self, t: ArrayLike, inertia: ArrayLike, shape_momentum: ArrayLike | None = None, *,
+                 check_triangle: bool = True) -> None:
         t = increasing_times(t, what="sample times", at_least=4)
         inertia = as_array(inertia, "inertia", tail=(3, 3))
         if inertia.shape != (t.size, 3, 3):
@@ -112,7 +118,7 @@ class VariableBody(Model):
 
     @classmethod
     def from_functions(cls, inertia: Callable, shape_momentum: Callable | None = None, *,
-                       t_span, dt: float, check_triangle: bool = True) -> VariableBody:
+                       t_span: tuple[float, float], dt: float, check_triangle: bool = True) -> VariableBody:
         """Sample ``inertia(t) -> (n, 3, 3)`` and ``shape_momentum(t) -> (n, 3)`` (vectorised in ``t``, s).
 
         The samples lie on a uniform grid of step ≤ ``dt`` (s) over ``t_span = (t0, t1)``;
@@ -123,7 +129,7 @@ class VariableBody(Model):
                    check_triangle=check_triangle)
 
     @staticmethod
-    def grid(t_span, dt: float) -> np.ndarray:
+    def grid(t_span: tuple[float, float], dt: float) -> np.ndarray:
         """A uniform grid over ``t_span = (t0, t1)`` (s) with step ≤ ``dt`` (s) and at least 4 points."""
         t0, t1 = (float(x) for x in t_span)
         if not t1 > t0:
@@ -150,7 +156,7 @@ class VariableBody(Model):
 
     # -- interpolants ------------------------------------------------------------------
 
-    def inertia(self, t, nu: int = 0) -> np.ndarray:
+    def inertia(self, t: ArrayLike, nu: int = 0) -> np.ndarray:
         """``I(t)`` (kg·m², body axes) or its ``nu``-th time derivative, by the spline: ``t.shape + (3, 3)``."""
         c = self._evaluate(t, nu)[..., :6]
         out = np.empty(c.shape[:-1] + (3, 3))
@@ -158,7 +164,7 @@ class VariableBody(Model):
         out[..., _COLS, _ROWS] = c
         return out
 
-    def shape_momentum(self, t, nu: int = 0) -> np.ndarray:
+    def shape_momentum(self, t: ArrayLike, nu: int = 0) -> np.ndarray:
         """``A(t)`` (kg·m²/s, body axes), or its ``nu``-th time derivative; shape ``t.shape + (3,)``."""
         return self._evaluate(t, nu)[..., 6:]
 
@@ -166,7 +172,7 @@ class VariableBody(Model):
         t = self.check_times(t)
         return self._spline(t, nu)
 
-    def check_times(self, t) -> np.ndarray:
+    def check_times(self, t: ArrayLike) -> np.ndarray:
         """``t`` as a float64 array, refused unless every time lies in :attr:`t_span`."""
         t = as_array(t, "t")
         t0, t1 = self.t_span
@@ -200,21 +206,21 @@ class VariableBody(Model):
                        default=attitude.identity(), quaternion=True),
         )
 
-    def check_run(self, method, t, dt) -> None:
+    def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:
         """Refuse output times outside :attr:`t_span` (the splines are not extrapolated)."""
         self.check_times(t)
 
-    def compile(self, torque, t0: float) -> _kernel.VariableModel:
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.VariableModel:
         """The compiled model (:class:`tumble.kernels.variable.VariableModel`) under an external torque (B axes)."""
         return _kernel.build(self, torques.as_torque_model(torque))
 
-    def initial_states(self, kernel, values, t0):
+    def initial_states(self, kernel: _kernel.VariableModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         """``[q, L_N, t₀]`` (N, 8), ``L_N = R(q₀) (I(t₀) ω₀ + A(t₀))``: the state of :mod:`tumble.kernels.variable`."""
         q0 = values["q0"]
         momentum = dynamics.angular_momentum(self.inertia(t0), values["omega0"]) + self.shape_momentum(t0)
         return np.concatenate([q0, attitude.rotate(q0, momentum), np.full((q0.shape[0], 1), t0)], axis=1)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: _kernel.VariableModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         q = states[..., :4]
         momentum_body = attitude.rotate_inverse(q, states[..., 4:7])              # (n, N, 3)
         inertia_t = np.broadcast_to(self.inertia(t)[:, None], momentum_body.shape + (3,))
@@ -241,14 +247,14 @@ class VariableBody(Model):
         return {"momentum_inertial": traj.momentum_inertial}
 
 
-def angular_velocity(inertia, shape_momentum, momentum_body) -> np.ndarray:
+def angular_velocity(inertia: ArrayLike, shape_momentum: ArrayLike, momentum_body: ArrayLike) -> np.ndarray:
     """``ω = I⁻¹ (L_B − A)`` (rad/s, body axes) from ``I`` (…, 3, 3), ``A`` and ``L_B`` (…, 3), broadcast."""
     rhs = np.asarray(momentum_body) - np.asarray(shape_momentum)
     inertia = np.broadcast_to(inertia, rhs.shape + (3,))
     return np.linalg.solve(inertia, rhs[..., None])[..., 0]
 
 
-def shape_power(body: VariableBody, t, omega) -> np.ndarray:
+def shape_power(body: VariableBody, t: ArrayLike, omega: ArrayLike) -> np.ndarray:
     """Power of the shape change on the rotation, W: ``dT/dt = −ω·Ȧ − ½ ω·İ ω`` (torque-free).
 
     ``T = ½ ω·Iω`` is the rotational energy of the body frozen in its current
@@ -267,7 +273,7 @@ def shape_power(body: VariableBody, t, omega) -> np.ndarray:
                                                                               inertia_rate, omega)
 
 
-def _check_tensors(t, inertia, check_triangle):
+def _check_tensors(t: np.ndarray, inertia: np.ndarray, check_triangle: bool) -> np.ndarray:
     """The rules of :func:`tumble.body.principal_axes` (symmetric, then symmetrised exactly; positive definite;
     the triangle inequality ``I₁ + I₂ ≥ I₃`` that every mass distribution obeys) at every sample; a broken
     rule is refused naming the sample and its time."""

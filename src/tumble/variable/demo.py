@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -12,6 +13,9 @@ from tumble._validate import ValidationError
 from tumble.trajectory import write_atomic
 from tumble.variable import diver
 from tumble.variable.human import Human
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["demo_diver", "figure_dive", "figure_twist_rule"]
 
@@ -22,7 +26,7 @@ _POSES = 9
 _NECK_AND_HEAD = 0.3
 
 
-def demo_diver(out_dir) -> dict:
+def demo_diver(out_dir: str | os.PathLike[str]) -> dict:
     """Run experiments (a)–(c) and write their figures and the dive's NetCDF into ``out_dir``.
 
     Files (each written atomically): ``diver_twisting_somersault.png`` (a),
@@ -77,7 +81,7 @@ def demo_diver(out_dir) -> dict:
     }
 
 
-def figure_dive(human: Human, dive: diver.Dive, title: str):
+def figure_dive(human: Human, dive: diver.Dive, title: str) -> Figure:
     """Figure of a dive: poses seen along ``L``; somersault and twist (turns); tilt; shoulder angles; energy."""
     from matplotlib.figure import Figure
 
@@ -181,7 +185,7 @@ def _segment_ends(human, kin, k):
     return ends
 
 
-def figure_twist_rule(sweep: dict):
+def figure_twist_rule(sweep: dict) -> Figure:
     """Figure (b): twists per somersault against the tilt, simulation and rule of thumb."""
     from matplotlib.figure import Figure
 

@@ -35,9 +35,10 @@ derived above for the axisymmetric body. For a real body
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import analytic, attitude, simulate
 from tumble._validate import ValidationError, as_array
@@ -68,7 +69,7 @@ class OrientationAngles(NamedTuple):
         return float((self.twist[-1] - self.twist[0]) / (2.0 * np.pi))
 
 
-def orientation_angles(q, momentum_inertial) -> OrientationAngles:
+def orientation_angles(q: ArrayLike, momentum_inertial: ArrayLike) -> OrientationAngles:
     """Somersault, tilt and twist of the attitudes ``q`` (n, 4) (B → inertial) about ``L`` (3,), any units.
 
     See the module docstring for the definitions.
@@ -94,7 +95,8 @@ def orientation_angles(q, momentum_inertial) -> OrientationAngles:
     return OrientationAngles(np.unwrap(angles[:, 0]), angles[:, 1], np.unwrap(angles[:, 2]))
 
 
-def twist_rule(tilt, somersault_inertia, long_inertia):
+def twist_rule(tilt: float | np.ndarray, somersault_inertia: float | np.ndarray,
+               long_inertia: float | np.ndarray) -> float | np.ndarray:
     """Twists per somersault of the rule of thumb, ``sin θ (I_s/I_l − 1)`` (exact for an axisymmetric body)."""
     return np.sin(tilt) * (somersault_inertia / long_inertia - 1.0)
 
@@ -125,8 +127,8 @@ class Dive(NamedTuple):
         return float(np.abs(L / L[0] - 1.0).max())
 
 
-def simulate_dive(human: Human, angles: Mapping | None, *, momentum: float, t, tilt: float = 0.0,
-                  method: str = "dop853", sample_dt: float = 2e-3, **solver) -> Dive:
+def simulate_dive(human: Human, angles: Mapping | None, *, momentum: float, t: ArrayLike, tilt: float = 0.0,
+                  method: str = "dop853", sample_dt: float = 2e-3, **solver: Any) -> Dive:
     """The flight of ``human`` moving its joints through ``angles``, torque-free.
 
     The angular momentum ``L_N = (momentum, 0, 0)`` (kg·m²/s; inertial x, the
@@ -171,7 +173,7 @@ def twisting_somersault(human: Human | None = None, *, duration: float = 2.0, n:
     return simulate_dive(human, angles, momentum=MOMENTUM, t=np.linspace(0.0, duration, n))
 
 
-def twist_rule_sweep(tilts, human: Human | None = None, *, posture: Mapping | None = None,
+def twist_rule_sweep(tilts: ArrayLike, human: Human | None = None, *, posture: Mapping | None = None,
                      duration: float = 20.0, n: int = 4001) -> dict:
     """Experiment (b): twists per somersault of a rigid posture against :func:`twist_rule`.
 

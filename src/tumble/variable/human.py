@@ -41,15 +41,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import Part, RigidBody
 from tumble.simulate import Outputs
 from tumble.trajectory import Extra
 from tumble.variable.body import VariableBody
+
+if TYPE_CHECKING:
+    from tumble.kernels.variable import VariableModel
 
 __all__ = ["DE_LEVA_MALE", "Human", "Kinematics", "Motion", "MovingHuman", "Segment"]
 
@@ -72,7 +76,7 @@ class Motion:
 
     __slots__ = ("start", "moves")
 
-    def __init__(self, start: float = 0.0, moves: Sequence = ()):
+    def __init__(self, start: float = 0.0, moves: Sequence = ()) -> None:
         self.start = float(as_array(start, "start"))
         checked, previous_end = [], -np.inf
         for k, move in enumerate(moves):
@@ -85,7 +89,7 @@ class Motion:
             previous_end = t1
         self.moves = tuple(checked)
 
-    def angle(self, t) -> np.ndarray:
+    def angle(self, t: ArrayLike) -> np.ndarray:
         """The angle at times ``t`` (rad)."""
         t = np.asarray(t, dtype=np.float64)
         out, value = np.full(t.shape, self.start), self.start
@@ -95,7 +99,7 @@ class Motion:
             value = target
         return out
 
-    def rate(self, t) -> np.ndarray:
+    def rate(self, t: ArrayLike) -> np.ndarray:
         """The angular rate at times ``t`` (rad/s)."""
         t = np.asarray(t, dtype=np.float64)
         out, value = np.zeros(t.shape), self.start
@@ -189,7 +193,7 @@ def _axis_rotation(axis, angle):
 class Human:
     """A tree of :class:`Segment` (root first, each parent before its children) with prescribed joint angles."""
 
-    def __init__(self, segments: Sequence[Segment]):
+    def __init__(self, segments: Sequence[Segment]) -> None:
         segments = tuple(segments)
         if not segments or segments[0].parent is not None:
             raise ValidationError("segments: the first segment must be the root (parent=None)")
@@ -227,7 +231,7 @@ class Human:
     def names(self) -> tuple[str, ...]:
         return tuple(s.name for s in self.segments)
 
-    def kinematics(self, t, angles: Mapping | None = None) -> Kinematics:
+    def kinematics(self, t: ArrayLike, angles: Mapping | None = None) -> Kinematics:
         """``I(t)``, ``A(t)`` and the segment motion at times ``t`` (s) for the joint ``angles``.
 
         ``angles`` maps joint-angle names (:attr:`dofs`) to a number (rad), a
@@ -285,7 +289,7 @@ class Human:
             raise ValidationError(f"angles: unknown joint angles {unknown}; this body has {list(self.dofs)}")
         return {name: _profile(angles.get(name, 0.0), name) for name in self.dofs}
 
-    def moving(self, angles: Mapping | None = None, *, t_span, dt: float = 2e-3) -> MovingHuman:
+    def moving(self, angles: Mapping | None = None, *, t_span: tuple[float, float], dt: float = 2e-3) -> MovingHuman:
         """This body moving its joints through ``angles`` over ``t_span`` (s): a model of :func:`tumble.simulate`.
 
         ``I(t)`` and ``A(t)`` are sampled every ``dt`` (s) or less and interpolated
@@ -314,7 +318,8 @@ class MovingHuman(VariableBody):
 
     __slots__ = ("_human", "_angles")
 
-    def __init__(self, human: Human, angles: Mapping | None = None, *, t_span, dt: float = 2e-3):
+    def __init__(self, human: Human, angles: Mapping | None = None, *, t_span: tuple[float, float],
+                 dt: float = 2e-3) -> None:
         if not isinstance(human, Human):
             raise ValidationError(f"human: must be a tumble.variable.Human, got {type(human).__name__}")
         profiles = human.profiles(angles)
@@ -332,7 +337,7 @@ class MovingHuman(VariableBody):
         """The joint angles, name → object with ``angle(t)`` and ``rate(t)`` (rad, rad/s)."""
         return dict(self._angles)
 
-    def outputs(self, kernel, t, states) -> Outputs:
+    def outputs(self, kernel: VariableModel, t: np.ndarray, states: np.ndarray) -> Outputs:
         out = super().outputs(kernel, t, states)
         lead = states.shape[:2]
         joints = np.stack([self._angles[name].angle(t) for name in self._human.dofs], axis=-1)

@@ -28,6 +28,8 @@ from __future__ import annotations
 
 import html
 import os
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -38,6 +40,10 @@ from tumble.viewer._page import document
 from tumble.viewer._scene import Scene, as_json
 from tumble.viewer._shapes import Box, Cylinder
 from tumble.viewer.scenes import BUILDERS, Options
+
+if TYPE_CHECKING:
+    from tumble.simulate import Model
+    from tumble.variable.human import Human
 
 __all__ = ["DEFAULT_FRAMES", "Box", "Cylinder", "html_page", "notebook_html", "scene", "write_html"]
 
@@ -73,7 +79,9 @@ def _axis(axis, traj: Trajectory) -> int:
     return _AXES[axis]
 
 
-def scene(traj, *, model=None, frames: int = DEFAULT_FRAMES, axis: str | None = None, shape=None) -> Scene:
+def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | Human | None = None,
+          frames: int = DEFAULT_FRAMES, axis: str | None = None,
+          shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
     """The :class:`~tumble.viewer._scene.Scene` of a trajectory (what the page draws), refusing what it cannot show.
 
     traj   : a :class:`tumble.Trajectory` (one run, not a batch: ``traj.body(i)`` picks one) or the path of one
@@ -101,12 +109,12 @@ def scene(traj, *, model=None, frames: int = DEFAULT_FRAMES, axis: str | None = 
     return builder(traj, idx, model, Options(_axis(axis, traj), shape, title))
 
 
-def html_page(traj, **options) -> str:
+def html_page(traj: Trajectory | str | os.PathLike[str], **options: Any) -> str:
     """The page (one HTML document) of a trajectory; ``options`` are those of :func:`scene`."""
     return document(as_json(scene(traj, **options)))
 
 
-def write_html(traj, path, **options) -> None:
+def write_html(traj: Trajectory | str | os.PathLike[str], path: str | os.PathLike[str], **options: Any) -> None:
     """Write the page of a trajectory to ``path`` atomically (:func:`tumble.trajectory.write_atomic`).
 
     ``options`` are those of :func:`scene`. Bad input (not a trajectory, an empty one, a frame budget < 2, a
@@ -122,7 +130,7 @@ def _write_text(path: str, text: str) -> None:
         fh.write(text)
 
 
-def notebook_html(traj, **options) -> str | None:
+def notebook_html(traj: Trajectory | str | os.PathLike[str], **options: Any) -> str | None:
     """The page in an ``<iframe srcdoc=…>`` for a notebook cell (Jupyter's ``_repr_html_``), or None (the text
     repr) for a trajectory that cannot be drawn without its model (a robot arm)."""
     try:

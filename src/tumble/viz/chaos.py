@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import os
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -29,6 +30,9 @@ from tumble.analysis import lyapunov_exponents, poincare_section
 from tumble.analytic import omega_at_energy, upward_vertical
 from tumble.torques import Gravity
 from tumble.trajectory import write_atomic
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["TOPS", "demo_chaos", "figure_chaos"]
 
@@ -89,7 +93,7 @@ def chaos_data(*, duration: float = 2000.0, orbits: int = 12, seed: int = 1) -> 
     return data
 
 
-def figure_chaos(data: dict):
+def figure_chaos(data: dict) -> Figure:
     """The matplotlib figure of :func:`chaos_data`: three sections above, the exponents against time below."""
     from matplotlib.figure import Figure
 
@@ -115,7 +119,7 @@ def figure_chaos(data: dict):
     return figure
 
 
-def demo_chaos(out_dir, *, duration: float = 2000.0) -> dict:
+def demo_chaos(out_dir: str | os.PathLike[str], *, duration: float = 2000.0) -> dict:
     """``tumble demo chaos``: write ``chaos.png`` in ``out_dir``; returns the exponents and section sizes."""
     if not os.path.isdir(out_dir):
         raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")

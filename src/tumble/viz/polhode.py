@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array
 from tumble.analytic._free import torque_free
@@ -36,7 +37,8 @@ _COLOURS = {"minor": "tab:blue", "major": "tab:orange", "separatrix": "black", "
 _HIDDEN_ALPHA = 0.18         # opacity of the parts of curves behind the ellipsoid
 
 
-def polhode_figure(body: RigidBody, omega, trajectory: Trajectory | None = None, *, n_curves: int = 5) -> Figure:
+def polhode_figure(body: RigidBody, omega: ArrayLike, trajectory: Trajectory | None = None, *,
+                   n_curves: int = 5) -> Figure:
     """A matplotlib figure of the polhodes and the herpolhode of the motion with body rate ``omega``.
 
     ``omega`` (3,) rad/s in body axes, at the start of the motion. Panels:

@@ -14,6 +14,7 @@ import os
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, require_positive
 from tumble.analytic._heavy_top import HeavyTop, axis_motion, measure_nutation
@@ -40,8 +41,8 @@ _MAX_EXACT_SAMPLES = 50_000
 _MAX_MARKERS = 400               # simulated samples drawn as markers, at most, per panel
 
 
-def top_figure(top: HeavyTop, trajectory: Trajectory | None = None, *, com=None, g=None,
-               duration: float | None = None) -> Figure:
+def top_figure(top: HeavyTop, trajectory: Trajectory | None = None, *, com: ArrayLike | None = None,
+               g: ArrayLike | None = None, duration: float | None = None) -> Figure:
     """A matplotlib figure of the heavy top's symmetry axis (nothing is shown or saved).
 
     Panels: (a) the axis seen from above, at distance θ (deg) from the centre
@@ -136,7 +137,7 @@ def _room_for_legend(ax, values) -> None:
     ax.set_ylim(lo - 0.1 * pad, hi + 0.6 * pad)
 
 
-def demo_top(out_dir, *, duration: float = 1.5) -> dict:
+def demo_top(out_dir: str | os.PathLike[str], *, duration: float = 1.5) -> dict:
     """Simulate :data:`DEMO_TOP` for ``duration`` s and compare it with the exact theory.
 
     Integrates with ``tumble.simulate`` (dop853, rtol = atol = 1e-12, 500

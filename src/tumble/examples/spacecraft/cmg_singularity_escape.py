@@ -11,6 +11,7 @@ argument) and prints the numbers quoted there. Run from the repository root::
 
 from __future__ import annotations
 
+import os
 import sys
 import warnings
 from pathlib import Path
@@ -65,7 +66,7 @@ def figure(sr: tumble.Trajectory, gsr: tumble.Trajectory) -> Figure:
     return fig
 
 
-def main(path=DEFAULT) -> dict:
+def main(path: str | os.PathLike[str] = DEFAULT) -> dict:
     sr, gsr = run(CLUSTER), run(CLUSTER.generalised())
     error = torque_error(gsr)
     cluster = gsr.momentum_body - gsr.omega @ spacecraft(CLUSTER).rate_inertia.T   # the gyros' momentum

@@ -22,14 +22,20 @@ Run:  python src/tumble/examples/sweep/explorer1_damper.py [SAMPLES] [figure.png
 from __future__ import annotations
 
 import math
+import os
 import sys
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import tumble
 from tumble.spacecraft import Spacecraft, SphericalDamper
 from tumble.spacecraft.damper import energy_sink_time_constant
-from tumble.sweep import CrossingTime, Normal, NutationAngle, TruncatedNormal
+from tumble.sweep import CrossingTime, Normal, NutationAngle, TruncatedNormal, sweep
+
+if TYPE_CHECKING:
+    import xarray
+    from numpy.typing import ArrayLike
 
 HUB = tumble.RigidBody(np.diag([1.0, 1.0, 0.4]))  # kg m², without the sphere
 J, SPIN = 0.02, 2.0  # kg m², rad/s
@@ -38,12 +44,12 @@ FLAT = math.radians(80.0)  # rad: the nutation angle counted as a flat spin
 T = np.arange(0.0, 1500.0 + 0.5, 1.0)  # s
 
 
-def spacecraft(damper_inertia, damping):
+def spacecraft(damper_inertia: float, damping: float) -> Spacecraft:
     """The hub with a sphere of inertia ``damper_inertia`` (kg m²) in a viscous film ``damping`` (N m s)."""
     return Spacecraft(hub=HUB, damper=SphericalDamper(float(damper_inertia), float(damping)))
 
 
-def estimate(damper_inertia, damping, omega0):
+def estimate(damper_inertia: float, damping: float, omega0: np.ndarray) -> float:
     """Energy-sink estimate of the time (s) from the initial nutation angle to FLAT: τ ln(θ_f / θ₀)."""
     i_s, i_t = 0.4 + damper_inertia, 1.0 + damper_inertia
     tau = energy_sink_time_constant(i_s, i_t, SphericalDamper(damper_inertia, damping), omega0[2])
@@ -51,18 +57,19 @@ def estimate(damper_inertia, damping, omega0):
     return tau * math.log(FLAT / theta0)
 
 
-def run(samples=500, t=T, seed=1958, **dask):
+def run(samples: int = 500, t: ArrayLike = T, seed: int = 1958, **dask: Any) -> xarray.Dataset:
     c = NOMINAL.damping
-    return tumble.sweep(
+    return sweep(
         spacecraft,
-        {"damper_inertia": TruncatedNormal(J, 0.1 * J), "damping": TruncatedNormal(c, 0.3 * c),
-         "omega0": Normal([0.0, 0.0, SPIN], [0.004, 0.004, 0.02])},
+        {"damper_inertia": TruncatedNormal(np.array(J), np.array(0.1 * J)),
+         "damping": TruncatedNormal(np.array(c), np.array(0.3 * c)),
+         "omega0": Normal(np.array([0.0, 0.0, SPIN]), np.array([0.004, 0.004, 0.02]))},
         samples=samples, seed=seed, t=t, rtol=1e-10, atol=1e-12,
-        outcomes={"time_to_flat_spin": CrossingTime(NutationAngle([0.0, 0.0, 1.0]), above=FLAT)},
-        statistics={"nutation_angle": NutationAngle([0.0, 0.0, 1.0])}, **dask)
+        outcomes={"time_to_flat_spin": CrossingTime(NutationAngle((0.0, 0.0, 1.0)), above=FLAT)},
+        statistics={"nutation_angle": NutationAngle((0.0, 0.0, 1.0))}, **dask)
 
 
-def main(samples=500, figure=None):
+def main(samples: int = 500, figure: str | os.PathLike[str] | None = None) -> xarray.Dataset:
     ds = run(samples)
     measured = ds.time_to_flat_spin.values
     expected = np.array([estimate(j, c, w) for j, c, w in

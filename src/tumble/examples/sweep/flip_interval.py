@@ -11,22 +11,31 @@ Run:  python src/tumble/examples/sweep/flip_interval.py [figure.png]
 
 from __future__ import annotations
 
+import os
 import sys
+from collections.abc import Iterable
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 import tumble
-from tumble.sweep import Grid
+from tumble.sweep import Grid, sweep
+
+if TYPE_CHECKING:
+    import xarray
+    from numpy.typing import ArrayLike
+
+    from tumble.trajectory import Trajectory
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))  # kg m², principal axes = body axes
 EPSILONS = np.logspace(-6, -1, 11)  # rad/s, the perturbation about x and z
 T = np.arange(0.0, 160.0 + 0.005, 0.01)  # s: at least two flips at ε = 1e-6 (interval 51 s)
 
 
-def flip_interval(traj):
+def flip_interval(traj: Trajectory) -> np.ndarray:
     """Outcome: the mean time (s) between successive sign changes of ω_y (body axes), (m,); NaN with fewer
     than two. A crossing time is interpolated linearly between the output times around it."""
-    w = traj.omega[..., 1]  # (n, m)
+    w = cast(np.ndarray, traj.omega)[..., 1]  # (n, m)
     change = np.signbit(w[:-1]) != np.signbit(w[1:])
     dt = np.diff(traj.t)[:, None]
     crossing = traj.t[:-1, None] - w[:-1] * dt / np.where(change, w[1:] - w[:-1], 1.0)
@@ -36,16 +45,16 @@ def flip_interval(traj):
     return np.where(count >= 2, (last - first) / np.maximum(count - 1, 1), np.nan)
 
 
-def run(epsilons=EPSILONS, t=T, **dask):
+def run(epsilons: Iterable[float] = EPSILONS, t: ArrayLike = T, **dask: Any) -> tuple[xarray.Dataset, np.ndarray]:
     """The sweep (one sample per grid point) and the analytic intervals, s."""
-    grid = Grid([[e, 1.0, e] for e in epsilons])
-    ds = tumble.sweep(BODY, {"omega0": grid}, t=t, method="rk4", dt=0.01,
-                      outcomes={"flip_interval": flip_interval}, **dask)
+    grid = Grid(np.array([[e, 1.0, e] for e in epsilons]))
+    ds = sweep(BODY, {"omega0": grid}, t=t, method="rk4", dt=0.01,
+               outcomes={"flip_interval": flip_interval}, **dask)
     exact = np.array([tumble.analytic.flip_interval(BODY, w) for w in grid.points])
     return ds, exact
 
 
-def main(figure=None):
+def main(figure: str | os.PathLike[str] | None = None) -> tuple[xarray.Dataset, np.ndarray]:
     ds, exact = run(workers=0)
     measured = ds.flip_interval.values
     print(" epsilon (rad/s)   measured (s)   2K/lambda (s)   relative difference")

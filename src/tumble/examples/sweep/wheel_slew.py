@@ -23,14 +23,22 @@ Run:  python src/tumble/examples/sweep/wheel_slew.py [SAMPLES] [figure.png]
 from __future__ import annotations
 
 import math
+import os
 import sys
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 import tumble
 from tumble.spacecraft import QuaternionPD, ReactionWheel, Spacecraft
 from tumble.spacecraft.actuators import pyramid_wheels
-from tumble.sweep import Final, Inertia, Misalignment, Normal, PointingError
+from tumble.sweep import Final, Inertia, Misalignment, Normal, PointingError, sweep
+
+if TYPE_CHECKING:
+    import xarray
+    from numpy.typing import ArrayLike
+
+    from tumble.sweep import Dispersion
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])  # kg m², total, body axes
 NOMINAL = pyramid_wheels(0.02, max_torque=0.05, max_speed=600.0, viscous=1e-5)
@@ -39,31 +47,31 @@ LAW = QuaternionPD(natural_frequency=0.15, damping_ratio=0.9, max_rate=0.02, tar
 T = np.arange(0.0, 150.0 + 0.25, 0.5)  # s
 
 
-def spacecraft(inertia, wheel_axes):
+def spacecraft(inertia: np.ndarray, wheel_axes: np.ndarray) -> Spacecraft:
     """The spacecraft of one sample: its inertia (kg m², body axes) and the spin axes of its wheels."""
     wheels = [ReactionWheel(axis=a, inertia=w.inertia, max_torque=w.max_torque, max_speed=w.max_speed,
                             viscous=w.viscous) for a, w in zip(wheel_axes, NOMINAL, strict=True)]
     return Spacecraft(inertia=inertia, wheels=wheels, controller=LAW, control_period=0.5)
 
 
-def dispersions():
+def dispersions() -> dict[str, Dispersion]:
     moments, axes = np.linalg.eigh(INERTIA)
     axes[:, 2] *= np.sign(np.linalg.det(axes))  # a proper rotation
     return {
         "inertia": Inertia(moments, 0.02 * moments, angle=math.radians(1.0), axes=axes),
-        "wheel_axes": Misalignment([w.axis for w in NOMINAL], math.radians(0.5)),
-        "omega0": Normal([0.0, 0.0, 0.0], 1e-3),
+        "wheel_axes": Misalignment(np.array([w.axis for w in NOMINAL]), math.radians(0.5)),
+        "omega0": Normal(np.zeros(3), np.array(1e-3)),
     }
 
 
-def run(samples=1000, t=T, seed=13, **dask):
+def run(samples: int = 1000, t: ArrayLike = T, seed: int = 13, **dask: Any) -> xarray.Dataset:
     """The sweep: pointing error at the end (rad) and over time."""
-    return tumble.sweep(spacecraft, dispersions(), samples=samples, seed=seed, t=t, method="rk4", dt=0.05,
-                        outcomes={"final_pointing_error": Final(PointingError(TARGET))},
-                        statistics={"pointing_error": PointingError(TARGET)}, **dask)
+    return sweep(spacecraft, dispersions(), samples=samples, seed=seed, t=t, method="rk4", dt=0.05,
+                 outcomes={"final_pointing_error": Final(PointingError(tuple(TARGET)))},
+                 statistics={"pointing_error": PointingError(tuple(TARGET))}, **dask)
 
 
-def main(samples=1000, figure=None):
+def main(samples: int = 1000, figure: str | os.PathLike[str] | None = None) -> xarray.Dataset:
     ds = run(samples)
     error = ds.final_pointing_error.values
     p = dict(zip(ds.percentile.values, ds.final_pointing_error_percentiles.values, strict=True))

@@ -11,9 +11,16 @@ Adding a model to the viewer is one module here and one row of
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from tumble.viewer.scenes import flexible, human, rigid, robot, slosh, spacecraft
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from tumble.trajectory import Trajectory
+    from tumble.viewer._scene import Scene
 
 __all__ = ["BUILDERS", "Options"]
 
@@ -28,7 +35,7 @@ class Options(NamedTuple):
 
 
 #: Trajectory.model → the builder of its scene.
-BUILDERS = {
+BUILDERS: dict[str, Callable[[Trajectory, np.ndarray, Any, Options], Scene]] = {
     "RigidBody": rigid.scene,
     "Spacecraft": spacecraft.scene,
     "SerialChain": robot.scene,

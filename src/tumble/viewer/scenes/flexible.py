@@ -12,12 +12,19 @@ tip deflection is a quarter of ``s``, and stated on the page.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 
 from tumble.flexible import FlexibleBody
 from tumble.viewer._scene import Lines, check_model
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 from tumble.viewer.scenes.rigid import hub_mesh
+
+if TYPE_CHECKING:
+    from tumble.trajectory import Trajectory
+    from tumble.viewer._scene import Scene
+    from tumble.viewer.scenes import Options
 
 __all__ = ["scene"]
 
@@ -35,7 +42,7 @@ def _panel_axes(delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return u, np.cross(d, u)
 
 
-def scene(traj, idx, model, options):
+def scene(traj: Trajectory, idx: np.ndarray, model: FlexibleBody | None, options: Options) -> Scene:
     check_model(model, (FlexibleBody,), traj)
     body = model.body if isinstance(model, FlexibleBody) else None
     mesh, note = hub_mesh(traj, body, options.shape)
@@ -48,7 +55,7 @@ def scene(traj, idx, model, options):
     largest = float(np.abs(eta).max())
     gain = _TIP * length / largest if largest > 0.0 else 0.0
     x = np.linspace(0.0, 1.0, _POINTS)
-    R = rotations(traj.q[idx])
+    R = rotations(cast(np.ndarray, traj.q)[idx])
     for k, delta in enumerate(model.participation.T):
         u, bend = _panel_axes(delta)
         u, bend = (-1) ** k * u, (-1) ** k * bend   # modes alternate sides of the hub

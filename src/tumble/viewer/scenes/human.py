@@ -14,6 +14,8 @@ the trajectory's inertia.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 
 from tumble._inertia import principal_axes
@@ -24,6 +26,12 @@ from tumble.viewer._shapes import Mesh, box_mesh, equivalent_box
 from tumble.viewer.scenes import rigid
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 
+if TYPE_CHECKING:
+    from tumble.body import Part
+    from tumble.trajectory import Trajectory
+    from tumble.viewer._scene import Scene
+    from tumble.viewer.scenes import Options
+
 __all__ = ["scene", "segment_mesh"]
 
 _TRUNK, _LEFT, _RIGHT = "#f2a541", "#d62728", "#1f77b4"
@@ -31,7 +39,7 @@ _NOTE = ("its segments, each the uniform box of its own mass and principal momen
          "from Human.kinematics, about the whole-body centre of mass (red: left limbs, blue: right limbs)")
 
 
-def segment_mesh(part) -> Mesh:
+def segment_mesh(part: Part) -> Mesh:
     """The equivalent box of a segment's ``part`` (mass, inertia about its centre of mass), in the segment's axes,
     centred on its centre of mass."""
     _, moments, axes = principal_axes(part.inertia, "inertia", check_triangle=False)
@@ -51,7 +59,7 @@ class _AtFrames:
         return np.zeros_like(self._values)
 
 
-def scene(traj, idx, model, options):
+def scene(traj: Trajectory, idx: np.ndarray, model: MovingHuman | Human | None, options: Options) -> Scene:
     check_model(model, (MovingHuman, Human), traj)
     if model is None:
         return rigid.scene(traj, idx, None, options)
@@ -61,7 +69,7 @@ def scene(traj, idx, model, options):
                               f"{traj.joint_angles.shape[-1]}")
     angles = traj.joint_angles[idx]
     kin = human.kinematics(traj.t[idx], {name: _AtFrames(angles[:, k]) for k, name in enumerate(human.dofs)})
-    R = rotations(traj.q[idx])
+    R = rotations(cast(np.ndarray, traj.q)[idx])
     meshes = [segment_mesh(s.part) for s in human.segments]
     points = [np.einsum("fij,vj->fvi", kin.rotation[:, i], m.vertices) + (kin.joint[:, i] - kin.com)[:, None]
               for i, m in enumerate(meshes)]

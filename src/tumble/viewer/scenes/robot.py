@@ -11,12 +11,18 @@ against time.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from tumble._validate import ValidationError
 from tumble.robot import SerialChain, link_poses
 from tumble.viewer._scene import Lines, Panel, Scene, Solid, check_model
 from tumble.viewer._shapes import box_mesh
+
+if TYPE_CHECKING:
+    from tumble.trajectory import Trajectory
+    from tumble.viewer.scenes import Options
 
 __all__ = ["joint_points", "scene"]
 
@@ -29,7 +35,7 @@ def joint_points(chain: SerialChain, q: np.ndarray) -> np.ndarray:
     return np.concatenate([np.zeros((len(q), 1, 3)), poses[:, :, :3, 3]], axis=1)
 
 
-def scene(traj, idx, model, options):
+def scene(traj: Trajectory, idx: np.ndarray, model: SerialChain | None, options: Options) -> Scene:
     check_model(model, (SerialChain,), traj)
     if model is None:
         raise ValidationError("model: a SerialChain trajectory holds joint coordinates only; pass its chain "

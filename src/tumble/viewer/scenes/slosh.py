@@ -9,6 +9,8 @@ half-diagonal.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 
 from tumble.slosh import SloshBody
@@ -16,10 +18,15 @@ from tumble.viewer._scene import Lines, check_model
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 from tumble.viewer.scenes.rigid import hub_mesh
 
+if TYPE_CHECKING:
+    from tumble.trajectory import Trajectory
+    from tumble.viewer._scene import Scene
+    from tumble.viewer.scenes import Options
+
 __all__ = ["scene"]
 
 
-def scene(traj, idx, model, options):
+def scene(traj: Trajectory, idx: np.ndarray, model: SloshBody | None, options: Options) -> Scene:
     check_model(model, (SloshBody,), traj)
     body = model.body if isinstance(model, SloshBody) else None
     mesh, note = hub_mesh(traj, body, options.shape)
@@ -30,7 +37,7 @@ def scene(traj, idx, model, options):
         hinge, length = np.zeros(3), float(np.linalg.norm(mesh.vertices, axis=-1).max())
         where = "from the centre, a rod of the hub's half-diagonal (no model given)"
     ends = np.stack([np.broadcast_to(hinge, (len(idx), 3)), hinge + length * traj.pendulum_direction[idx]], axis=1)
-    R = rotations(traj.q[idx])
+    R = rotations(cast(np.ndarray, traj.q)[idx])
     scene.lines.append(Lines("slosh pendulum", np.einsum("fij,fpj->fpi", R, ends), "#17becf", width=7.0,
                              markers=True))
     scene.notes.append(f"slosh pendulum: rod and mass at true scale (exaggeration 1), {where}")

@@ -17,6 +17,8 @@ Drawn from the :class:`tumble.spacecraft.Spacecraft` (its parts) and its traject
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 import numpy as np
 
 from tumble.spacecraft import Spacecraft
@@ -24,6 +26,11 @@ from tumble.viewer._scene import Lines, Solid, check_model
 from tumble.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
 from tumble.viewer.scenes.rigid import hub_mesh
+
+if TYPE_CHECKING:
+    from tumble.trajectory import Trajectory
+    from tumble.viewer._scene import Scene
+    from tumble.viewer.scenes import Options
 
 __all__ = ["scene", "spin_angles"]
 
@@ -50,7 +57,7 @@ def _rotor(radius: float, thickness: float) -> tuple[Mesh, Mesh]:
     return cylinder_mesh(radius, thickness), spoke
 
 
-def scene(traj, idx, model, options):
+def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: Options) -> Scene:
     check_model(model, (Spacecraft,), traj)
     craft = model if isinstance(model, Spacecraft) else None
     body = None if craft is None else (craft.hub if craft.hub is not None else craft.body)
@@ -61,7 +68,7 @@ def scene(traj, idx, model, options):
         return scene
     half = float(np.linalg.norm(mesh.vertices, axis=-1).max())
     com = np.zeros(3) if craft.body.com is None else craft.body.com
-    R = rotations(traj.q[idx])
+    R = rotations(cast(np.ndarray, traj.q)[idx])
     disk, spoke = _rotor(_DISK[0] * half, _DISK[1] * half)
     if craft.wheels:
         theta = spin_angles(traj.t, traj.wheel_speed)[idx]
