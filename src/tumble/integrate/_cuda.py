@@ -80,7 +80,11 @@ def _torque_by_type(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
             return None
 
         return impl
-    return torques.evaluate_compiled
+
+    def program(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):  # the typing signature's names, unannotated
+        return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
+
+    return program
 
 
 @register_jitable
