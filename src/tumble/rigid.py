@@ -21,6 +21,7 @@ RigidBody or an (N, 3, 3) inertia array, validated in one vectorised call).
 from __future__ import annotations
 
 import abc
+import functools
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, cast
 
@@ -44,12 +45,15 @@ __all__ = ["RigidMotion", "RigidBodies"]
 _STACKLEVEL = 4
 
 
-#: The initial state of every rigid model (made once: a simulate call reads it).
-_STATE_FIELDS = (
-    StateField("omega0", 3, "initial body rate, rad/s, body axes"),
-    StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
-               default=attitude.identity(), quaternion=True),
-)
+@functools.cache
+def _state_fields() -> tuple[StateField, ...]:
+    """The initial state of every rigid model, made once, on the first call: a simulate call reads it (not at
+    import: checking the default quaternion calls compiled code, whose loading would slow ``import tumble``)."""
+    return (
+        StateField("omega0", 3, "initial body rate, rad/s, body axes"),
+        StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
+                   default=attitude.identity(), quaternion=True),
+    )
 
 
 class RigidMotion(Model):
@@ -77,7 +81,7 @@ class RigidMotion(Model):
         """The mass(es), kg, or None when unknown (for the rigidity check)."""
 
     def state_fields(self) -> tuple[StateField, ...]:
-        return _STATE_FIELDS
+        return _state_fields()
 
     def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.RigidModel:
         moments, axes, _ = self._principal()
