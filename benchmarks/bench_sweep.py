@@ -1,9 +1,9 @@
 """Sweep throughput on Dask against the plain in-process batch, the Dask overhead per chunk, and the peak memory
 of a big ``simulate(..., store=)`` run.
 
-    python benchmarks/bench_sweep.py [--samples 40000] [--chunk 10000] [--big 100000] [--repeats 5]
+    python benchmarks/bench_sweep.py [--samples 40000] [--chunk 10000] [--big 100000] [--repeats 5] [--dt 0.01]
 
-Workload: rigid bodies I = diag(1, 2, 3) kg m², rk4 at dt = 0.01 s for 10 s
+Workload: rigid bodies I = diag(1, 2, 3) kg m², rk4 at dt = 0.01 s (``--dt``) for 10 s
 (1000 steps), 101 output times, initial rates N((0, 0, 1), 0.05²) and uniform
 attitudes; the sweep keeps one outcome (the final nutation angle) and one
 series (ω_z, with its per-time statistics and percentiles). Figures:
@@ -112,17 +112,21 @@ def main():
     parser.add_argument("--tiny", type=int, default=200, help="one-sample chunks for the overhead per chunk")
     parser.add_argument("--big", type=int, default=100_000, help="bodies of the store= run (0: skip it)")
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--dt", type=float, default=0.01, help="rk4 step, s (0.001: 10 000 steps a sample, an "
+                        "integration ten times as costly for the same outputs and statistics)")
     args = parser.parse_args()
     from distributed import Client
 
     print(machine())
     print(load(), "(before)")
     s, chunk, repeats = args.samples, args.chunk, args.repeats
+    OPTIONS["dt"] = args.dt
+    steps = round(T[-1] / args.dt)
     sweep = dict(dispersions=DISPERSIONS, samples=s, seed=1, chunk=chunk, t=T, **OPTIONS, **REDUCE)
     inputs = tumble.sweep(BODY, **{**sweep, "samples": 8, "chunk": 8}, workers=0)  # compile, warm the cache
     inputs = tumble.sweep(BODY, **sweep, workers=0)
     omega0, q0 = inputs.omega0.values, inputs.q0.values
-    print(f"\nsamples/s: {s} samples of 1000 rk4 steps, 101 outputs, chunks of {chunk}; {repeats} repeats")
+    print(f"\nsamples/s: {s} samples of {steps} rk4 steps, 101 outputs, chunks of {chunk}; {repeats} repeats")
     print(f"  {'':<34} {'wall min':>10} {'wall med':>10}   {'CPU min':>10} {'CPU med':>10}   {'s min':>7} "
           f"{'s med':>7}")
     plain = row(f"plain batch, {os.cpu_count()} threads", s,
