@@ -32,7 +32,10 @@ The per-time statistics merge the chunks' moments in chunk order with
 :mod:`tumble.ensemble`'s exact pairwise update (Chan, Golub & LeVeque 1979),
 so they are the same bit for bit whatever the number of workers or the order
 in which chunks finished; the percentiles are exact (``numpy.percentile``,
-linear interpolation), read from the stored series in blocks of output times.
+linear interpolation), read from the stored series in blocks of output times,
+each block's times shared between threads (one per core: NumPy's partition
+releases the GIL, and each time's percentiles are computed alone, so they are
+the same whatever the split).
 An outcome is NaN where its event did not happen within the run (a
 :class:`~tumble.sweep.CrossingTime` never crossed, a
 :class:`~tumble.sweep.SettlingTime` not settled at the end): its percentiles
@@ -209,7 +212,7 @@ class SweepStore:
             for stat, value in zip(STATISTICS, (mean, np.sqrt(m2 / count), low, high), strict=True):
                 data[f"{name}_{stat}"] = ("time", value)
             block = max(1, _BLOCK_WORDS // plan.samples)
-            bands = [np.percentile(group[name][:, a:a + block], p, axis=0) for a in range(0, len(plan.t), block)]
+            bands = [_percentiles(group[name][:, a:a + block], p) for a in range(0, len(plan.t), block)]
             data[f"{name}_percentiles"] = ("percentile", "time"), np.concatenate(bands, axis=1)
         for name in plan.outcomes:
             values = group[name][:]
@@ -230,3 +233,15 @@ class SweepStore:
         if self.path is None:  # read here, not through whatever Dask scheduler is the default now
             return xr.open_zarr(self._memory, consolidated=False, zarr_format=3, chunks=None).load()
         return xr.open_zarr(self.path, consolidated=False, zarr_format=3)
+
+
+def _percentiles(values: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``numpy.percentile(values, p, axis=0)``, the columns (output times) split between one thread per core."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    parts = [c for c in np.array_split(np.arange(values.shape[1]), os.cpu_count() or 1) if c.size]
+    if len(parts) < 2:
+        return np.percentile(values, p, axis=0)
+    with ThreadPoolExecutor(len(parts)) as pool:
+        return np.concatenate(list(pool.map(lambda c: np.percentile(values[:, c[0]:c[-1] + 1], p, axis=0), parts)),
+                              axis=1)
