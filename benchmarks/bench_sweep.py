@@ -16,7 +16,8 @@ series (ω_z, with its per-time statistics and percentiles). Figures:
   draw per chunk);
 * the sweep in this process (``workers=0``: draws, chunks, reductions, store in memory);
 * the sweep on a LocalCluster of 1 and of 2 single-threaded worker processes
-  (started and warmed up before the timing);
+  (started and warmed up before the timing), and on 2 with the outcomes only
+  (no per-time series, whose exact percentiles need every sample at the end);
 * the overhead per chunk: a sweep of ``--tiny`` one-sample chunks of one step
   on 2 workers, minus the same sweep in this process, per chunk;
 * the peak RSS of ``simulate(..., store=)`` of ``--big`` bodies × 1000 output
@@ -158,6 +159,9 @@ def main():
         rates[n] = row(f"sweep on {n} local worker{'s' if n > 1 else ''}", s,
                        *timed(repeats, lambda client=client: tumble.sweep(BODY, **sweep, client=client), client))
         if n == 2:
+            lean = {**sweep, "statistics": None}  # no per-time series: the outcomes and their percentiles only
+            rates["lean"] = row("  the same, outcomes only", s, *timed(
+                repeats, lambda client=client: tumble.sweep(BODY, **lean, client=client), client))
             tiny = dict(dispersions=DISPERSIONS, samples=args.tiny, seed=1, chunk=1, t=[0.0, 0.01], **OPTIONS)
             local, _ = timed(repeats, lambda: tumble.sweep(BODY, **tiny, workers=0))
             dask, _ = timed(repeats, lambda client=client: tumble.sweep(BODY, **tiny, client=client))
@@ -166,7 +170,7 @@ def main():
         print(f"    (cluster of {n} started in {started:.2f} s, not counted)")
     print(f"\n2 workers / plain batch on {os.cpu_count()} threads: {rates[2] / plain:.3f} (wall, best runs); "
           f"2 workers / the same work in one process: {rates[2] / full:.3f}; 2 workers / 1 worker: "
-          f"{rates[2] / rates[1]:.2f}")
+          f"{rates[2] / rates[1]:.2f}; 2 workers with the outcomes only / plain batch: {rates['lean'] / plain:.3f}")
     per_chunk = [(d - l) / args.tiny for d, l in zip(sorted(dask), sorted(local), strict=True)]
     print(f"Dask overhead per chunk ({args.tiny} one-sample chunks on 2 workers, minus the same in this process): "
           f"min {min(per_chunk) * 1e3:.2f} ms, median {statistics.median(per_chunk) * 1e3:.2f} ms "
