@@ -107,7 +107,7 @@ def _splitting_workspace(scheme, model, b0, Y):
 
 # error_model="numpy": IEEE division without Python's zero check, which measured
 # 2x in the rotation loop (no divisor below can be zero).
-@_protocol.implements(_fixed.advance, Splitting, error_model="numpy")
+@_protocol.implements(_fixed.advance, Splitting)
 def _splitting_advance(scheme, model, b0, t0, h, m, Y, work):
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
