@@ -57,6 +57,21 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
     return arr
 
 
+def readonly(arr: np.ndarray) -> np.ndarray:
+    """``arr`` C-contiguous and read-only (a view when it is already contiguous), the one form in which the
+    compiled loops that only read an array take it.
+
+    Numba compiles a function once per combination of its arrays' layout and writeability, so handing every
+    input over in one form compiles one copy, whether it came from a user or from a Trajectory (whose
+    arrays are read-only).
+    """
+    arr = np.ascontiguousarray(arr)
+    if arr.flags.writeable:
+        arr = arr.view()
+        arr.flags.writeable = False
+    return arr
+
+
 def require_finite(arr: np.ndarray, name: str) -> None:
     """Raise :class:`ValidationError` if ``arr`` holds NaN or ±inf."""
     finite = np.isfinite(arr)
@@ -115,11 +130,12 @@ def increasing_times(t, name: str = "t", *, what: str = "output times", at_least
 
 
 def output_times(t) -> np.ndarray:
-    """The output times ``t`` (s) as a 1-D float64 array of at least one strictly increasing time.
+    """The output times ``t`` (s) as a 1-D float64 array of at least one strictly increasing time, C-contiguous
+    and read-only (:func:`readonly`: one compiled copy of each driver, whatever array the times came in).
 
     The one check of output times, used by every model through :func:`tumble.simulate`.
     """
-    return increasing_times(t)
+    return readonly(increasing_times(t))
 
 
 

@@ -42,7 +42,7 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from ._quat import qexp, qfrom_matrix, qlog, qmul, qnorm, qrotate, qrotate_inv, qto_matrix
-from ._validate import ValidationError, as_array, require_positive
+from ._validate import ValidationError, as_array, readonly, require_positive
 
 if TYPE_CHECKING:
     from scipy.spatial.transform import Rotation
@@ -114,8 +114,9 @@ def _scaled(q: np.ndarray) -> np.ndarray:
 
 
 def _flat(arr: np.ndarray, batch: tuple[int, ...], tail: tuple[int, ...]) -> np.ndarray:
-    """``arr`` broadcast to ``batch + tail`` and flattened to a C-contiguous (n, *tail) array."""
-    return np.ascontiguousarray(np.broadcast_to(arr, batch + tail)).reshape((-1, *tail))
+    """``arr`` broadcast to ``batch + tail`` and flattened to a C-contiguous, read-only (n, *tail) array
+    (:func:`~tumble._validate.readonly`: the loops compile once)."""
+    return readonly(np.broadcast_to(arr, batch + tail)).reshape((-1, *tail))
 
 
 def _batch(*args: tuple[str, np.ndarray, int]) -> tuple[int, ...]:
@@ -308,7 +309,7 @@ def normalize(q: ArrayLike) -> np.ndarray:
 def _normalized(q: np.ndarray) -> np.ndarray:
     """:func:`normalize` of a float64 (…, 4) array already checked (finite, non-zero; the front door's)."""
     out = np.empty((math.prod(q.shape[:-1]), 4))
-    _normalize_loop(np.ascontiguousarray(q).reshape((-1, 4)), out)
+    _normalize_loop(readonly(q).reshape((-1, 4)), out)
     return out.reshape(q.shape)
 
 

@@ -32,7 +32,7 @@ from numpy.typing import ArrayLike
 from tumble import attitude, limits, torques
 from tumble._inertia import principal_axes
 from tumble._quat import qmul
-from tumble._validate import ValidationError, as_array
+from tumble._validate import ValidationError, as_array, readonly
 from tumble.kernels import rigid as _kernel
 from tumble.simulate import Model, Outputs, StateField
 
@@ -90,7 +90,7 @@ class RigidMotion(Model):
     def initial_states(self, kernel: _kernel.RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         moments, axes, q_bp = self._principal()
         y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
-        _to_principal_axes(values["q0"], values["omega0"], q_bp, axes, y0)
+        _to_principal_axes(readonly(values["q0"]), readonly(values["omega0"]), readonly(q_bp), readonly(axes), y0)
         limits.check_rigid_motion(moments, y0[:, 4:], self._masses(), stacklevel=_STACKLEVEL)
         return y0
 
@@ -99,7 +99,7 @@ class RigidMotion(Model):
         if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
             limits.check_rigid_motion(moments, states[-1, :, 4:], self._masses(), stacklevel=_STACKLEVEL)
         q, omega = np.empty(states.shape[:-1] + (4,)), np.empty(states.shape[:-1] + (3,))
-        _to_body_axes(states, q_bp, axes, q, omega)
+        _to_body_axes(states, readonly(q_bp), readonly(axes), q, omega)
         return Outputs(q=q, omega=omega, inertia=self._reported_inertia(), extras={}, totals={}, info={})
 
 

@@ -45,7 +45,7 @@ from typing import Any, cast
 import numpy as np
 
 from tumble._protocol import CAPABILITIES
-from tumble._validate import ValidationError, require_memory, require_positive
+from tumble._validate import ValidationError, readonly, require_memory, require_positive
 from tumble.integrate import _dop853, _exact, _exactsplit, _fixed, _liegroup, _rk4, _splitting
 
 __all__ = ["MAX_STEPS", "METHODS", "Diverged", "Method", "Solution", "SolverError", "check_method", "check_options",
@@ -236,6 +236,7 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float |
     m = check_method(method, model.provides, f"a {type(model).__name__}")
     check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
     y = (np.asarray if overwrite_y0 else np.array)(y0, dtype=np.float64, order="C")
+    t = readonly(t)  # the form simulate's output times come in: the drivers compile once
     n_out = t.shape[0]
     require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
                    f"member(s) × {y.shape[1]} values")

@@ -104,13 +104,15 @@ def _three(model: RobotTree, a: ArrayLike, b: ArrayLike, c: ArrayLike, names: tu
 
 
 def _joints(model: RobotTree, x, name: str, size: int | None = None) -> np.ndarray:
-    """``x`` as a float64 array (n,) or a C-contiguous (B, n) batch, n = ``size`` (default nq)."""
+    """``x`` as a C-contiguous, writeable float64 array (n,) or batch (B, n), n = ``size`` (default nq).
+
+    Writeable (a read-only input, such as a Trajectory's, is copied): the kernels then compile once, with the
+    arrays that the compiled robot model passes them.
+    """
     a = np.asarray(x, dtype=np.float64)
     n = model._nq if size is None else size
-    if a.ndim == 1 and a.shape[0] == n:
-        return a  # one state: a 1-D float64 array is contiguous unless strided (then Numba adapts)
-    if a.ndim == 2 and a.shape[1] == n:
-        return np.ascontiguousarray(a)
+    if (a.ndim == 1 and a.shape[0] == n) or (a.ndim == 2 and a.shape[1] == n):
+        return a if a.flags.c_contiguous and a.flags.writeable else np.array(a)
     what = "configuration coordinates" if size is None or size == model._nq else "velocity coordinates"
     raise ValidationError(f"{name}: must have shape ({n},) or (B, {n}) for the {n} {what} of this robot, "
                           f"got {a.shape}")
