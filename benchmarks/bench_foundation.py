@@ -27,6 +27,7 @@ import ctypes
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 from pathlib import Path
 
@@ -36,6 +37,7 @@ from scipy.integrate import solve_ivp
 
 import tumble
 from _timing import fmt, machine, measure
+from tumble._validate import readonly
 from tumble.integrate import _fixed, _rk4
 from tumble.kernels import rigid as _rigid
 from tumble.rigid import RigidBodies
@@ -85,6 +87,7 @@ def single_body(steps):
     t = np.array([0.0, steps * 1e-3])
     m, h = _fixed.landing_steps(t, 1e-3, 10**9)
     out, stats = np.empty((2, 1, 7)), np.zeros((1, 5))
+    t = readonly(t)  # the arguments' types those of simulate's call: the same compiled function runs
     run = lambda: _fixed.run_one(_rk4.SCHEME, model, y.copy(), t, m, h, out, stats)  # noqa: E731
     run()  # compile / load from cache
     naive_numba_rk4(naive_rhs, y[0].copy(), 1e-3, 10)
@@ -130,7 +133,9 @@ def batch(n_bodies, steps, per_body, c_kernels):
     m, h = _fixed.landing_steps(t, 1e-3, 10**9)
     y = np.zeros((n_bodies, 7))
     y[:, 0], y[:, 4:] = 1.0, omega0
-    out, stats = np.empty((2, n_bodies, 7)), np.zeros((n_bodies, 3), dtype=np.int64)
+    # the arguments' types those of simulate's call (read-only times, float statistics): the same compiled
+    # function runs, not a copy compiled here against a cached rest (docs/architecture.md)
+    out, stats, t = np.empty((2, n_bodies, 7)), np.zeros((n_bodies, 5)), readonly(t)
     rows["kernel alone"] = measure(lambda: _fixed.run_batch(_rk4.SCHEME, kernel, y, t, m, h, out, stats)).rates(
         work, CORES)
     for name, c_kernel in c_kernels.items():
@@ -167,11 +172,41 @@ def adaptive_vs_scipy(t_end, rtol, atol, reference):
             "scipy_err": np.abs(theirs.result.y[4:].T - reference).max()}
 
 
+_COMPILING = """
+import os, sys, time
+import numpy as np
+import tumble
+body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+n, steps = int(sys.argv[1]), int(sys.argv[2])
+omega0 = np.array([1e-3, 1.0, 1e-3]) + 1e-2 * np.random.default_rng(1).standard_normal((n, 3))
+tumble.simulate(body, omega0, t=[0.0, 1e-3], method="rk4", dt=1e-3)  # compiles the batch path here
+best = float("inf")
+for _ in range(5):
+    start = time.process_time()
+    tumble.simulate(body, omega0, t=[0.0, steps * 1e-3], method="rk4", dt=1e-3)
+    best = min(best, time.process_time() - start)
+print(n * steps / best * len(os.sched_getaffinity(0)))
+"""
+
+
+def compiling_process_rate(n_bodies, steps):
+    """Body-steps/s (CPU × cores, best of 5) of the shared-inertia batch in a new process that compiles the
+    batch path itself (an empty ``NUMBA_CACHE_DIR``): it runs the copy of the fused step compiled on its own,
+    which one round of LLVM's optimisation leaves scalar (docs/architecture.md)."""
+    with tempfile.TemporaryDirectory() as cache:
+        done = subprocess.run([sys.executable, "-c", _COMPILING, str(n_bodies), str(steps)], check=True,
+                              capture_output=True, text=True, env=dict(os.environ, NUMBA_CACHE_DIR=cache))
+    return float(done.stdout.split()[-1])
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller sizes")
     args = parser.parse_args()
     print(machine())
+    # the rows measure compiled code loaded from the cache, as every process after the first runs it (row 2c:
+    # the process that compiles)
+    subprocess.run([sys.executable, "-m", "tumble", "warmup"], check=True, capture_output=True)
     print(f"tumble {tumble.__version__}; body I = diag{MOMENTS.tolist()} kg m²; min / median of >= 5 repeats; "
           f"'cpu' rates = work / CPU s × {CORES} cores\n")
 
@@ -192,6 +227,9 @@ def main():
             if c_name in rows:
                 print(f"   tumble / {c_name} (cpu, best): {rows['tumble']['cpu'][0] / rows[c_name]['cpu'][0]:.0%}; "
                       f"kernel alone: {rows['kernel alone']['cpu'][0] / rows[c_name]['cpu'][0]:.0%}")
+
+    print(f"\n2c. batch RK4 as 2a, in a new process that compiles it (empty NUMBA_CACHE_DIR): "
+          f"{compiling_process_rate(n_bodies, steps):.3g} body-steps/s (cpu, best of 5)")
 
     n_big = 200_000 if args.quick else 1_000_000
     setup, step = big_batch_overhead(n_big)
