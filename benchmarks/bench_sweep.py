@@ -115,16 +115,24 @@ def main():
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--dt", type=float, default=0.01, help="rk4 step, s (0.001: 10 000 steps a sample, an "
                         "integration ten times as costly for the same outputs and statistics)")
+    parser.add_argument("--warm-only", action="store_true", help="compile the paths into the cache and exit (the "
+                        "script runs itself so first: a process that compiles a batch runs it about 5x slower than "
+                        "one that loads it, docs/architecture.md)")
     args = parser.parse_args()
     from distributed import Client
 
-    print(machine())
-    print(load(), "(before)")
+    if not args.warm_only:
+        subprocess.run([sys.executable, __file__, "--warm-only", "--dt", str(args.dt)], check=True)
+        print(machine())
+        print(load(), "(before)")
     s, chunk, repeats = args.samples, args.chunk, args.repeats
     OPTIONS["dt"] = args.dt
     steps = round(T[-1] / args.dt)
     sweep = dict(dispersions=DISPERSIONS, samples=s, seed=1, chunk=chunk, t=T, **OPTIONS, **REDUCE)
-    inputs = tumble.sweep(BODY, **{**sweep, "samples": 8, "chunk": 8}, workers=0)  # compile, warm the cache
+    inputs = tumble.sweep(BODY, **{**sweep, "samples": 8, "chunk": 8}, workers=0)  # compile, or load from the cache
+    if args.warm_only:
+        tumble.simulate(BODY, inputs.omega0.values, q0=inputs.q0.values, t=T, **OPTIONS)
+        return
     inputs = tumble.sweep(BODY, **sweep, workers=0)
     omega0, q0 = inputs.omega0.values, inputs.q0.values
     print(f"\nsamples/s: {s} samples of {steps} rk4 steps, 101 outputs, chunks of {chunk}; {repeats} repeats")
