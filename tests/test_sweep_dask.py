@@ -94,8 +94,9 @@ def scheduler_file(reference, tmp_path_factory):
         with distributed.Client(scheduler_file=str(path), timeout=TIMEOUT) as client:
             client.wait_for_workers(2, timeout=TIMEOUT)
         yield path
-    finally:
-        stop(*processes)
+    finally:  # the workers first: a worker whose scheduler is gone retries it before it exits (5 s and more)
+        stop(*processes[1:])
+        stop(*processes[:1])
 
 
 def test_local_cluster_of_two_processes_equals_the_run_in_this_process(local_client, reference):
