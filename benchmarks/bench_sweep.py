@@ -116,8 +116,8 @@ def main():
     parser.add_argument("--dt", type=float, default=0.01, help="rk4 step, s (0.001: 10 000 steps a sample, an "
                         "integration ten times as costly for the same outputs and statistics)")
     parser.add_argument("--warm-only", action="store_true", help="compile the paths into the cache and exit (the "
-                        "script runs itself so first: a process that compiles a batch runs it about 5x slower than "
-                        "one that loads it, docs/architecture.md)")
+                        "script runs itself so first: every figure is then of code loaded from the cache, as "
+                        "every later process runs it)")
     args = parser.parse_args()
     from distributed import Client
 

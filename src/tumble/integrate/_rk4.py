@@ -128,6 +128,37 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     return impl
 
 
+W = _fixed.LANES  # lanes of a block: the stride of the buffer x
+
+
+@njit(_nrt=False, error_model="numpy")
+def _lane_steps(model, block, shared, t0, h, m, x, lanes):
+    """``m`` RK4 steps of ``h`` (s) from ``t0`` of the ``lanes`` lanes of the buffer ``x`` (see
+    :func:`_fused_advance`), with the parameters of ``model`` (row 0, ``shared``) or of ``block`` (row ``j``
+    for lane ``j``).
+
+    Compiled without reference counting (``_nrt=False``; it allocates nothing), so that the copy compiled
+    on its own is vectorised: the step, IR-inlined, binds the model's arrays again in every call, and
+    the increments and decrements of their counts, split across the status branches of its helpers'
+    calls, were still in the lane loop when LLVM's one ``-O3`` round tried to vectorise it. The process
+    that compiles a batch runs that copy (docs/architecture.md): it ran 5× slower than one loading the
+    cached code, and now runs as fast.
+    """
+    # two loops, so that shared parameters are a broadcast and per-member ones a contiguous load
+    for s in range(m):
+        t = t0 + s * h
+        if shared:
+            for j in range(lanes):
+                (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
+                    point_step(model, 0, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
+                                                x[5 * W + j], x[6 * W + j])))
+        else:
+            for j in range(lanes):
+                (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
+                    point_step(block, j, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
+                                                x[5 * W + j], x[6 * W + j])))
+
+
 def _fused_advance(Y):
     """``advance`` of a kernel with ``point_rates``: the state vector, or each lane of the block, in
     registers through all ``m`` steps (one body) or through one step per pass over the lanes (a block).
@@ -149,28 +180,13 @@ def _fused_advance(Y):
 
         return impl
 
-    W = _fixed.LANES
-
     def impl(scheme, model, b0, t0, h, m, Y, work):
         x, block = work
         lanes = Y.shape[1]
         for i in range(7):
             for j in range(lanes):
                 x[i * W + j] = Y[i, j]
-        # two loops, so that shared parameters are a broadcast and per-member ones a contiguous load
-        shared = uniform(model)
-        for s in range(m):
-            t = t0 + s * h
-            if shared:
-                for j in range(lanes):
-                    (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
-                        point_step(model, 0, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
-                                                    x[5 * W + j], x[6 * W + j])))
-            else:
-                for j in range(lanes):
-                    (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
-                        point_step(block, j, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
-                                                    x[5 * W + j], x[6 * W + j])))
+        _lane_steps(model, block, uniform(model), t0, h, m, x, lanes)
         for i in range(7):
             for j in range(lanes):
                 Y[i, j] = x[i * W + j]
