@@ -24,7 +24,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 from numba.extending import register_jitable
 
 from tumble import _protocol
@@ -101,7 +101,7 @@ def _rk4_workspace(scheme, model, b0, Y):
 @_protocol.implements(_fixed.advance, RK4)
 def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     if _protocol.implemented(point_rates, model):
-        return _fused_advance(Y)
+        return _fused_advance(Y, model)
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         k1, k2, k3, k4, tmp = work
@@ -131,18 +131,18 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
 W = _fixed.LANES  # lanes of a block: the stride of the buffer x
 
 
-@njit(_nrt=False, error_model="numpy")
 def _lane_steps(model, block, shared, t0, h, m, x, lanes):
     """``m`` RK4 steps of ``h`` (s) from ``t0`` of the ``lanes`` lanes of the buffer ``x`` (see
     :func:`_fused_advance`), with the parameters of ``model`` (row 0, ``shared``) or of ``block`` (row ``j``
     for lane ``j``).
 
-    Compiled without reference counting (``_nrt=False``; it allocates nothing), so that the copy compiled
-    on its own is vectorised: the step, IR-inlined, binds the model's arrays again in every call, and
-    the increments and decrements of their counts, split across the status branches of its helpers'
-    calls, were still in the lane loop when LLVM's one ``-O3`` round tried to vectorise it. The process
-    that compiles a batch runs that copy (docs/architecture.md): it ran 5× slower than one loading the
-    cached code, and now runs as fast.
+    For a model without a torque program it is compiled without reference counting
+    (:data:`_lane_steps_counted_not`), so that the copy compiled on its own is vectorised: the step,
+    IR-inlined, binds the model's arrays again in every call, and the increments and decrements of their
+    counts, split across the status branches of its helpers' calls, were still in the lane loop when
+    LLVM's one ``-O3`` round tried to vectorise it. The process that compiles a batch runs that copy
+    (docs/architecture.md): it ran 5× slower than one loading the cached code, and now runs as fast. A
+    torque program keeps the counts: its evaluator may call a Python function, which allocates.
     """
     # two loops, so that shared parameters are a broadcast and per-member ones a contiguous load
     for s in range(m):
@@ -159,7 +159,18 @@ def _lane_steps(model, block, shared, t0, h, m, x, lanes):
                                                 x[5 * W + j], x[6 * W + j])))
 
 
-def _fused_advance(Y):
+_lane_steps_counted = njit(error_model="numpy")(_lane_steps)
+_lane_steps_counted_not = njit(_nrt=False, error_model="numpy")(_lane_steps)
+
+
+def _counts_references(model) -> bool:
+    """Whether the passes over the lanes of ``model`` (a Numba type with ``point_rates``) need reference
+    counting: unless it has no torque program (its ``codes`` None, the torque-free rigid body)."""
+    codes = model.types[model.fields.index("codes")] if "codes" in model.fields else None
+    return not isinstance(codes, types.NoneType)
+
+
+def _fused_advance(Y, model):
     """``advance`` of a kernel with ``point_rates``: the state vector, or each lane of the block, in
     registers through all ``m`` steps (one body) or through one step per pass over the lanes (a block).
 
@@ -180,13 +191,15 @@ def _fused_advance(Y):
 
         return impl
 
+    lane_steps = _lane_steps_counted if _counts_references(model) else _lane_steps_counted_not
+
     def impl(scheme, model, b0, t0, h, m, Y, work):
         x, block = work
         lanes = Y.shape[1]
         for i in range(7):
             for j in range(lanes):
                 x[i * W + j] = Y[i, j]
-        _lane_steps(model, block, uniform(model), t0, h, m, x, lanes)
+        lane_steps(model, block, uniform(model), t0, h, m, x, lanes)
         for i in range(7):
             for j in range(lanes):
                 Y[i, j] = x[i * W + j]
