@@ -86,9 +86,15 @@ def _coefficients(moments, out):
 
 
 
+def _torque_free(model) -> bool:
+    """Whether the Numba type ``model`` of a :class:`RigidModel` has no torque program (``codes`` None): known
+    when a call is typed, so that a torque-free body compiles no torque terms at all."""
+    return isinstance(model.types[2], types.NoneType)
+
+
 @_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
 def _rigid_point_rates(model, b, t, y):
-    if isinstance(model.types[2], types.NoneType):  # torque-free: no torque code at all
+    if _torque_free(model):  # no torque code at all
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
             return None
@@ -171,7 +177,7 @@ def _rigid_body_rate(model, Y, j):
 
 @_protocol.implements(_protocol.inverse_moments, RigidModel, inline=True)
 def _rigid_inverse_moments(model, b):
-    if not isinstance(model.types[2], types.NoneType):
+    if not _torque_free(model):
         return None  # with a torque program, the body is not free: no splitting
 
     def impl(model, b):
@@ -205,7 +211,7 @@ def _rigid_free_evaluate(model, motion, tau):
 
 @_protocol.implements(_protocol.torque_acceleration, RigidModel, inline=True)
 def _rigid_torque_acceleration(model, b, t, x, w1, w2, w3):
-    if isinstance(model.types[2], types.NoneType):
+    if _torque_free(model):
         return lambda model, b, t, x, w1, w2, w3: (0.0, 0.0, 0.0)
 
     def impl(model, b, t, x, w1, w2, w3):
@@ -220,5 +226,5 @@ def _rigid_torque_acceleration(model, b, t, x, w1, w2, w3):
 
 @_protocol.implements(_protocol.torque_free, RigidModel, inline=True)
 def _rigid_torque_free(model):
-    free = isinstance(model.types[2], types.NoneType)
+    free = _torque_free(model)
     return lambda model: free
