@@ -284,6 +284,19 @@ def test_an_interrupted_sweep_resumes_with_the_missing_chunks_only(tmp_path):
     assert again.attrs["chunks_computed"] == 0
 
 
+def test_a_sweep_in_memory_is_its_store_on_disk_loaded(tmp_path):
+    # without a store the results stay in NumPy arrays laid out as the Zarr store: the same variables,
+    # dimensions, coordinates, attributes, dtypes and values, bit for bit
+    import xarray as xr
+
+    args = dict(dispersions=DISPERSIONS, samples=N, seed=1, chunk=5, trajectories=True, **RUN)
+    memory = tumble.sweep(BODY, **args)
+    disk = tumble.sweep(BODY, store=tmp_path / "mc.zarr", **args).load()
+    xr.testing.assert_identical(memory, disk)
+    assert {k: v.dtype for k, v in memory.variables.items()} == {k: v.dtype for k, v in disk.variables.items()}
+    assert memory.attrs["tumble_sweep_complete"] is True and memory.attrs["chunks_computed"] == 5
+
+
 def test_a_store_of_other_settings_is_refused_and_left_alone(tmp_path):
     store = tmp_path / "mc.zarr"
     tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=5, store=store, **RUN)

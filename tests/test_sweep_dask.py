@@ -52,7 +52,17 @@ def assert_same(ds, reference):
 
 @pytest.fixture(scope="module")
 def local_client(reference):
-    cluster = tumble.sweep.local_cluster(2)
+    # as an earlier Dask cluster leaves this process (its Nanny sets Dask's malloc setting here before spawning)
+    saved = os.environ.get("MALLOC_TRIM_THRESHOLD_")
+    os.environ["MALLOC_TRIM_THRESHOLD_"] = "65536"
+    try:
+        cluster = tumble.sweep.local_cluster(2)
+        assert os.environ["MALLOC_TRIM_THRESHOLD_"] == "65536"  # given back
+    finally:
+        if saved is None:
+            del os.environ["MALLOC_TRIM_THRESHOLD_"]
+        else:
+            os.environ["MALLOC_TRIM_THRESHOLD_"] = saved
     client = distributed.Client(cluster)
     yield client
     client.close(timeout=TIMEOUT)
@@ -103,6 +113,9 @@ def test_local_cluster_of_two_processes_equals_the_run_in_this_process(local_cli
     assert len(local_client.scheduler_info()["workers"]) == 2
     pids = set(local_client.run(os.getpid).values())
     assert len(pids) == 2 and os.getpid() not in pids
+    # glibc's own malloc thresholds: Dask's MALLOC_TRIM_THRESHOLD_=65536 is not set in tumble's workers
+    trim = local_client.run(lambda: __import__("os").environ.get("MALLOC_TRIM_THRESHOLD_"))
+    assert list(trim.values()) == [None, None]
     done = []
     ds = tumble.sweep(BODY, client=local_client, progress=lambda k, n: done.append((k, n)), **SWEEP)
     assert_same(ds, reference)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from tumble._validate import ValidationError
@@ -31,15 +32,41 @@ if TYPE_CHECKING:
 
 __all__ = ["local_cluster", "run_chunks"]
 
+_TRIM = "MALLOC_TRIM_THRESHOLD_"  # glibc's malloc setting that Dask gives its workers
+
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
     """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: one per core),
-    every server on 127.0.0.1 (the scheduler's HTTP endpoint on a free port there)."""
+    every server on 127.0.0.1 (the scheduler's HTTP endpoint on a free port there).
+
+    The workers run with glibc's own ``malloc`` thresholds. Dask starts its workers with
+    ``MALLOC_TRIM_THRESHOLD_=65536`` (``distributed.nanny.pre-spawn-environ``, also left set in the process
+    that started them), which fixes the ``mmap`` threshold too: every array of a chunk over 128 KiB is then
+    mapped and its pages faulted afresh, and a sweep of chunks of 1e4 rigid bodies ran 10–15 % slower
+    (docs/sweeps.md). With glibc's defaults a chunk reuses the memory the previous one freed, and a worker
+    holds about one chunk's memory between tasks. For Dask's setting, start a cluster and pass its client."""
     from distributed import LocalCluster
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
-    return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                        dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
+    with _glibc_malloc_defaults():
+        return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                            dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
+
+
+@contextmanager
+def _glibc_malloc_defaults():
+    """Worker processes spawned inside get no ``MALLOC_TRIM_THRESHOLD_`` (from Dask's configuration or from this
+    process's environment, where an earlier Dask cluster may have left it); this process's value comes back
+    after."""
+    import dask
+
+    saved = os.environ.pop(_TRIM, None)
+    try:
+        with dask.config.set({f"distributed.nanny.pre-spawn-environ.{_TRIM}": None}):
+            yield
+    finally:
+        if saved is not None:
+            os.environ[_TRIM] = saved
 
 
 def _run_chunk(plan: Plan, k: int):

@@ -45,6 +45,7 @@ has one), and ``OUTCOME_count`` says how many of the samples that is.
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import tempfile
@@ -72,12 +73,16 @@ _BLOCK_WORDS = 2**25
 
 
 class SweepStore:
-    """The results of one sweep in a Zarr store at ``path`` (a directory), or in memory when ``path`` is None."""
+    """The results of one sweep in a Zarr store at ``path`` (a directory), or in memory when ``path`` is None.
+
+    In memory the store is an :class:`xarray.Dataset` of NumPy arrays laid out as the Zarr store would be (the
+    same variables, dimensions, coordinates and attributes, read back as JSON would give them): chunks are
+    written into it in place, and :meth:`dataset` returns it without a copy."""
 
     def __init__(self, path: str | os.PathLike[str] | None, plan: Plan) -> None:
         self.path = None if path is None else os.fspath(path)
         self.plan = plan
-        self._memory: zarr.storage.MemoryStore | None = None  # the store when path is None, once made
+        self._memory: xarray.Dataset | None = None  # the store when path is None, once made
         self._writable: zarr.Group | None = None  # the group open for writing once the store exists, and its arrays
         self._arrays: dict[str, zarr.Array] = {}
         self._done = np.zeros(plan.n_chunks, dtype=bool)
@@ -91,10 +96,14 @@ class SweepStore:
 
         if mode == "r+" and self._writable is not None:
             return self._writable
-        group = zarr.open_group(self._memory if self.path is None else self.path, mode=mode, zarr_format=3)
+        group = zarr.open_group(self.path, mode=mode, zarr_format=3)
         if mode == "r+":
             self._writable = group
         return group
+
+    def _attrs(self):
+        """The store's attributes (writable)."""
+        return self._memory.attrs if self._memory is not None else self._group().attrs
 
     @property
     def exists(self) -> bool:
@@ -120,11 +129,14 @@ class SweepStore:
 
     @property
     def complete(self) -> bool:
-        return self.exists and bool(dict(self._group("r").attrs).get(COMPLETE_ATTR, False))
+        if not self.exists:
+            return False
+        attrs = self._memory.attrs if self._memory is not None else self._group("r").attrs
+        return bool(dict(attrs).get(COMPLETE_ATTR, False))
 
     def has_percentiles(self, percentiles: Iterable[float]) -> bool:
         """Whether the store's statistics are those of ``percentiles``."""
-        group = self._group("r")
+        group = self._memory if self._memory is not None else self._group("r")
         return "percentile" in group and np.array_equal(group["percentile"][:], np.asarray(percentiles, float))
 
     def missing(self) -> list[int]:
@@ -133,37 +145,42 @@ class SweepStore:
 
     # -- writing ----------------------------------------------------------------------
 
+    def _layout(self, first: ChunkResult) -> tuple[dict[str, tuple], dict, dict]:
+        """The store's variables (name → dims, shape, dtype), coordinates and attributes, shaped from the first
+        chunk's results; every variable is chunked along its first dimension as the sweep is."""
+        plan = self.plan
+        s = plan.samples
+        variables: dict[str, tuple] = {}
+        for name, v in {**first.inputs, **first.outcomes}.items():
+            variables[name] = (("sample", *(f"{name}_dim{k}" for k in range(v.ndim - 1))), (s, *v.shape[1:]),
+                               v.dtype)
+        for name in first.series:
+            variables[name] = ("sample", "time"), (s, len(plan.t)), np.dtype(np.float64)
+        for name, v in first.trajectories.items():
+            variables[name] = (("sample", "time", *(f"{name}_dim{k}" for k in range(v.ndim - 2))),
+                               (s, *v.shape[1:]), np.dtype(np.float64))
+        variables["done"] = ("chunk",), (plan.n_chunks,), np.dtype(bool)
+        coords = {"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})}
+        # as Zarr's JSON gives them back: lists for tuples
+        attrs = json.loads(json.dumps({SETTINGS_ATTR: plan.settings(), COMPLETE_ATTR: False}))
+        return variables, coords, attrs
+
     def _create(self, first: ChunkResult) -> None:
         """Make the empty store (arrays shaped from the first chunk's results), under a temporary name first."""
-        import dask.array as da
         import xarray as xr
 
-        plan = self.plan
-        s, c = plan.samples, plan.chunk
-
-        def empty(name, value, lead):
-            tail = value.shape[1:]
-            dims = lead + tuple(f"{name}_dim{k}" for k in range(len(tail)))
-            return dims, da.zeros((s, *tail), chunks=(c, *tail), dtype=value.dtype)
-
-        data: dict[str, tuple] = {name: empty(name, v, ("sample",))  # name → (dims, values)
-                                  for name, v in {**first.inputs, **first.outcomes}.items()}
-        for name, v in first.series.items():
-            data[name] = ("sample", "time"), da.zeros((s, len(plan.t)), chunks=(c, len(plan.t)))
-        for name, v in first.trajectories.items():
-            dims = ("sample", "time") + tuple(f"{name}_dim{k}" for k in range(v.ndim - 2))
-            data[name] = dims, da.zeros((s, *v.shape[1:]), chunks=(c, *v.shape[1:]))
-        data["done"] = "chunk", da.zeros(plan.n_chunks, chunks=1, dtype=bool)
-        ds = xr.Dataset(data, coords={"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})},
-                        attrs={SETTINGS_ATTR: plan.settings(), COMPLETE_ATTR: False})
-        encoding = {name: {"fill_value": None} for name in ds.data_vars}
-        if self.path is None:  # loaded whole by dataset(): compressing the chunks there would be work for nothing
-            encoding = {name: {**e, "compressors": None} for name, e in encoding.items()}
-            import zarr
-
-            self._memory = zarr.storage.MemoryStore()
-            ds.to_zarr(self._memory, compute=False, consolidated=False, encoding=encoding, zarr_format=3)
+        variables, coords, attrs = self._layout(first)
+        if self.path is None:
+            self._memory = xr.Dataset({name: (dims, np.zeros(shape, dtype))
+                                       for name, (dims, shape, dtype) in variables.items()}, coords=coords,
+                                      attrs=attrs)
             return
+        import dask.array as da
+
+        c = self.plan.chunk
+        ds = xr.Dataset({name: (dims, da.zeros(shape, chunks=(1 if name == "done" else c, *shape[1:]), dtype=dtype))
+                         for name, (dims, shape, dtype) in variables.items()}, coords=coords, attrs=attrs)
+        encoding = {name: {"fill_value": None} for name in ds.data_vars}
         parent = os.path.dirname(os.path.abspath(self.path))
         if not os.path.isdir(parent):
             raise FileNotFoundError(f"store: directory {parent!r} does not exist")
@@ -179,16 +196,15 @@ class SweepStore:
         """Write chunk ``k``'s results, then mark it done."""
         if not self.exists:
             self._create(result)
-        group = self._group()
         for name, value in {**result.inputs, **result.outcomes, **result.series, **result.trajectories}.items():
-            self._array(group, name)[result.lo:result.hi] = value
-        self._array(group, "done")[k] = True
+            self._array(name)[result.lo:result.hi] = value
+        self._array("done")[k] = True
         self._done[k] = True
 
-    def _array(self, group, name):
-        """The store's array ``name``, opened once."""
+    def _array(self, name):
+        """The store's array ``name`` (a NumPy array in memory, a Zarr array on disk), opened once."""
         if name not in self._arrays:
-            self._arrays[name] = group[name]
+            self._arrays[name] = self._memory[name].values if self._memory is not None else self._group()[name]
         return self._arrays[name]
 
     # -- statistics -------------------------------------------------------------------
@@ -198,40 +214,43 @@ class SweepStore:
         import xarray as xr
 
         plan = self.plan
-        group = self._group()
         p = np.asarray(percentiles, dtype=np.float64)
         data: dict[str, tuple] = {}  # name → (dims, values)
         for name in plan.series:
+            series = self._array(name)
             stats: list[np.ndarray] | None = None
             for k in range(plan.n_chunks):
                 lo, hi = plan.bounds(k)
-                part = moments(group[name][lo:hi].T)
+                part = moments(series[lo:hi].T)
                 stats = part if stats is None else _merge(stats, part)
             assert stats is not None  # a sweep has at least one chunk
             count, mean, m2, low, high = stats
             for stat, value in zip(STATISTICS, (mean, np.sqrt(m2 / count), low, high), strict=True):
                 data[f"{name}_{stat}"] = ("time", value)
             block = max(1, _BLOCK_WORDS // plan.samples)
-            bands = [_percentiles(group[name][:, a:a + block], p) for a in range(0, len(plan.t), block)]
+            bands = [_percentiles(series[:, a:a + block], p) for a in range(0, len(plan.t), block)]
             data[f"{name}_percentiles"] = ("percentile", "time"), np.concatenate(bands, axis=1)
         for name in plan.outcomes:
-            values = group[name][:]
+            values = self._array(name)[:]
             dims = tuple(f"{name}_dim{k}" for k in range(values.ndim - 1))
             with warnings.catch_warnings():  # an outcome no sample reached: NaN percentiles, said by its count
                 warnings.simplefilter("ignore", RuntimeWarning)
                 data[f"{name}_percentiles"] = ("percentile", *dims), np.nanpercentile(values, p, axis=0)
             data[f"{name}_count"] = dims, np.count_nonzero(~np.isnan(values), axis=0)
         ds = xr.Dataset(data, coords={"percentile": p})
-        ds.to_zarr(self._memory if self.path is None else self.path, mode="a", consolidated=False, zarr_format=3)
-        group.attrs[COMPLETE_ATTR] = True
+        if self._memory is not None:
+            self._memory = self._memory.drop_vars(list(ds.variables), errors="ignore").merge(ds)
+        else:
+            ds.to_zarr(self.path, mode="a", consolidated=False, zarr_format=3)
+        self._attrs()[COMPLETE_ATTR] = True
 
     def dataset(self) -> xarray.Dataset:
-        """The store as an :class:`xarray.Dataset`: lazily (Dask arrays) for a store on disk, loaded for one in
-        memory."""
+        """The store as an :class:`xarray.Dataset`: lazily (Dask arrays) for a store on disk; in memory, the
+        store itself."""
         import xarray as xr
 
-        if self.path is None:  # read here, not through whatever Dask scheduler is the default now
-            return xr.open_zarr(self._memory, consolidated=False, zarr_format=3, chunks=None).load()
+        if self._memory is not None:
+            return self._memory
         return xr.open_zarr(self.path, consolidated=False, zarr_format=3)
 
 
