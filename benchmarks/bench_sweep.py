@@ -12,7 +12,7 @@ series (ω_z, with its per-time statistics and percentiles). Figures:
   threads on every core), the inputs drawn beforehand;
 * the plain batch followed by the sweep's reductions, then also by its per-time
   statistics and percentiles (the sweep's work in one process, without chunks,
-  store or Dask), and the drawing of the inputs alone (one vectorised Philox
+  store or Dask; the percentiles on one thread per core, as the sweep's), and the drawing of the inputs alone (one vectorised Philox
   draw per chunk);
 * the sweep in this process (``workers=0``: draws, chunks, reductions, store in memory);
 * the sweep on a LocalCluster of 1 and of 2 single-threaded worker processes
@@ -39,6 +39,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import psutil
@@ -153,7 +154,11 @@ def main():
     def summarised():  # the sweep's work in one process, without chunks, store or Dask
         outcome, series = reduced()  # (samples,) and (time, samples)
         moments(series)  # per-time count, mean, M2, min, max
-        return np.percentile(series, PERCENTILES, axis=1), np.nanpercentile(outcome, PERCENTILES, axis=0)
+        # the per-time percentiles with the times shared between one thread per core, as the sweep takes them
+        with ThreadPoolExecutor(os.cpu_count()) as pool:
+            bands = list(pool.map(lambda rows: np.percentile(series[rows], PERCENTILES, axis=1),
+                                  np.array_split(np.arange(series.shape[0]), os.cpu_count() or 1)))
+        return np.concatenate(bands, axis=1), np.nanpercentile(outcome, PERCENTILES, axis=0)
 
     full = row("  + per-time statistics, percentiles", s, *timed(repeats, summarised))
     row("drawing the inputs only", s, *timed(repeats, lambda: make_plan(

@@ -42,7 +42,7 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     The workers run with glibc's own ``malloc`` thresholds. Dask starts its workers with
     ``MALLOC_TRIM_THRESHOLD_=65536`` (``distributed.nanny.pre-spawn-environ``, also left set in the process
     that started them), which fixes the ``mmap`` threshold too: every array of a chunk over 128 KiB is then
-    mapped and its pages faulted afresh, and a sweep of chunks of 1e4 rigid bodies ran 10–15 % slower
+    mapped and its pages faulted afresh, and a sweep of chunks of 1e4 rigid bodies ran 12–15 % slower
     (docs/sweeps.md). With glibc's defaults a chunk reuses the memory the previous one freed, and a worker
     holds about one chunk's memory between tasks. For Dask's setting, start a cluster and pass its client."""
     from distributed import LocalCluster
