@@ -3,7 +3,9 @@
 Prints, side by side, with the machine (CPU model, cores, load average), min / median over at least
 5 repeats, wall and CPU-time-based rates (``_timing``):
 
-1. single-body RK4, cost per step: tumble's compiled loop, a naive Numba loop and a NumPy loop;
+1. single-body RK4, cost per step: tumble's compiled loop, the same step on two independent bodies in one
+   loop (what the step costs when its chain of dependent operations is not the bound), a naive Numba loop
+   and a NumPy loop;
 2. batch RK4, body-steps per second on all cores, one shared inertia and one inertia per body:
    ``simulate`` end to end and its compiled kernel alone, beside a hand-written C kernel
    (``rk4_reference.c``, all four stages fused in registers) built here with
@@ -80,8 +82,22 @@ naive_rhs = njit(euler_rhs)
 naive_numba_rk4 = njit(rk4_loop)
 
 
+@njit(error_model="numpy")
+def two_chains(model, y, z, t0, h, m):
+    """``m`` RK4 steps of two independent bodies ``y`` and ``z`` (updated in place) in one loop, by tumble's
+    one-body step: the second body's step fills the gaps of the first's chain of dependent operations."""
+    a = (y[0], y[1], y[2], y[3], y[4], y[5], y[6])
+    b = (z[0], z[1], z[2], z[3], z[4], z[5], z[6])
+    for s in range(m):
+        a = _rk4.point_step(model, 0, t0 + s * h, h, a)
+        b = _rk4.point_step(model, 0, t0 + s * h, h, b)
+    y[0], y[1], y[2], y[3], y[4], y[5], y[6] = a
+    z[0], z[1], z[2], z[3], z[4], z[5], z[6] = b
+
+
 def single_body(steps):
-    """ns per step (CPU, min / median): tumble's one-body path, the naive Numba loop, NumPy."""
+    """ns per step (CPU, min / median): tumble's one-body path, the same step on two independent bodies in
+    one loop (per step of one body), the naive Numba loop, NumPy."""
     model = _rigid.build([tumble.RigidBody(np.diag(MOMENTS))], None)
     y = np.concatenate([Q0, OMEGA0])[None, :]
     t = np.array([0.0, steps * 1e-3])
@@ -91,8 +107,11 @@ def single_body(steps):
     run = lambda: _fixed.run_one(_rk4.SCHEME, model, y.copy(), t, m, h, out, stats)  # noqa: E731
     run()  # compile / load from cache
     naive_numba_rk4(naive_rhs, y[0].copy(), 1e-3, 10)
+    z = np.concatenate([Q0, OMEGA0 + np.array([0.01, 0.0, -0.01])])  # another body, its own path
+    pair = lambda: two_chains(model, y[0].copy(), z.copy(), 0.0, 1e-3, steps)  # noqa: E731
+    pair()
     ns = lambda timing, n: tuple(1e9 / r for r in timing.rates(n)["cpu"])  # noqa: E731
-    return {"tumble": ns(measure(run), steps),
+    return {"tumble": ns(measure(run), steps), "2 bodies/loop": ns(measure(pair), 2 * steps),
             "naive Numba": ns(measure(lambda: naive_numba_rk4(naive_rhs, y[0].copy(), 1e-3, steps)), steps),
             "NumPy": ns(measure(lambda: rk4_loop(euler_rhs, y[0].copy(), 1e-3, 2000)), 2000)}
 
