@@ -13,7 +13,8 @@ Prints, side by side, with the machine (CPU model, cores, load average), min / m
    ``-ffp-contract=off`` (no fused multiply-adds, as tumble);
 3. the cost per body of set-up and output at N = 1e6 (a run of one step, less the kernel's share);
 4. the adaptive method against scipy's ``solve_ivp(DOP853)`` at equal error, end to end, with scipy
-   given a fair right-hand side (one preallocated-free expression returning one array), and the
+   given a fair right-hand side (one preallocated-free expression returning one array), the cost of one
+   DOP853 step over a long run beside one right-hand side and one projection measured alone, and the
    fixed cost of one ``simulate`` call.
 
 Run by hand (not a test; timings vary with the machine)::
@@ -39,6 +40,7 @@ from scipy.integrate import solve_ivp
 
 import tumble
 from _timing import fmt, machine, measure
+from tumble._protocol import project, rhs
 from tumble._validate import readonly
 from tumble.integrate import _fixed, _rk4
 from tumble.kernels import rigid as _rigid
@@ -93,6 +95,38 @@ def two_chains(model, y, z, t0, h, m):
         b = _rk4.point_step(model, 0, t0 + s * h, h, b)
     y[0], y[1], y[2], y[3], y[4], y[5], y[6] = a
     z[0], z[1], z[2], z[3], z[4], z[5], z[6] = b
+
+
+@njit(error_model="numpy")
+def rhs_chain(model, y, out, m):
+    """``m`` right-hand sides of the one-body state ``y``, each fed by the last (a dependent chain)."""
+    for _ in range(m):
+        rhs(model, 0, 0.0, y, out)
+        y[4] = y[4] + 1e-12 * out[5]
+
+
+@njit(error_model="numpy")
+def project_chain(model, y, m):
+    """``m`` projections of the quaternion of ``y`` onto the unit sphere, each of a perturbed quaternion."""
+    for _ in range(m):
+        project(model, 0, 0.0, y)
+        y[0] += 1e-12
+
+
+def dop853_step(t_end=20_000.0):
+    """CPU ns (min / median) of one DOP853 step over a long run (the fixed cost spread over ≈ 5e4 steps), and,
+    measured alone, of one right-hand side and one projection of the quaternion."""
+    body = tumble.RigidBody(np.diag(MOMENTS))
+    t = np.array([0.0, t_end / 2, t_end])
+    steps = tumble.simulate(body, OMEGA0_ACCURACY, t=t, rtol=1e-10, atol=1e-10).info["n_steps"]
+    run = measure(lambda: tumble.simulate(body, OMEGA0_ACCURACY, t=t, rtol=1e-10, atol=1e-10))
+    model = _rigid.build([body], None)
+    y, out, m = np.concatenate([Q0, OMEGA0_ACCURACY]), np.empty(7), 10**6
+    rhs_chain(model, y, out, 10)
+    project_chain(model, y.copy(), 10)
+    ns = lambda timing, n: tuple(1e9 / r for r in timing.rates(n)["cpu"])  # noqa: E731
+    return steps, {"step": ns(run, steps), "rhs": ns(measure(lambda: rhs_chain(model, y, out, m)), m),
+                   "projection": ns(measure(lambda: project_chain(model, y.copy(), m)), m)}
 
 
 def single_body(steps):
@@ -266,6 +300,10 @@ def main():
         r = adaptive_vs_scipy(100.0, tol, tol, reference)
         print(f"   {tol:10.0e} {fmt(r['tumble']):>20} {fmt(r['scipy']):>20} {r['scipy'][0] / r['tumble'][0]:8.0f}x "
               f"{r['tumble_err']:11.2e} {r['scipy_err']:11.2e}")
+    steps, cost = dop853_step()
+    print(f"   one DOP853 step ({steps} steps over 0..20 000 s, rtol = atol = 1e-10): {fmt(cost['step'], ' ns')} CPU; "
+          f"measured alone, one right-hand side {fmt(cost['rhs'], ' ns')} (a step makes 12), the projection "
+          f"{fmt(cost['projection'], ' ns')}")
     body = tumble.RigidBody(np.diag(MOMENTS))
     for method, options in (("dop853", {}), ("rk4", {"dt": 1e-3})):
         tumble.simulate(body, OMEGA0_ACCURACY, t=[0.0, 1e-3], method=method, **options)
