@@ -147,7 +147,7 @@ class SweepStore:
 
     def _layout(self, first: ChunkResult) -> tuple[dict[str, tuple], dict, dict]:
         """The store's variables (name → dims, shape, dtype), coordinates and attributes, shaped from the first
-        chunk's results; every variable is chunked along its first dimension as the sweep is."""
+        chunk's results (on disk each variable is then chunked along its first dimension as the sweep is)."""
         plan = self.plan
         s = plan.samples
         variables: dict[str, tuple] = {}
