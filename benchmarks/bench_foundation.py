@@ -11,6 +11,7 @@ Prints, side by side, with the machine (CPU model, cores, load average), min / m
    (``rk4_reference.c``, all four stages fused in registers) built here with
    ``gcc -O3 -march=native -fopenmp -fno-math-errno`` when gcc is present, with and without
    ``-ffp-contract=off`` (no fused multiply-adds, as tumble);
+   and the same batch and one body under compiled torque programs (a constant torque, gravity on a top);
 3. the cost per body of set-up and output at N = 1e6 (a run of one step, less the kernel's share);
 4. the adaptive method against scipy's ``solve_ivp(DOP853)`` at equal error, end to end, with scipy
    given a fair right-hand side (one preallocated-free expression returning one array), the cost of one
@@ -201,6 +202,28 @@ def batch(n_bodies, steps, per_body, c_kernels):
     return rows
 
 
+def torque_programs(n_bodies, steps):
+    """``simulate`` rk4 under compiled torque programs (a constant body torque, uniform gravity on a top):
+    body-steps per second of the batch (wall and CPU × cores, min / median) and CPU ns per step of one body."""
+    from tumble.torques import ConstantBody, Gravity
+
+    rng = np.random.default_rng(1)
+    omega0 = OMEGA0 + 1e-2 * rng.standard_normal((n_bodies, 3))
+    t, t_one = np.array([0.0, steps * 1e-3]), np.array([0.0, 100 * steps * 1e-3])
+    body = tumble.RigidBody(np.diag(MOMENTS))
+    rows = {}
+    for name, torque in (("none", None), ("constant", ConstantBody([0.0, 0.0, 0.01])),
+                         ("gravity", Gravity(1.0, [0.0, 0.0, 0.1]))):
+        run = lambda omega, t, torque=torque: tumble.simulate(body, omega, t=t, method="rk4", dt=1e-3,  # noqa: E731
+                                                              torque=torque)
+        run(omega0[:100], t[:1].tolist() + [1e-3])  # compile / load from cache
+        run(omega0[0], t[:1].tolist() + [1e-3])
+        one = measure(lambda run=run: run(omega0[0], t_one)).rates(100 * steps)["cpu"]
+        rows[name] = {**measure(lambda run=run: run(omega0, t)).rates(n_bodies * steps, CORES),
+                      "one": tuple(1e9 / r for r in one)}
+    return rows
+
+
 def big_batch_overhead(n_bodies):
     """CPU ns per body of set-up and output at N = n_bodies: a one-step run less one step's kernel cost."""
     rng = np.random.default_rng(2)
@@ -284,6 +307,11 @@ def main():
 
     print(f"\n2c. batch RK4 as 2a, in a new process that compiles it (empty NUMBA_CACHE_DIR): "
           f"{compiling_process_rate(n_bodies, steps):.3g} body-steps/s (cpu, best of 5)")
+
+    print(f"\n2d. rk4 under a compiled torque program: the batch as 2a (body-steps/s, min-time / median), one body "
+          f"(CPU ns per step, min / median)")
+    for name, v in torque_programs(n_bodies, steps).items():
+        print(f"   {name:<9} batch wall {fmt(v['wall'])}   cpu {fmt(v['cpu'])}   one body {fmt(v['one'], ' ns')}")
 
     n_big = 200_000 if args.quick else 1_000_000
     setup, step = big_batch_overhead(n_big)

@@ -32,12 +32,16 @@ class RigidModel(NamedTuple):
     params  : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes   : int64 torque-program codes, or None for a torque-free body
     moments : (N or 1, 3) principal moments, kg·m² (for the exact flow, ``method="exact"``)
+    callbacks : the codes again when the program calls a Python function, otherwise None. Known when a
+                call is typed, so that a compiled program's terms are compiled into the integrators'
+                loops (``torques.evaluate_compiled``), with no call and no reference counting per body
     """
 
     coefficients: np.ndarray
     params: np.ndarray
     codes: np.ndarray | None
     moments: np.ndarray
+    callbacks: np.ndarray | None = None
 
     @property
     def provides(self) -> frozenset[str]:
@@ -74,7 +78,8 @@ def from_principal(moments, axes, model) -> RigidModel:
     else:
         programs = [torques.compile_program(model, a, offset=0) for a in axes]
         codes, params = programs[0][0], np.ascontiguousarray(np.stack([p for _, p in programs]))
-    return RigidModel(coefficients=coefficients, params=params, codes=codes, moments=moments)
+    return RigidModel(coefficients=coefficients, params=params, codes=codes, moments=moments,
+                      callbacks=codes if torques.calls_python(codes) else None)
 
 
 @njit(cache=True)
@@ -92,6 +97,12 @@ def _torque_free(model) -> bool:
     return isinstance(model.types[2], types.NoneType)
 
 
+def _calls_python(model) -> bool:
+    """Whether the Numba type ``model`` of a :class:`RigidModel` has a torque program that calls Python
+    (``callbacks`` not None)."""
+    return not isinstance(model.types[model.fields.index("callbacks")], types.NoneType)
+
+
 @_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
 def _rigid_point_rates(model, b, t, y):
     if _torque_free(model):  # no torque code at all
@@ -99,10 +110,15 @@ def _rigid_point_rates(model, b, t, y):
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
             return None
 
-    else:
+    elif _calls_python(model):  # the evaluator, compiled on its own: a Python function's arrays are allocated
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
             return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
+
+    else:  # compiled terms only: into the caller's loop (the same sums as torques.evaluate)
+
+        def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
+            return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
 
     torque = njit(inline="always")(torque)
 
@@ -132,7 +148,7 @@ def _rigid_members(model, b0, b1):
     def impl(model, b0, b1):
         c = np.ascontiguousarray(model.coefficients[:, b0:b1])
         params = np.ascontiguousarray(model.params[b0:b1]) if model.params.shape[0] > 1 else model.params
-        return RigidModel(c, params, model.codes, np.ascontiguousarray(model.moments[b0:b1]))
+        return RigidModel(c, params, model.codes, np.ascontiguousarray(model.moments[b0:b1]), model.callbacks)
 
     return impl
 
