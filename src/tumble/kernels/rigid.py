@@ -103,22 +103,26 @@ def _calls_python(model) -> bool:
     return not isinstance(model.types[model.fields.index("callbacks")], types.NoneType)
 
 
-@_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
-def _rigid_point_rates(model, b, t, y):
+def _rates(model, into_loop: bool):
+    """The rigid body's pointwise right-hand side ``rates(model, r, t, y)`` for the Numba type ``model``: its
+    torque program's compiled terms written into the caller (``into_loop``, for the fused RK4 loops: no call
+    and no reference counting per body) or called in ``torques.evaluate``, compiled once (the other
+    integrators: their several right-hand sides per step would each compile the program's terms again, for
+    seconds more per model). A program that calls Python is always called: its arrays are allocated."""
     if _torque_free(model):  # no torque code at all
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
             return None
 
-    elif _calls_python(model):  # the evaluator, compiled on its own: a Python function's arrays are allocated
-
-        def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
-            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
-
-    else:  # compiled terms only: into the caller's loop (the same sums as torques.evaluate)
+    elif into_loop and not _calls_python(model):  # the same sums as torques.evaluate
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
             return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
+
+    else:
+
+        def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
+            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
 
     torque = njit(inline="always")(torque)
 
@@ -133,6 +137,11 @@ def _rigid_point_rates(model, b, t, y):
                            torque(model, b, t, qw, qx, qy, qz, w1, w2, w3))
 
     return impl
+
+
+@_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
+def _rigid_point_rates(model, b, t, y):
+    return _rates(model, into_loop=True)
 
 
 @_protocol.implements(_protocol.uniform, RigidModel, inline=True)
@@ -155,10 +164,11 @@ def _rigid_members(model, b0, b1):
 
 @_protocol.implements(_protocol.rhs, RigidModel, inline=True)
 def _rigid_rhs(model, b0, t, Y, OUT):
+    rates = njit(inline="always")(_rates(model, into_loop=False))
     if Y.ndim == 1:  # one body: the state vector itself
 
         def impl(model, b0, t, Y, OUT):
-            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = _protocol.point_rates(
+            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = rates(
                 model, b0 * (model.coefficients.shape[1] > 1), t, (Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]))
 
     else:  # a block: state × lanes
@@ -166,7 +176,7 @@ def _rigid_rhs(model, b0, t, Y, OUT):
         def impl(model, b0, t, Y, OUT):
             per_body = model.coefficients.shape[1] > 1  # not uniform: row b0 + j (see _rigid_uniform)
             for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = _protocol.point_rates(
+                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = rates(
                     model, (b0 + j) * per_body, t, (Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]))
 
     return impl
