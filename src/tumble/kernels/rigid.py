@@ -33,8 +33,8 @@ class RigidModel(NamedTuple):
     codes   : int64 torque-program codes, or None for a torque-free body
     moments : (N or 1, 3) principal moments, kg·m² (for the exact flow, ``method="exact"``)
     callbacks : the codes again when the program calls a Python function, otherwise None. Known when a
-                call is typed, so that a compiled program's terms are compiled into the integrators'
-                loops (``torques.evaluate_compiled``), with no call and no reference counting per body
+                call is typed, so that a compiled program's terms are compiled into the fused RK4 loops
+                (``torques.evaluate_compiled``), with no call and no reference counting per body
     """
 
     coefficients: np.ndarray
