@@ -44,7 +44,8 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     that started them), which fixes the ``mmap`` threshold too: every array of a chunk over 128 KiB is then
     mapped and its pages faulted afresh, and a sweep of chunks of 1e4 rigid bodies ran 12–15 % slower
     (docs/sweeps.md). With glibc's defaults a chunk reuses the memory the previous one freed, and a worker
-    holds about one chunk's memory between tasks. For Dask's setting, start a cluster and pass its client."""
+    holds about one chunk's memory between tasks (379–405 MiB against Dask's 218 MiB, after five sweeps of
+    chunks of 1e4 bodies). For Dask's setting, start a cluster and pass its client."""
     from distributed import LocalCluster
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
