@@ -440,11 +440,10 @@ def test_an_object_that_is_not_a_model_is_refused_naming_its_type():
         tumble.simulate({"inertia": DIAG}, [0.0, 0.0, 1.0], t=[0.0, 1.0])
 
 
-def test_lane_passes_drop_reference_counts_unless_the_torque_program_calls_python():
+def test_lane_passes_drop_reference_counts_only_without_a_torque_program():
     # _rk4._lane_steps compiled without reference counting vectorises in the process that compiles it
-    # (docs/architecture.md); a compiled torque program's terms are compiled into the lane loop
-    # (torques.evaluate_compiled) and need no counts either; a program that calls Python keeps them (its
-    # evaluator allocates the function's arrays: compiled without counts, its batch failed to type)
+    # (docs/architecture.md); a torque program's evaluator may call Python, which allocates, so a model
+    # with one keeps the counts (compiled without them, its batch failed to type in a fresh process)
     from numba import typeof
 
     from tumble.integrate import _rk4
@@ -454,5 +453,5 @@ def test_lane_passes_drop_reference_counts_unless_the_torque_program_calls_pytho
     free = typeof(rigid.build([body], None))
     with_program = typeof(rigid.build([body], torques.ConstantBody([0.1, 0.0, 0.0])))
     with_python = typeof(rigid.build([body], torques.as_torque_model(lambda t, q, w: np.zeros(3))))
-    assert not _rk4._counts_references(free) and not _rk4._counts_references(with_program)
-    assert _rk4._counts_references(with_python)
+    assert not _rk4._counts_references(free)
+    assert _rk4._counts_references(with_program) and _rk4._counts_references(with_python)

@@ -136,14 +136,13 @@ def _lane_steps(model, block, shared, t0, h, m, x, lanes):
     :func:`_fused_advance`), with the parameters of ``model`` (row 0, ``shared``) or of ``block`` (row ``j``
     for lane ``j``).
 
-    Unless the model's torque program calls Python it is compiled without reference counting
+    For a model without a torque program it is compiled without reference counting
     (:data:`_lane_steps_counted_not`), so that the copy compiled on its own is vectorised: the step,
     IR-inlined, binds the model's arrays again in every call, and the increments and decrements of their
     counts, split across the status branches of its helpers' calls, were still in the lane loop when
     LLVM's one ``-O3`` round tried to vectorise it. The process that compiles a batch runs that copy
     (docs/architecture.md): it ran 5× slower than one loading the cached code, and now runs as fast. A
-    program that calls Python keeps the counts: its evaluator allocates the function's arrays (and a
-    function compiled for a caller without reference counts is compiled without them too).
+    torque program keeps the counts: its evaluator may call a Python function, which allocates.
     """
     # two loops, so that shared parameters are a broadcast and per-member ones a contiguous load
     for s in range(m):
@@ -166,9 +165,9 @@ _lane_steps_counted_not = njit(_nrt=False, error_model="numpy")(_lane_steps)
 
 def _counts_references(model) -> bool:
     """Whether the passes over the lanes of ``model`` (a Numba type with ``point_rates``) need reference
-    counting: only for a torque program that calls Python (its ``callbacks`` not None)."""
-    callbacks = model.types[model.fields.index("callbacks")] if "callbacks" in model.fields else None
-    return callbacks is not None and not isinstance(callbacks, types.NoneType)
+    counting: unless it has no torque program (its ``codes`` None, the torque-free rigid body)."""
+    codes = model.types[model.fields.index("codes")] if "codes" in model.fields else None
+    return not isinstance(codes, types.NoneType)
 
 
 def _fused_advance(Y, model):

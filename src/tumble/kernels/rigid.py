@@ -32,16 +32,12 @@ class RigidModel(NamedTuple):
     params  : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes   : int64 torque-program codes, or None for a torque-free body
     moments : (N or 1, 3) principal moments, kg·m² (for the exact flow, ``method="exact"``)
-    callbacks : the codes again when the program calls a Python function, otherwise None. Known when a
-                call is typed, so that a compiled program's terms are compiled into the fused RK4 loops
-                (``torques.evaluate_compiled``), with no call and no reference counting per body
     """
 
     coefficients: np.ndarray
     params: np.ndarray
     codes: np.ndarray | None
     moments: np.ndarray
-    callbacks: np.ndarray | None = None
 
     @property
     def provides(self) -> frozenset[str]:
@@ -78,8 +74,7 @@ def from_principal(moments, axes, model) -> RigidModel:
     else:
         programs = [torques.compile_program(model, a, offset=0) for a in axes]
         codes, params = programs[0][0], np.ascontiguousarray(np.stack([p for _, p in programs]))
-    return RigidModel(coefficients=coefficients, params=params, codes=codes, moments=moments,
-                      callbacks=codes if torques.calls_python(codes) else None)
+    return RigidModel(coefficients=coefficients, params=params, codes=codes, moments=moments)
 
 
 @njit(cache=True)
@@ -97,27 +92,12 @@ def _torque_free(model) -> bool:
     return isinstance(model.types[2], types.NoneType)
 
 
-def _calls_python(model) -> bool:
-    """Whether the Numba type ``model`` of a :class:`RigidModel` has a torque program that calls Python
-    (``callbacks`` not None)."""
-    return not isinstance(model.types[model.fields.index("callbacks")], types.NoneType)
-
-
-def _rates(model, into_loop: bool):
-    """The rigid body's pointwise right-hand side ``rates(model, r, t, y)`` for the Numba type ``model``: its
-    torque program's compiled terms written into the caller (``into_loop``, for the fused RK4 loops: no call
-    and no reference counting per body) or called in ``torques.evaluate``, compiled once (the other
-    integrators: their several right-hand sides per step would each compile the program's terms again, for
-    seconds more per model). A program that calls Python is always called: its arrays are allocated."""
+@_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
+def _rigid_point_rates(model, b, t, y):
     if _torque_free(model):  # no torque code at all
 
         def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
             return None
-
-    elif into_loop and not _calls_python(model):  # the same sums as torques.evaluate
-
-        def torque(model, b, t, qw, qx, qy, qz, w1, w2, w3):
-            return torques.evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, model.params, b, model.codes)
 
     else:
 
@@ -139,11 +119,6 @@ def _rates(model, into_loop: bool):
     return impl
 
 
-@_protocol.implements(_protocol.point_rates, RigidModel, inline=True)
-def _rigid_point_rates(model, b, t, y):
-    return _rates(model, into_loop=True)
-
-
 @_protocol.implements(_protocol.uniform, RigidModel, inline=True)
 def _rigid_uniform(model):
     # one body for all (from_principal gives the coefficients and a torque program's parameters
@@ -157,18 +132,17 @@ def _rigid_members(model, b0, b1):
     def impl(model, b0, b1):
         c = np.ascontiguousarray(model.coefficients[:, b0:b1])
         params = np.ascontiguousarray(model.params[b0:b1]) if model.params.shape[0] > 1 else model.params
-        return RigidModel(c, params, model.codes, np.ascontiguousarray(model.moments[b0:b1]), model.callbacks)
+        return RigidModel(c, params, model.codes, np.ascontiguousarray(model.moments[b0:b1]))
 
     return impl
 
 
 @_protocol.implements(_protocol.rhs, RigidModel, inline=True)
 def _rigid_rhs(model, b0, t, Y, OUT):
-    rates = njit(inline="always")(_rates(model, into_loop=False))
     if Y.ndim == 1:  # one body: the state vector itself
 
         def impl(model, b0, t, Y, OUT):
-            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = rates(
+            OUT[0], OUT[1], OUT[2], OUT[3], OUT[4], OUT[5], OUT[6] = _protocol.point_rates(
                 model, b0 * (model.coefficients.shape[1] > 1), t, (Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6]))
 
     else:  # a block: state × lanes
@@ -176,7 +150,7 @@ def _rigid_rhs(model, b0, t, Y, OUT):
         def impl(model, b0, t, Y, OUT):
             per_body = model.coefficients.shape[1] > 1  # not uniform: row b0 + j (see _rigid_uniform)
             for j in range(Y.shape[1]):
-                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = rates(
+                (OUT[0, j], OUT[1, j], OUT[2, j], OUT[3, j], OUT[4, j], OUT[5, j], OUT[6, j]) = _protocol.point_rates(
                     model, (b0 + j) * per_body, t, (Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j]))
 
     return impl
