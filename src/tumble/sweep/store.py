@@ -101,9 +101,10 @@ class SweepStore:
             self._writable = group
         return group
 
-    def _attrs(self):
-        """The store's attributes (writable)."""
-        return self._memory.attrs if self._memory is not None else self._group().attrs
+    def _readable(self):
+        """The store to read: the in-memory dataset, or the Zarr group opened read-only (both take ``name in``,
+        ``[name]`` and ``.attrs``)."""
+        return self._memory if self._memory is not None else self._group("r")
 
     @property
     def exists(self) -> bool:
@@ -129,14 +130,11 @@ class SweepStore:
 
     @property
     def complete(self) -> bool:
-        if not self.exists:
-            return False
-        attrs = self._memory.attrs if self._memory is not None else self._group("r").attrs
-        return bool(dict(attrs).get(COMPLETE_ATTR, False))
+        return self.exists and bool(dict(self._readable().attrs).get(COMPLETE_ATTR, False))
 
     def has_percentiles(self, percentiles: Iterable[float]) -> bool:
         """Whether the store's statistics are those of ``percentiles``."""
-        group = self._memory if self._memory is not None else self._group("r")
+        group = self._readable()
         return "percentile" in group and np.array_equal(group["percentile"][:], np.asarray(percentiles, float))
 
     def missing(self) -> list[int]:
@@ -242,7 +240,7 @@ class SweepStore:
             self._memory = self._memory.drop_vars(list(ds.variables), errors="ignore").merge(ds)
         else:
             ds.to_zarr(self.path, mode="a", consolidated=False, zarr_format=3)
-        self._attrs()[COMPLETE_ATTR] = True
+        (self._memory if self._memory is not None else self._group()).attrs[COMPLETE_ATTR] = True
 
     def dataset(self) -> xarray.Dataset:
         """The store as an :class:`xarray.Dataset`: lazily (Dask arrays) for a store on disk; in memory, the
