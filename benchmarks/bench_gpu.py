@@ -1,15 +1,19 @@
-"""GPU benchmark: torque-free RK4 on an NVIDIA GPU beside tumble's CPU batch RK4, in one run.
+"""GPU benchmark: RK4 on an NVIDIA GPU beside tumble's CPU batch RK4, in one run.
 
-Prints body-steps per second of the CUDA kernel (``tumble.integrate._cuda``)
-for N = 10⁶ … 10⁷ torque-free bodies, each with its own moments of inertia,
-timed two ways: the kernel alone (data already on the GPU), and
-``solve_cuda`` end to end (copies to and from the GPU included). Beside them:
-tumble's CPU batch RK4 (``tumble.integrate.solve``, all cores) on the first
-bodies of the same batch, and the largest difference between the two results.
+Prints, with the machine line and min / median wall time over at least 5 repeats (``_timing``),
+body-steps per second of the CUDA kernel (``tumble.integrate._cuda``) for batches of N bodies:
+
+1. the kernel alone (data already on the GPU, synchronised before the clock is read) and
+   ``solve_cuda`` end to end (copies to and from the GPU included), for torque-free bodies with one
+   shared body, torque-free bodies with one inertia each, and one shared body under a compiled torque
+   program (a constant body torque plus gravity on a top);
+2. ``tumble.simulate(..., device="cuda")`` end to end (body axes in and out) for one inertia per body,
+   beside ``tumble.simulate`` on the CPU (all cores) for the same bodies, and the largest difference
+   between the two.
 
 Without a GPU it says so and exits 0. Run by hand (not a test)::
 
-    python benchmarks/bench_gpu.py            # N = 1e6, 3e6, 1e7; 1000 steps
+    python benchmarks/bench_gpu.py            # N = 1e6, 1e7; 1000 steps
     python benchmarks/bench_gpu.py --quick    # N = 1e6; 100 steps
 """
 
@@ -24,37 +28,46 @@ from numba import cuda
 from numba.core import config
 
 import tumble
-from _timing import best_of
-from tumble import attitude, integrate
-from tumble.kernels import rigid as _rigid
-from tumble.dynamics import euler_coefficients
+from _timing import fmt, machine, measure
+from tumble import attitude, integrate, torques
 from tumble.integrate import _cuda, _fixed
+from tumble.kernels import rigid as _rigid
 
 DT = 1e-3                                   # s
 OMEGA0 = np.array([1e-3, 1.0, 1e-3])        # rad/s, near the intermediate axis, dispersed per body
+TORQUE = torques.ConstantBody([0.0, 0.0, 0.01]) + torques.Gravity(1.0, [0.0, 0.0, 0.1])  # N·m; kg, m
 CPU_BODIES = 100_000
+CORES = len(os.sched_getaffinity(0))
 
 
-def batch(n, seed=1):
-    """n torque-free bodies: Euler coefficients (n, 6), principal moments (n, 3) in [1, 3] kg m², states (n, 7)."""
+def moments(n, seed=1):
+    """n principal moments (n, 3) uniform in [1.5, 2.5] kg m² (physical: each at most the sum of the others)."""
+    return np.random.default_rng(seed).uniform(1.5, 2.5, (n, 3))
+
+
+def states(n, seed=2):
+    """n initial states [q_NP, ω_P] (n, 7): random attitudes, rates dispersed about OMEGA0."""
     rng = np.random.default_rng(seed)
-    moments = rng.uniform(1.0, 3.0, (n, 3))
-    coefficients = np.ascontiguousarray(np.stack(euler_coefficients(*moments.T), axis=1))
     y0 = np.empty((n, 7))
     y0[:, :4] = attitude.normalize(rng.standard_normal((n, 4)))
     y0[:, 4:] = OMEGA0 + 1e-2 * rng.standard_normal((n, 3))
-    return coefficients, moments, y0
+    return y0
 
 
-def cpu_model(coefficients, moments):
-    """The CPU integrators' RigidModel of the same bodies (one row each), torque-free."""
-    one = _rigid.build([tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))], None)
-    return one._replace(coefficients=coefficients, moments=moments, params=np.zeros((coefficients.shape[0], 0)))
+def models(n):
+    """name -> the RigidModel of n bodies (principal axes = body axes) that the GPU and CPU integrate."""
+    eye = np.eye(3)[None]
+    return {
+        "free, one shared body": _rigid.from_principal(moments(1), eye, None),
+        "free, one inertia each": _rigid.from_principal(moments(n), eye, None),
+        "torque program, shared body": _rigid.from_principal(moments(1), eye, TORQUE),
+    }
 
 
-def kernel_seconds(coefficients, y0, t):
-    """Best time (s) of the kernel alone, on data already on the GPU (synchronised before the clock is read)."""
-    args = [cuda.to_device(coefficients), cuda.to_device(np.zeros((y0.shape[0], 0))), (), cuda.to_device(y0),
+def kernel_timing(model, y0, t):
+    """Timing of the kernel alone, on data already on the GPU."""
+    codes = () if model.codes is None else cuda.to_device(model.codes)
+    args = [cuda.to_device(model.coefficients), cuda.to_device(model.params), codes, cuda.to_device(y0),
             cuda.to_device(t), *map(cuda.to_device, _fixed.landing_steps(t, DT, integrate.MAX_STEPS)),
             cuda.device_array((t.size, *y0.shape))]
     blocks = math.ceil(y0.shape[0] / _cuda.THREADS_PER_BLOCK)
@@ -63,27 +76,22 @@ def kernel_seconds(coefficients, y0, t):
         _cuda._rk4_kernel[blocks, _cuda.THREADS_PER_BLOCK](*args)
         cuda.synchronize()
 
-    return wall_seconds(launch)[0]
-
-
-def wall_seconds(fn, repeats=3):
-    """Best wall time (s) of ``fn()`` and its last result."""
-    return best_of(repeats, fn)
+    launch()                                            # compile / load from the cache
+    return measure(launch)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="N = 1e6 and 100 steps")
-    parser.add_argument("--sizes", type=int, nargs="+", help="batch sizes N (default 1e6, 3e6, 1e7)")
+    parser.add_argument("--sizes", type=int, nargs="+", help="batch sizes N (default 1e6, 1e7)")
     parser.add_argument("--steps", type=int, help="RK4 steps of 1 ms per body (default 1000)")
     args = parser.parse_args()
     if not _cuda.cuda_available():
         print("No CUDA GPU present (numba.cuda.is_available() is False): nothing measured.")
         return
-    sizes = args.sizes or ([1_000_000] if args.quick else [1_000_000, 3_000_000, 10_000_000])
+    sizes = args.sizes or ([1_000_000] if args.quick else [1_000_000, 10_000_000])
     steps = args.steps or (100 if args.quick else 1000)
     t = np.array([0.0, steps * DT])
-    cores = len(os.sched_getaffinity(0))
     if config.ENABLE_CUDASIM:
         print("NUMBA_ENABLE_CUDASIM=1: Numba's CUDA simulator, not a GPU; the figures are not GPU measurements.")
         device = "simulator"
@@ -91,28 +99,41 @@ def main():
         dev = cuda.get_current_device()
         name = dev.name.decode() if isinstance(dev.name, bytes) else dev.name
         device = f"{name} (compute capability {'.'.join(map(str, dev.compute_capability))})"
-    print(f"tumble {tumble.__version__}; GPU: {device}; CPU: {cores} cores")
-    print(f"torque-free RK4, float64, one Euler-coefficient row per body, {steps} steps of {DT * 1e3:g} ms, "
-          f"{_cuda.THREADS_PER_BLOCK} threads per block\n")
+    print(machine())
+    print(f"tumble {tumble.__version__}; GPU: {device}")
+    print(f"RK4, float64, {steps} steps of {DT * 1e3:g} ms, {_cuda.THREADS_PER_BLOCK} threads per block; "
+          "body-steps/s from wall time, min / median\n")
 
-    def gpu_run(coefficients, y0):
-        return _cuda.solve_cuda(cpu_model(coefficients, np.ones((y0.shape[0], 3))), y0, t, DT)[0]
-
-    small, _, small_y0 = batch(2 * _cuda.THREADS_PER_BLOCK)
-    gpu_run(small, small_y0)                              # compile the kernel / load it from the cache
-    print(f"   {'N bodies':>12} {'kernel body-steps/s':>22} {'solve_cuda body-steps/s':>25}")
+    print(f"   {'bodies':<30} {'N':>12} {'kernel alone':>24} {'solve_cuda end to end':>24}")
     for n in sizes:
-        coefficients, moments, y0 = batch(n)
-        kernel = kernel_seconds(coefficients, y0, t)
-        end_to_end, gpu = wall_seconds(lambda: gpu_run(coefficients, y0))
-        print(f"   {n:12,d} {n * steps / kernel:22.3g} {n * steps / end_to_end:25.3g}")
+        y0 = states(n)
+        for name, model in models(n).items():
+            kernel = kernel_timing(model, y0, t)
+            _cuda.solve_cuda(model, y0[:256], t, DT)
+            whole = measure(lambda: _cuda.solve_cuda(model, y0, t, DT)[0])
+            print(f"   {name:<30} {n:12,d} {fmt(kernel.rates(n * steps)['wall']):>24} "
+                  f"{fmt(whole.rates(n * steps)['wall']):>24}")
 
-    n_cpu = min(CPU_BODIES, sizes[-1])
-    model = cpu_model(coefficients[:n_cpu], moments[:n_cpu])
-    integrate.solve(model, y0[:2], t, method="rk4", dt=DT)    # compile / load from cache
-    seconds, cpu = wall_seconds(lambda: integrate.solve(model, y0[:n_cpu], t, method="rk4", dt=DT).states)
-    print(f"\n   CPU, tumble rk4 on all {cores} cores, N = {n_cpu:,d}: {n_cpu * steps / seconds:.3g} body-steps/s")
-    print(f"   max |GPU - CPU| over those bodies at t = {t[-1]:g} s: {np.abs(gpu[:, :n_cpu] - cpu).max():.2e}")
+    # The public front door, body axes in and out, one inertia per body; the CPU on the first bodies.
+    n = sizes[0]
+    inertia = np.einsum("bi,ij->bij", moments(n), np.eye(3))        # (n, 3, 3) kg m², principal = body axes
+    y0 = states(n)
+    q0, omega0 = y0[:, :4], y0[:, 4:]
+
+    def run(device, k):
+        return tumble.simulate(inertia[:k], omega0[:k], q0=q0[:k], t=t, method="rk4", dt=DT, device=device)
+
+    run("cuda", 256), run("cpu", 256)
+    gpu = measure(lambda: run("cuda", n))
+    k = min(CPU_BODIES, n)
+    cpu = measure(lambda: run("cpu", k))
+    print(f"\n   tumble.simulate, one inertia per body, end to end, body-steps/s (min / median):")
+    print(f"   device='cuda', N = {n:,d}: {fmt(gpu.rates(n * steps)['wall'])}")
+    rates = cpu.rates(k * steps, CORES)
+    print(f"   device='cpu' on {CORES} cores, N = {k:,d}: {fmt(rates['wall'])} wall, {fmt(rates['cpu'])} CPU-time based")
+    a, b = gpu.result, cpu.result
+    print(f"   max |GPU - CPU| over those bodies at t = {t[-1]:g} s: q {np.abs(a.q[:, :k] - b.q).max():.2e}, "
+          f"omega {np.abs(a.omega[:, :k] - b.omega).max():.2e} rad/s")
 
 
 if __name__ == "__main__":

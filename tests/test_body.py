@@ -408,3 +408,52 @@ def test_principal_axes_of_a_batch_equal_rigid_body_one_by_one():
     bad[4] = np.diag([1.0, 1.0, 3.0])  # breaks I1 + I2 >= I3
     with pytest.raises(ValidationError, match=r"^inertia\[4\]: principal moments break the triangle inequality"):
         principal_axes(bad)
+
+
+def _principal_axes_numpy(inertia):
+    """The rule of principal_axes written with NumPy alone (its earlier implementation): the reference."""
+    sym = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
+    moments, axes = np.linalg.eigh(sym)
+    m0, m1, m2 = moments.T.copy()
+    tol = 16 * np.finfo(float).eps * np.abs(m2)
+    lower, upper = m1 - m0 <= tol, m2 - m1 <= tol
+    moments[lower & upper] = ((m0 + m1 + m2) / 3.0)[lower & upper, None]
+    moments[lower & ~upper, :2] = (0.5 * (m0 + m1))[lower & ~upper, None]
+    moments[upper & ~lower, 1:] = (0.5 * (m1 + m2))[upper & ~lower, None]
+    largest = np.abs(axes).argmax(axis=-2)[..., None, :]
+    axes = axes * np.sign(np.take_along_axis(axes, largest, axis=-2))
+    axes[..., :, 2] *= np.sign(np.linalg.det(axes))[..., None]
+    return sym, moments, axes
+
+
+def test_principal_axes_equal_their_rule_in_numpy_bit_for_bit():
+    # The compiled passes (symmetrization, merged double moments, sign rule, right-handed frame) against the
+    # same rule in NumPy, on asymmetric, symmetric and spherical bodies, in rotated and in body axes, with
+    # entries 1e-12-asymmetric and eigenvectors whose components tie in magnitude.
+    rng = np.random.default_rng(5)
+    r, _ = np.linalg.qr(rng.standard_normal((400, 3, 3)))
+    moments = rng.uniform(1.0, 1.9, (400, 3))
+    moments[100:200, 1] = moments[100:200, 2]                 # symmetric tops, split by rounding when rotated
+    moments[200:250] = moments[200:250, :1]                   # spheres
+    inertia = r @ (moments[..., None] * np.swapaxes(r, -1, -2))
+    inertia[300:350] = np.eye(3) * moments[300:350, None, :]  # diagonal, principal axes = body axes (permuted)
+    inertia[350:] += 1e-13 * rng.standard_normal((50, 3, 3))  # asymmetric within the tolerance
+    inertia[399] = [[2.0, 0.5, 0.5], [0.5, 2.0, 0.5], [0.5, 0.5, 2.0]]   # eigenvectors with equal components
+    sym, m, axes = principal_axes(inertia)
+    ref = _principal_axes_numpy(inertia)
+    assert np.array_equal(sym, ref[0]) and np.array_equal(m, ref[1]) and np.array_equal(axes, ref[2])
+    assert np.all(m[200:250] == m[200:250, :1])               # a sphere's three moments merged (were 2 of 3)
+    equal = (np.diff(m, axis=1) == 0).sum(axis=1)
+    assert np.all(equal[100:200] == 1) and np.all(equal[:100] == 0)   # symmetric tops, asymmetric bodies
+    np.testing.assert_allclose(np.linalg.det(axes), 1.0, rtol=0, atol=1e-14)
+
+
+def test_a_batch_trajectory_shares_the_batch_tensors():
+    import tumble
+
+    inertia = np.diag([1.0, 2.0, 2.5]) * np.ones((3, 1, 1))
+    traj = tumble.simulate(inertia, np.ones((3, 3)), t=[0.0, 0.1], method="rk4", dt=0.05)
+    np.testing.assert_array_equal(traj.inertia, inertia)
+    assert not traj.inertia.flags.writeable
+    again = tumble.simulate(traj.inertia, np.ones((3, 3)), t=[0.0, 0.1], method="rk4", dt=0.05)
+    assert np.array_equal(again.omega, traj.omega)

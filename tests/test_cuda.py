@@ -202,6 +202,17 @@ def test_gpu_equals_cpu():
     np.testing.assert_allclose(gpu, cpu, rtol=0, atol=TOL_GPU)
 
 
+@pytest.mark.skipif(config.ENABLE_CUDASIM or not _cuda.cuda_available(), reason="no GPU")
+def test_simulate_device_cuda_equals_cpu_on_a_gpu():
+    # The front door on a real GPU: rotated bodies, one each, body axes in and out, every compiled torque.
+    bodies, y0 = _bodies(4, 5), _states(4, 1)
+    run = {device: tumble.simulate(bodies, y0[:, 4:], q0=y0[:, :4], t=T_OUT, method="rk4", dt=DT, torque=PROGRAM,
+                                   device=device) for device in ("cpu", "cuda")}
+    np.testing.assert_allclose(run["cuda"].q, run["cpu"].q, rtol=0, atol=TOL_GPU)
+    np.testing.assert_allclose(run["cuda"].omega, run["cpu"].omega, rtol=0, atol=TOL_GPU)
+    assert np.abs(run["cpu"].omega[-1] - y0[:, 4:]).max() > 1e-2   # the bodies moved
+
+
 def test_simulate_refuses_bad_device_settings():
     body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
     with pytest.raises(tumble.ValidationError, match="device"):

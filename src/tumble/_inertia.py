@@ -9,10 +9,12 @@ helpers for rotations and point masses live beside it.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
 from tumble import _quat
-from tumble._validate import ValidationError, as_array
+from tumble._quat import orthonormality
+from tumble._validate import ValidationError, as_array, readonly
 
 # Inertia symmetric when max |I − Iᵀ| ≤ _SYMMETRY_RTOL · max |I|.
 _SYMMETRY_RTOL = 1e-12
@@ -69,10 +71,11 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
     raises :class:`ValidationError` naming ``name`` (and the batch index);
     ``member_note(k)``, if given, adds a word on member ``k`` (an index tuple),
     e.g. its sample time.
-    ``moments`` (…, 3) ascend, and two that differ by less than
+    ``moments`` (…, 3) ascend, and neighbours that differ by at most
     ``_DEGENERATE_RTOL`` (16 ε) × the largest — the rounding of the
-    eigen-decomposition — are replaced by their mean, so a symmetric body
-    described in rotated axes stays symmetric; ``axes`` (…, 3, 3) = R_BP, columns the principal
+    eigen-decomposition — are replaced by the mean of their group (two, or all
+    three), so a symmetric body or a sphere described in rotated axes stays
+    one; ``axes`` (…, 3, 3) = R_BP, columns the principal
     axes in body axes, made deterministic: each eigenvector's largest-magnitude
     component is positive, then the third is flipped if needed for det +1.
     Batched, so that a batch of N bodies is validated in one call.
@@ -86,13 +89,15 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
     def note(k):
         return f" ({member_note(k)})" if member_note is not None and k else ""
 
-    scale = np.abs(inertia).max(axis=(-2, -1))
+    batch = inertia.shape[:-2]
+    symmetric, scale, asym = np.empty(inertia.shape), np.empty(batch), np.empty(batch)
+    _symmetrized(readonly(np.ascontiguousarray(inertia)).reshape(-1, 3, 3), symmetric.reshape(-1, 3, 3),
+                 scale.reshape(-1), asym.reshape(-1))
     bad = scale > _LARGEST
     if bad.any():
         field, k = where(bad)
         raise ValidationError(f"{field}: entries must be at most {_LARGEST:g} kg m^2 in magnitude (the "
                               f"eigen-decomposition squares them), got {scale[k]:.3g}{note(k)}")
-    asym = np.abs(inertia - np.swapaxes(inertia, -1, -2)).max(axis=(-2, -1))
     bad = asym > _SYMMETRY_RTOL * scale
     if bad.any():
         field, k = where(bad)
@@ -100,13 +105,10 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
             f"{field}: must be symmetric (max |I - I^T| = {asym[k]:.3g} > "
             f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale[k]:.3g}){note(k)}"
         )
-    inertia = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
+    inertia = symmetric
     moments, axes = np.linalg.eigh(inertia)
-    for i in (0, 1):  # a double (or triple) moment split by rounding: made equal again
-        close = moments[..., i + 1] - moments[..., i] <= _DEGENERATE_RTOL * np.abs(moments[..., 2])
-        mean = 0.5 * (moments[..., i] + moments[..., i + 1])
-        moments[..., i] = np.where(close, mean, moments[..., i])
-        moments[..., i + 1] = np.where(close, mean, moments[..., i + 1])
+    moments, axes = np.ascontiguousarray(moments), np.ascontiguousarray(axes)
+    _canonical(moments.reshape(-1, 3), axes.reshape(-1, 3, 3))
     m1, m2, m3 = moments[..., 0], moments[..., 1], moments[..., 2]
     bad = ~(m1 > _DEFINITE_RTOL * m3) if definite else m1 < -_DEFINITE_RTOL * m3
     if bad.any():
@@ -123,10 +125,49 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
             f"I1 + I2 >= I3 (1 - {_TRIANGLE_RTOL:g}): {m1[k]:.6g} + {m2[k]:.6g} "
             f"< {m3[k]:.6g}; pass check_triangle=False to accept such data{note(k)}"
         )
-    largest = np.abs(axes).argmax(axis=-2)[..., None, :]
-    axes = axes * np.sign(np.take_along_axis(axes, largest, axis=-2))
-    axes[..., :, 2] *= np.sign(np.linalg.det(axes))[..., None]
     return inertia, moments, axes
+
+
+@njit(cache=True)
+def _symmetrized(inertia, out, scale, asym):
+    """Per tensor ``n`` of ``inertia`` (n, 3, 3): ``out[n] = (I + Iᵀ)/2``, ``scale[n] = max |Iᵢⱼ|`` and
+    ``asym[n] = max |Iᵢⱼ − Iⱼᵢ|``."""
+    for n in range(out.shape[0]):
+        s = a = 0.0
+        for i in range(3):
+            for j in range(3):
+                s = max(s, abs(inertia[n, i, j]))
+                a = max(a, abs(inertia[n, i, j] - inertia[n, j, i]))
+                out[n, i, j] = 0.5 * (inertia[n, i, j] + inertia[n, j, i])
+        scale[n], asym[n] = s, a
+
+
+@njit(cache=True)
+def _canonical(moments, axes):
+    """In place, per body ``n``: ascending ``moments[n]`` within ``_DEGENERATE_RTOL`` × the largest of a
+    neighbour replaced by the mean of their group (a pair, or all three); each column of ``axes[n]`` (the
+    eigenvectors) signed so that its largest-magnitude component (the first of equals) is positive, then
+    the third negated where ``det < 0``, for a right-handed frame."""
+    for n in range(moments.shape[0]):
+        m = moments[n]
+        tol = _DEGENERATE_RTOL * abs(m[2])
+        lower, upper = m[1] - m[0] <= tol, m[2] - m[1] <= tol
+        if lower and upper:
+            m[0] = m[1] = m[2] = (m[0] + m[1] + m[2]) / 3.0
+        elif lower:
+            m[0] = m[1] = 0.5 * (m[0] + m[1])
+        elif upper:
+            m[1] = m[2] = 0.5 * (m[1] + m[2])
+        a = axes[n]
+        for j in range(3):
+            largest = 0
+            for i in range(1, 3):
+                if abs(a[i, j]) > abs(a[largest, j]):
+                    largest = i
+            if a[largest, j] < 0.0:
+                a[0, j], a[1, j], a[2, j] = -a[0, j], -a[1, j], -a[2, j]
+        if orthonormality(a)[1] < 0.0:
+            a[0, 2], a[1, 2], a[2, 2] = -a[0, 2], -a[1, 2], -a[2, 2]
 
 
 def as_rotation(rotation, name: str) -> np.ndarray:

@@ -41,7 +41,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
-from ._quat import qexp, qfrom_matrix, qlog, qmul, qnorm, qrotate, qrotate_inv, qto_matrix
+from ._quat import orthonormality, qexp, qfrom_matrix, qlog, qmul, qnorm, qrotate, qrotate_inv, qto_matrix
 from ._validate import ValidationError, as_array, readonly, require_positive
 
 if TYPE_CHECKING:
@@ -174,9 +174,13 @@ def _to_matrix_loop(q, out):
 
 
 @njit(cache=True)
-def _from_matrix_loop(m, out):
+def _from_matrix_loop(m, tol, out, err, det):
+    """``err[n], det[n]`` = max |mᵀm − 1| and det m of each matrix, and its quaternion into ``out[n]`` where
+    ``err[n] ≤ tol`` and ``det[n] > 0`` (the caller refuses the others)."""
     for n in range(out.shape[0]):
-        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qfrom_matrix(m[n])
+        err[n], det[n] = orthonormality(m[n])
+        if err[n] <= tol and det[n] > 0.0:
+            out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qfrom_matrix(m[n])
 
 
 @njit(cache=True)
@@ -366,20 +370,19 @@ def from_matrix(R: ArrayLike, *, tol: float = 1e-6) -> np.ndarray:
     """
     tol = require_positive(tol, "tol")
     R = as_array(R, "R", tail=(3, 3))
-    err = np.abs(np.swapaxes(R, -1, -2) @ R - np.eye(3)).max(axis=(-2, -1))
+    batch = R.shape[:-2]
+    out, err, det = np.empty((math.prod(batch), 4)), np.empty(batch), np.empty(batch)
+    _from_matrix_loop(_flat(R, batch, (3, 3)), tol, out, err.reshape(-1), det.reshape(-1))
     bad = err > tol
     if bad.any():
         raise ValidationError(
             f"R: must be orthonormal (max |RᵀR - 1| = {err[bad].flat[0]:.3g} > tol = {tol:g}{_where(bad)})"
         )
-    det = np.linalg.det(R)
     bad = det <= 0.0
     if bad.any():
         raise ValidationError(
             f"R: must have det = +1, a proper rotation (found det = {det[bad].flat[0]:.3g}{_where(bad)})"
         )
-    out = np.empty((math.prod(R.shape[:-2]), 4))
-    _from_matrix_loop(_flat(R, R.shape[:-2], (3, 3)), out)
     return out.reshape((*R.shape[:-2], 4))
 
 

@@ -147,7 +147,8 @@ class RigidBodies(RigidMotion):
     __slots__ = ("inertia", "moments", "axes", "q_bp", "masses")
 
     def __init__(self, inertia: np.ndarray, moments: np.ndarray, axes: np.ndarray, masses: np.ndarray | None) -> None:
-        self.inertia, self.moments, self.axes, self.masses = inertia, moments, axes, masses
+        # read-only: the batch's own tensors, which each Trajectory of it shares instead of copying
+        self.inertia, self.moments, self.axes, self.masses = readonly(inertia), moments, axes, masses
         self.q_bp = attitude.from_matrix(axes)
 
     @classmethod
