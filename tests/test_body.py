@@ -411,7 +411,7 @@ def test_principal_axes_of_a_batch_equal_rigid_body_one_by_one():
 
 
 def _principal_axes_numpy(inertia):
-    """The rule of principal_axes written with NumPy alone (its earlier implementation): the reference."""
+    """The rule of principal_axes written with NumPy alone (LAPACK's eigh for every tensor): the reference."""
     sym = 0.5 * (inertia + np.swapaxes(inertia, -1, -2))
     moments, axes = np.linalg.eigh(sym)
     m0, m1, m2 = moments.T.copy()
@@ -427,18 +427,23 @@ def _principal_axes_numpy(inertia):
 
 
 def test_principal_axes_equal_their_rule_in_numpy_bit_for_bit():
-    # The compiled passes (symmetrization, merged double moments, sign rule, right-handed frame) against the
-    # same rule in NumPy, on asymmetric, symmetric and spherical bodies, in rotated and in body axes, with
-    # entries 1e-12-asymmetric and eigenvectors whose components tie in magnitude.
+    # The compiled passes (symmetrization, merged double moments, sign rule, right-handed frame) and the
+    # diagonal tensors' decomposition without eigh, against the same rule with LAPACK for every tensor, on
+    # asymmetric, symmetric and spherical bodies in rotated axes, diagonal tensors with every pattern of
+    # equal moments (LAPACK's order of equal eigenvalues), entries 1e-13-asymmetric, eigenvectors whose
+    # components tie in magnitude, and entries near the largest and smallest allowed magnitudes.
     rng = np.random.default_rng(5)
     r, _ = np.linalg.qr(rng.standard_normal((400, 3, 3)))
     moments = rng.uniform(1.0, 1.9, (400, 3))
     moments[100:200, 1] = moments[100:200, 2]                 # symmetric tops, split by rounding when rotated
     moments[200:250] = moments[200:250, :1]                   # spheres
     inertia = r @ (moments[..., None] * np.swapaxes(r, -1, -2))
-    inertia[300:350] = np.eye(3) * moments[300:350, None, :]  # diagonal, principal axes = body axes (permuted)
-    inertia[350:] += 1e-13 * rng.standard_normal((50, 3, 3))  # asymmetric within the tolerance
-    inertia[399] = [[2.0, 0.5, 0.5], [0.5, 2.0, 0.5], [0.5, 0.5, 2.0]]   # eigenvectors with equal components
+    levels = np.array([1.0, 1.5, 1.5 + 2 ** -52, 1.9])
+    inertia[300:350] = np.eye(3) * levels[rng.integers(0, 4, (50, 1, 3))]   # diagonal, ties of every kind
+    inertia[350:360] *= 1e140
+    inertia[360:370] *= 1e-140
+    inertia[370:] += 1e-13 * rng.standard_normal((30, 3, 3))  # asymmetric within the tolerance
+    inertia[399] = [[2.0, 0.5, 0.5], [0.5, 2.0, 0.5], [0.5, 0.5, 2.0]]   # moments 1.5, 1.5, 3
     sym, m, axes = principal_axes(inertia)
     ref = _principal_axes_numpy(inertia)
     assert np.array_equal(sym, ref[0]) and np.array_equal(m, ref[1]) and np.array_equal(axes, ref[2])

@@ -106,9 +106,13 @@ def principal_axes(inertia, name: str = "inertia", *, definite: bool = True, che
             f"{_SYMMETRY_RTOL:g} x max |I| = {_SYMMETRY_RTOL * scale[k]:.3g}){note(k)}"
         )
     inertia = symmetric
-    moments, axes = np.linalg.eigh(inertia)
-    moments, axes = np.ascontiguousarray(moments), np.ascontiguousarray(axes)
-    _canonical(moments.reshape(-1, 3), axes.reshape(-1, 3, 3))
+    moments, axes, diagonal = np.empty(batch + (3,)), np.empty(batch + (3, 3)), np.empty(batch, dtype=np.bool_)
+    flat_moments, flat_axes = moments.reshape(-1, 3), axes.reshape(-1, 3, 3)
+    _diagonal_decomposition(readonly(inertia).reshape(-1, 3, 3), flat_moments, flat_axes, diagonal.reshape(-1))
+    rest = np.flatnonzero(~diagonal)
+    if rest.size:
+        flat_moments[rest], flat_axes[rest] = np.linalg.eigh(inertia.reshape(-1, 3, 3)[rest])
+    _canonical(flat_moments, flat_axes)
     m1, m2, m3 = moments[..., 0], moments[..., 1], moments[..., 2]
     bad = ~(m1 > _DEFINITE_RTOL * m3) if definite else m1 < -_DEFINITE_RTOL * m3
     if bad.any():
@@ -140,6 +144,34 @@ def _symmetrized(inertia, out, scale, asym):
                 a = max(a, abs(inertia[n, i, j] - inertia[n, j, i]))
                 out[n, i, j] = 0.5 * (inertia[n, i, j] + inertia[n, j, i])
         scale[n], asym[n] = s, a
+
+
+@njit(cache=True)
+def _diagonal_decomposition(inertia, moments, axes, diagonal):
+    """Per tensor ``n`` of ``inertia`` (n, 3, 3), symmetric: ``diagonal[n]``, whether its products of inertia
+    are all zero, and for those the eigen-decomposition LAPACK's ``eigh`` returns, without its cost (0.3 µs
+    a tensor): the diagonal into ``moments[n]`` and the body axes into the columns of ``axes[n]``, sorted
+    ascending by selection (the smallest of the rest swapped into place, the first of equals), as LAPACK
+    sorts. Other tensors are left to ``eigh``."""
+    for n in range(inertia.shape[0]):
+        a = inertia[n]
+        diagonal[n] = a[0, 1] == 0.0 and a[0, 2] == 0.0 and a[1, 2] == 0.0
+        if not diagonal[n]:
+            continue
+        m, v = moments[n], axes[n]
+        for i in range(3):
+            m[i] = a[i, i]
+            for j in range(3):
+                v[i, j] = 1.0 if i == j else 0.0
+        for i in range(2):
+            k = i
+            for j in range(i + 1, 3):
+                if m[j] < m[k]:
+                    k = j
+            if k != i:
+                m[i], m[k] = m[k], m[i]
+                for r in range(3):
+                    v[r, i], v[r, k] = v[r, k], v[r, i]
 
 
 @njit(cache=True)
