@@ -8,8 +8,8 @@ body-steps per second of the CUDA kernel (``tumble.integrate._cuda``) for batche
    shared body, torque-free bodies with one inertia each, and one shared body under a compiled torque
    program (a constant body torque plus gravity on a top);
 2. ``tumble.simulate(..., device="cuda")`` end to end (body axes in and out) for one inertia per body,
-   beside ``tumble.simulate`` on the CPU (all cores) for the same bodies, and the largest difference
-   between the two.
+   diagonal tensors and the same in rotated body axes, beside ``tumble.simulate`` on the CPU (all cores)
+   for the first of the same bodies, and the largest difference between the two.
 
 Without a GPU it says so and exits 0. Run by hand (not a test)::
 
@@ -24,7 +24,7 @@ import math
 import os
 
 import numpy as np
-from numba import cuda
+from numba import cuda, types
 from numba.core import config
 
 import tumble
@@ -114,27 +114,32 @@ def main():
             print(f"   {name:<30} {n:12,d} {fmt(kernel.rates(n * steps)['wall']):>24} "
                   f"{fmt(whole.rates(n * steps)['wall']):>24}")
 
-    # The public front door, body axes in and out, one inertia per body; the CPU on the first bodies.
-    n = sizes[0]
-    inertia = np.einsum("bi,ij->bij", moments(n), np.eye(3))        # (n, 3, 3) kg m², principal = body axes
+    if not config.ENABLE_CUDASIM:  # registers per thread of each compiled kernel (torque-free, torque program)
+        for signature, regs in getattr(_cuda._rk4_kernel, "get_regs_per_thread", dict)().items():
+            kind = "torque-free" if isinstance(signature[2], types.BaseTuple) else "torque program"  # codes = ()
+            print(f"   registers per thread, {kind} kernel: {regs}")
+
+    # The public front door, body axes in and out, one inertia per body (diagonal tensors, then the same
+    # tensors in rotated body axes: their set-up finds each one's principal axes); the CPU on the first bodies.
+    n, k = sizes[0], min(CPU_BODIES, sizes[0])
+    diagonal = np.einsum("bi,ij->bij", moments(n), np.eye(3))        # (n, 3, 3) kg m², principal = body axes
+    turn = attitude.to_matrix(states(n, seed=3)[:, :4])
     y0 = states(n)
     q0, omega0 = y0[:, :4], y0[:, 4:]
+    print("\n   tumble.simulate, one inertia per body, end to end, body-steps/s (min / median):")
+    for name, inertia in (("diagonal", diagonal), ("rotated", turn @ diagonal @ np.swapaxes(turn, -1, -2))):
 
-    def run(device, k):
-        return tumble.simulate(inertia[:k], omega0[:k], q0=q0[:k], t=t, method="rk4", dt=DT, device=device)
+        def run(device, k, inertia=inertia):
+            return tumble.simulate(inertia[:k], omega0[:k], q0=q0[:k], t=t, method="rk4", dt=DT, device=device)
 
-    run("cuda", 256), run("cpu", 256)
-    gpu = measure(lambda: run("cuda", n))
-    k = min(CPU_BODIES, n)
-    cpu = measure(lambda: run("cpu", k))
-    print(f"\n   tumble.simulate, one inertia per body, end to end, body-steps/s (min / median):")
-    print(f"   device='cuda', N = {n:,d}: {fmt(gpu.rates(n * steps)['wall'])}")
-    rates = cpu.rates(k * steps, CORES)
-    print(f"   device='cpu' on {CORES} cores, N = {k:,d}: {fmt(rates['wall'])} wall, {fmt(rates['cpu'])} CPU-time based")
-    a, b = gpu.result, cpu.result
-    print(f"   max |GPU - CPU| over those bodies at t = {t[-1]:g} s: q {np.abs(a.q[:, :k] - b.q).max():.2e}, "
-          f"omega {np.abs(a.omega[:, :k] - b.omega).max():.2e} rad/s")
-
+        run("cuda", 256), run("cpu", 256)
+        gpu, cpu = measure(lambda: run("cuda", n)), measure(lambda: run("cpu", k))
+        rates = cpu.rates(k * steps, CORES)
+        a, b = gpu.result, cpu.result
+        print(f"   {name} tensors: device='cuda', N = {n:,d}: {fmt(gpu.rates(n * steps)['wall'])}; device='cpu' on "
+              f"{CORES} cores, N = {k:,d}: {fmt(rates['wall'])} wall, {fmt(rates['cpu'])} CPU-time based; "
+              f"max |GPU - CPU| at t = {t[-1]:g} s: q {np.abs(a.q[:, :k] - b.q).max():.2e}, "
+              f"omega {np.abs(a.omega[:, :k] - b.omega).max():.2e} rad/s")
 
 if __name__ == "__main__":
     main()
