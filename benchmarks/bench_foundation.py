@@ -276,7 +276,7 @@ def compiling_process_rate(n_bodies, steps):
     """Body-steps/s (CPU × cores, best of 5) of the shared-inertia batch in a new process that compiles the
     batch path itself (an empty ``NUMBA_CACHE_DIR``): it runs the copy of the lane passes compiled on its
     own, which ran scalar, 5x slower, until they were compiled without reference counting
-    (``_rk4._lane_steps``, docs/architecture.md)."""
+    (``_fused.advance`'s lane passes`, docs/architecture.md)."""
     with tempfile.TemporaryDirectory() as cache:
         done = subprocess.run([sys.executable, "-c", _COMPILING, str(n_bodies), str(steps)], check=True,
                               capture_output=True, text=True, env=dict(os.environ, NUMBA_CACHE_DIR=cache))

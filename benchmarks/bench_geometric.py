@@ -87,7 +87,8 @@ def splitting_energy_error(scheme, moments, omega0, dt, steps):
     y = np.concatenate([[1.0, 0.0, 0.0, 0.0], omega0])[None, :]
     t = np.arange(steps + 1) * dt
     out, stats = np.empty((steps + 1, 1, 7)), np.zeros((1, 5))
-    _fixed.run_block(scheme, model, 0, y, t, dt, out, stats)
+    m, h = _fixed.landing_steps(t, dt, 10**9)
+    _fixed.run_block(scheme, model, 0, y, t, m, h, out, stats)
     omega = out[:, 0, 4:]
     energy = 0.5 * (omega**2 * moments).sum(axis=-1)
     return np.abs(energy / energy[0] - 1.0).max()

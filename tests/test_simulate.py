@@ -441,17 +441,18 @@ def test_an_object_that_is_not_a_model_is_refused_naming_its_type():
 
 
 def test_lane_passes_drop_reference_counts_only_without_a_torque_program():
-    # _rk4._lane_steps compiled without reference counting vectorises in the process that compiles it
+    # the fused lane passes (_fused.advance) compiled without reference counting vectorise in the process that
+    # compiles them
     # (docs/architecture.md); a torque program's evaluator may call Python, which allocates, so a model
     # with one keeps the counts (compiled without them, its batch failed to type in a fresh process)
     from numba import typeof
 
-    from tumble.integrate import _rk4
+    from tumble.integrate import _fused
     from tumble.kernels import rigid
 
     body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
     free = typeof(rigid.build([body], None))
     with_program = typeof(rigid.build([body], torques.ConstantBody([0.1, 0.0, 0.0])))
     with_python = typeof(rigid.build([body], torques.as_torque_model(lambda t, q, w: np.zeros(3))))
-    assert not _rk4._counts_references(free)
-    assert _rk4._counts_references(with_program) and _rk4._counts_references(with_python)
+    assert not _fused.counts_references(free)
+    assert _fused.counts_references(with_program) and _fused.counts_references(with_python)

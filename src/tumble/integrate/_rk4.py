@@ -24,12 +24,12 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 from numba.extending import register_jitable
 
 from tumble import _protocol
-from tumble._protocol import members, point_rates, project, quaternion_scale, rhs, state_size, uniform
-from tumble.integrate import _fixed
+from tumble._protocol import point_rates, project, quaternion_scale, rhs, state_size
+from tumble.integrate import _fixed, _fused
 
 ORDER = 4
 
@@ -89,11 +89,7 @@ SCHEME = RK4()
 @_protocol.implements(_fixed.workspace, RK4)
 def _rk4_workspace(scheme, model, b0, Y):
     if _protocol.implemented(point_rates, model):
-        if Y.ndim == 1:  # fused: registers only
-            return lambda scheme, model, b0, Y: ()
-        # the lanes at a fixed stride, and the block's own rows of a non-uniform model
-        return lambda scheme, model, b0, Y: (np.empty(7 * _fixed.LANES),
-                                             model if uniform(model) else members(model, b0, b0 + Y.shape[1]))
+        return _fused.workspace(model, Y)
     return lambda scheme, model, b0, Y: (np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y),
                                      np.empty_like(Y))
 
@@ -101,7 +97,7 @@ def _rk4_workspace(scheme, model, b0, Y):
 @_protocol.implements(_fixed.advance, RK4)
 def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     if _protocol.implemented(point_rates, model):
-        return _fused_advance(Y, model)
+        return _fused_advance(Y, model)  # one step of a lane in registers (_fused)
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
         k1, k2, k3, k4, tmp = work
@@ -128,80 +124,4 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     return impl
 
 
-W = _fixed.LANES  # lanes of a block: the stride of the buffer x
-
-
-def _lane_steps(model, block, shared, t0, h, m, x, lanes):
-    """``m`` RK4 steps of ``h`` (s) from ``t0`` of the ``lanes`` lanes of the buffer ``x`` (see
-    :func:`_fused_advance`), with the parameters of ``model`` (row 0, ``shared``) or of ``block`` (row ``j``
-    for lane ``j``).
-
-    For a model without a torque program it is compiled without reference counting
-    (:data:`_lane_steps_counted_not`), so that the copy compiled on its own is vectorised: the step,
-    IR-inlined, binds the model's arrays again in every call, and the increments and decrements of their
-    counts, split across the status branches of its helpers' calls, were still in the lane loop when
-    LLVM's one ``-O3`` round tried to vectorise it. The process that compiles a batch runs that copy
-    (docs/architecture.md): it ran 5× slower than one loading the cached code, and now runs as fast. A
-    torque program keeps the counts: its evaluator may call a Python function, which allocates.
-    """
-    # two loops, so that shared parameters are a broadcast and per-member ones a contiguous load
-    for s in range(m):
-        t = t0 + s * h
-        if shared:
-            for j in range(lanes):
-                (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
-                    point_step(model, 0, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
-                                                x[5 * W + j], x[6 * W + j])))
-        else:
-            for j in range(lanes):
-                (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j], x[5 * W + j], x[6 * W + j]) = (
-                    point_step(block, j, t, h, (x[j], x[W + j], x[2 * W + j], x[3 * W + j], x[4 * W + j],
-                                                x[5 * W + j], x[6 * W + j])))
-
-
-_lane_steps_counted = njit(error_model="numpy")(_lane_steps)
-_lane_steps_counted_not = njit(_nrt=False, error_model="numpy")(_lane_steps)
-
-
-def _counts_references(model) -> bool:
-    """Whether the passes over the lanes of ``model`` (a Numba type with ``point_rates``) need reference
-    counting: unless it has no torque program (its ``codes`` None, the torque-free rigid body)."""
-    codes = model.types[model.fields.index("codes")] if "codes" in model.fields else None
-    return not isinstance(codes, types.NoneType)
-
-
-def _fused_advance(Y, model):
-    """``advance`` of a kernel with ``point_rates``: the state vector, or each lane of the block, in
-    registers through all ``m`` steps (one body) or through one step per pass over the lanes (a block).
-
-    A block's lanes are copied into a buffer where component ``i`` of lane ``j`` is ``x[i·LANES + j]``:
-    with a stride known at compile time LLVM sees that the lanes of one pass are independent and
-    vectorises the pass (with the block's own run-time stride it does not). Lane ``j`` reads row ``j``
-    of the block's own kernel (:func:`tumble._protocol.members`), or row 0 of a uniform one: indices
-    from 0, which LLVM reads as contiguous vectors (from ``b0`` it did not).
-    """
-    if Y.ndim == 1:
-
-        def impl(scheme, model, b0, t0, h, m, Y, work):
-            r = 0 if uniform(model) else b0
-            y = (Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6])
-            for s in range(m):
-                y = point_step(model, r, t0 + s * h, h, y)
-            Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6] = y
-
-        return impl
-
-    lane_steps = _lane_steps_counted if _counts_references(model) else _lane_steps_counted_not
-
-    def impl(scheme, model, b0, t0, h, m, Y, work):
-        x, block = work
-        lanes = Y.shape[1]
-        for i in range(7):
-            for j in range(lanes):
-                x[i * W + j] = Y[i, j]
-        lane_steps(model, block, uniform(model), t0, h, m, x, lanes)
-        for i in range(7):
-            for j in range(lanes):
-                Y[i, j] = x[i * W + j]
-
-    return impl
+_fused_advance = _fused.advance(point_step)
