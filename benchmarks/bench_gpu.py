@@ -64,8 +64,8 @@ def models(n):
     }
 
 
-def kernel_timing(model, y0, t):
-    """Timing of the kernel alone, on data already on the GPU."""
+def kernel_timing(model, y0, t, kernel=_cuda._rk4_kernel):
+    """Timing of ``kernel`` (by default tumble's) alone, on data already on the GPU."""
     codes = () if model.codes is None else cuda.to_device(model.codes)
     args = [cuda.to_device(model.coefficients), cuda.to_device(model.params), codes, cuda.to_device(y0),
             cuda.to_device(t), *map(cuda.to_device, _fixed.landing_steps(t, DT, integrate.MAX_STEPS)),
@@ -73,7 +73,7 @@ def kernel_timing(model, y0, t):
     blocks = math.ceil(y0.shape[0] / _cuda.THREADS_PER_BLOCK)
 
     def launch():
-        _cuda._rk4_kernel[blocks, _cuda.THREADS_PER_BLOCK](*args)
+        kernel[blocks, _cuda.THREADS_PER_BLOCK](*args)
         cuda.synchronize()
 
     launch()                                            # compile / load from the cache
@@ -85,6 +85,9 @@ def main():
     parser.add_argument("--quick", action="store_true", help="N = 1e6 and 100 steps")
     parser.add_argument("--sizes", type=int, nargs="+", help="batch sizes N (default 1e6, 1e7)")
     parser.add_argument("--steps", type=int, help="RK4 steps of 1 ms per body (default 1000)")
+    parser.add_argument("--registers", type=int, nargs="+", default=[],
+                        help="also time the torque-program kernel compiled with each of these caps on its registers "
+                             "per thread (numba.cuda's max_registers), at the first N")
     args = parser.parse_args()
     if not _cuda.cuda_available():
         print("No CUDA GPU present (numba.cuda.is_available() is False): nothing measured.")
@@ -118,6 +121,17 @@ def main():
         for signature, regs in getattr(_cuda._rk4_kernel, "get_regs_per_thread", dict)().items():
             kind = "torque-free" if isinstance(signature[2], types.BaseTuple) else "torque program"  # codes = ()
             print(f"   registers per thread, {kind} kernel: {regs}")
+
+    if args.registers and not config.ENABLE_CUDASIM:
+        n, model = sizes[0], models(1)["torque program, shared body"]
+        y0 = states(n)
+        print(f"\n   torque program, shared body, N = {n:,d}, kernel alone, by cap on registers per thread:")
+        for cap in args.registers:
+            capped = cuda.jit(max_registers=cap)(_cuda._rk4_kernel.py_func)
+            timing = kernel_timing(model, y0, t, capped)
+            regs = list(capped.get_regs_per_thread().values())
+            print(f"   at most {cap:4d}: {fmt(timing.rates(n * steps)['wall'])} body-steps/s, {regs} registers, "
+                  f"local memory {list(getattr(capped, 'get_local_mem_per_thread', dict)().values())} bytes per thread")
 
     # The public front door, body axes in and out, one inertia per body (diagonal tensors, then the same
     # tensors in rotated body axes: their set-up finds each one's principal axes); the CPU on the first bodies.
