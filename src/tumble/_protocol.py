@@ -41,8 +41,8 @@ compiles::
 
 Two more are optional: a kernel whose state is ``[q_NP, ω_P]`` (7) and whose
 projection is ``q ← q/|q|`` may give its right-hand side on one body's state
-held in registers (a 7-tuple), which the fixed-step RK4 then runs fused, all
-four stages, the update and the projection of a lane in one pass::
+held in registers (a 7-tuple), which the fixed-step RK4 and CF4 then run fused
+(:mod:`tumble.integrate._fused`), a lane's whole step, stages, update and projection, in one pass::
 
     point_rates(model, r, t, y) -> dy/dt    (7-tuples) with the parameters of row r
     uniform(model) -> bool                  one row for all members (r = 0); otherwise member b has row b

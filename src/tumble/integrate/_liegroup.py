@@ -27,6 +27,12 @@ Every step ends, as with every stepper, with the model's
 :func:`~tumble._protocol.project`: it renormalises a quaternion that the
 exact rotations kept unit to rounding, and it is where a model updates what it
 samples at step ends (a spacecraft's zero-order hold, its PWPF triggers).
+
+A kernel that gives its right-hand side on one body's state in registers
+(``point_rates``: the rigid body) runs *fused* (:mod:`._fused`): the whole
+step of a lane, stages, exponentials, update and projection, on its seven
+values (:func:`point_step`), with the same operations in the same order as
+the stages over a block (:func:`_cf4_step`), which the other models run.
 """
 
 from __future__ import annotations
