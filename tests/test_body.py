@@ -453,6 +453,22 @@ def test_principal_axes_equal_their_rule_in_numpy_bit_for_bit():
     np.testing.assert_allclose(np.linalg.det(axes), 1.0, rtol=0, atol=1e-14)
 
 
+def test_a_large_batch_shares_its_eigen_decompositions_between_threads_and_gets_the_same_bits():
+    import numba
+
+    from tumble import _inertia
+
+    if numba.get_num_threads() < 2:
+        pytest.skip("one Numba thread: the batch is decomposed on one")
+    n = 2 * _inertia._THREADED + 5  # two shares or more, of unequal sizes
+    rng = np.random.default_rng(8)
+    r, _ = np.linalg.qr(rng.standard_normal((n, 3, 3)))
+    inertia = r @ (rng.uniform(1.0, 1.9, (n, 3))[..., None] * np.swapaxes(r, -1, -2))
+    inertia[::7] = np.eye(3) * rng.uniform(1.0, 1.9, (len(inertia[::7]), 1, 3))  # diagonal ones between
+    got, ref = principal_axes(inertia), _principal_axes_numpy(inertia)
+    assert all(np.array_equal(a, b) for a, b in zip(got, ref))
+
+
 def test_a_batch_trajectory_shares_the_batch_tensors():
     import tumble
 
