@@ -16,7 +16,7 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from tumble import _quat
-from tumble._quat import orthonormality
+from tumble._quat import mdet
 from tumble._validate import ValidationError, as_array, readonly
 
 # Inertia symmetric when max |I − Iᵀ| ≤ _SYMMETRY_RTOL · max |I|.
@@ -215,7 +215,7 @@ def _canonical(moments, axes):
                     largest = i
             if a[largest, j] < 0.0:
                 a[0, j], a[1, j], a[2, j] = -a[0, j], -a[1, j], -a[2, j]
-        if orthonormality(a)[1] < 0.0:
+        if mdet(a) < 0.0:
             a[0, 2], a[1, 2], a[2, 2] = -a[0, 2], -a[1, 2], -a[2, 2]
 
 

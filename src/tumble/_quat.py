@@ -144,6 +144,13 @@ def qfrom_matrix(m):
 
 
 @njit(cache=True)
+def mdet(m):
+    """``det m`` of a 3×3 matrix, by cofactors along its first row."""
+    return (m[0, 0] * (m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]) - m[0, 1] * (m[1, 0] * m[2, 2] - m[1, 2] * m[2, 0])
+            + m[0, 2] * (m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]))
+
+
+@njit(cache=True)
 def orthonormality(m):
     """``(max |mᵀm − 1|, det m)`` of a 3×3 matrix: how far it is from a rotation (0 and +1 for one)."""
     err = 0.0
@@ -151,9 +158,7 @@ def orthonormality(m):
         for j in range(3):
             d = m[0, i] * m[0, j] + m[1, i] * m[1, j] + m[2, i] * m[2, j] - (1.0 if i == j else 0.0)
             err = max(err, abs(d))
-    det = (m[0, 0] * (m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]) - m[0, 1] * (m[1, 0] * m[2, 2] - m[1, 2] * m[2, 0])
-           + m[0, 2] * (m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]))
-    return err, det
+    return err, mdet(m)
 
 
 @njit(cache=True)

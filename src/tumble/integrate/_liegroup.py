@@ -45,6 +45,7 @@ from numba import njit
 from tumble import _protocol, _quat
 from tumble._protocol import body_rate, point_rates, project, quaternion_scale, rhs
 from tumble.integrate import _fixed, _fused
+from tumble.integrate._rk4 import weighted_sum
 
 ORDER = 4
 
@@ -120,9 +121,9 @@ def point_step(model, r, t, h, y):
                      h * (d0 * w3 + d1 * y2[6] + d2 * y3[6] + d3 * y4[6]))
     s = quaternion_scale(u[0], u[1], u[2], u[3])
     return (u[0] * s, u[1] * s, u[2] * s, u[3] * s,
-            w1 + h / 6.0 * (k1[4] + 2.0 * k2[4] + 2.0 * k3[4] + k4[4]),
-            w2 + h / 6.0 * (k1[5] + 2.0 * k2[5] + 2.0 * k3[5] + k4[5]),
-            w3 + h / 6.0 * (k1[6] + 2.0 * k2[6] + 2.0 * k3[6] + k4[6]))
+            w1 + weighted_sum(h, k1[4], k2[4], k3[4], k4[4]),
+            w2 + weighted_sum(h, k1[5], k2[5], k3[5], k4[5]),
+            w3 + weighted_sum(h, k1[6], k2[6], k3[6], k4[6]))
 
 
 @_protocol.implements(_fixed.workspace, CF4)
