@@ -152,8 +152,19 @@ def single_body(steps):
             "NumPy": ns(measure(lambda: rk4_loop(euler_rhs, y[0].copy(), 1e-3, 2000)), 2000)}
 
 
-def c_reference():
-    """The C kernel's ``rk4_batch`` (ctypes) built twice, ``{"C reference": …, "C, no FMA": …}``: as gcc
+def numba_target():
+    """The CPU name Numba compiles for, and whether its features include AVX-512 (``NUMBA_CPU_NAME``,
+    ``NUMBA_CPU_FEATURES`` set them; else the host's)."""
+    from numba.core import config
+    from llvmlite import binding
+
+    name = config.CPU_NAME or binding.get_host_cpu_name()
+    features = config.CPU_FEATURES if config.CPU_FEATURES is not None else binding.get_host_cpu_features().flatten()
+    return f"{name}, {'AVX-512' if '+avx512f' in features else 'no AVX-512'}"
+
+
+def c_reference(march="native"):
+    """The C kernel's ``rk4_batch`` (ctypes) for ``gcc -march=MARCH``, built twice, ``{"C reference": …, "C, no FMA": …}``: as gcc
     contracts ``a·b + c`` into fused multiply-adds by default, and with ``-ffp-contract=off``, rounding every
     operation as tumble does (which must not contract: its CPU and CUDA-simulator states agree bit for bit).
     Empty without gcc."""
@@ -163,7 +174,7 @@ def c_reference():
     kernels = {}
     for name, flags in (("C reference", []), ("C, no FMA", ["-ffp-contract=off"])):
         lib = Path(tempfile.mkdtemp()) / "rk4_reference.so"
-        subprocess.run([gcc, "-O3", "-march=native", "-fopenmp", "-fno-math-errno", *flags, "-shared", "-fPIC",
+        subprocess.run([gcc, "-O3", f"-march={march}", "-fopenmp", "-fno-math-errno", *flags, "-shared", "-fPIC",
                         "-o", str(lib), str(Path(__file__).with_name("rk4_reference.c"))], check=True)
         f = ctypes.CDLL(str(lib)).rk4_batch
         f.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int, ctypes.c_ssize_t, ctypes.c_double,
@@ -286,8 +297,12 @@ def compiling_process_rate(n_bodies, steps):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="smaller sizes")
+    parser.add_argument("--march", default="native",
+                        help="gcc's -march for the C kernel; give Numba the same target through NUMBA_CPU_NAME and "
+                             "NUMBA_CPU_FEATURES (e.g. haswell and '+avx,+avx2,+fma') to compare on another ISA")
     args = parser.parse_args()
     print(machine())
+    print(f"Numba target: {numba_target()}; C kernel: gcc -march={args.march}")
     # the rows measure compiled code loaded from the cache, as every process after the first runs it (row 2c:
     # the process that compiles)
     subprocess.run([sys.executable, "-m", "tumble", "warmup"], check=True, capture_output=True)
@@ -299,7 +314,7 @@ def main():
     for name, v in r.items():
         print(f"   {name:<14} {fmt(v, ' ns')}")
 
-    c_kernels = c_reference()
+    c_kernels = c_reference(args.march)
     n_bodies, steps = (20_000, 200) if args.quick else (100_000, 500)
     for per_body in (False, True):
         print(f"\n2{'b' if per_body else 'a'}. batch RK4, N = {n_bodies}, {steps} steps, "
