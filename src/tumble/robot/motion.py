@@ -24,8 +24,8 @@ extra ``beyond_limits`` says, per sample, whether a joint has left its range.
 
 :class:`ChainMotion` implements the model interface for
 :class:`tumble.robot.RobotTree`, which provides ``nq``, ``nv``, ``dof``,
-``joint_names``, ``name``, the limits and the compiled arrays ``_params`` and
-``_gravity``.
+``joint_names``, ``massless_joints``, ``name``, the limits and the compiled
+arrays ``_params`` and ``_gravity``.
 """
 
 from __future__ import annotations
@@ -104,6 +104,10 @@ class ChainMotion(Model):
 
     @property
     @abc.abstractmethod
+    def massless_joints(self) -> tuple[str | None, ...]: ...
+
+    @property
+    @abc.abstractmethod
     def lower(self) -> np.ndarray: ...
 
     @property
@@ -136,6 +140,10 @@ class ChainMotion(Model):
 
     def compile(self, torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None,
                 t0: float) -> _kernel.RobotModel:
+        if self.massless_joints:
+            raise ValidationError(f"model: joint(s) {list(self.massless_joints)} move no mass or inertia, so M(q) "
+                                  "is singular and the motion undefined (load the URDF with min_inertia > 0 to give "
+                                  "the links a least inertia)")
         law, slot, constant = self._torque_law(torque)
         return _kernel.RobotModel(params=self._params, sizes=np.array([self.nq, self.nv], dtype=np.int64),
                                   gravity=self._gravity, law=np.array([law, slot], dtype=np.int64),
