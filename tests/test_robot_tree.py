@@ -179,3 +179,15 @@ BAD = [
 def test_bad_trees_are_refused_naming_the_element_and_the_rule(text, message):
     with pytest.raises(ValidationError, match=message):
         robot.RobotTree.from_urdf(text)
+
+
+def test_centroidal_momentum_matches_pinocchio(pair):
+    """The compiled ``h_G = (k_G, l)``, batched (what a floating-base simulate outputs at every sample), against
+    Pinocchio's computeCentroidalMomentum on 20 random states."""
+    states = pair.states(18, STATES)
+    h = robot.centroidal_momentum(pair.tree, np.array([s[0] for s in states]), np.array([s[1] for s in states]))
+    assert h.shape == (STATES, 6)
+    for k, (q, v, _) in enumerate(states):
+        expected = pin.computeCentroidalMomentum(pair.model, pair.data, pair.to_pin_q(q), pair.to_pin_v(v))
+        close(h[k], np.concatenate([expected.angular, expected.linear]), ORACLE_TOL)
+        np.testing.assert_array_equal(robot.centroidal_momentum(pair.tree, q, v), h[k])

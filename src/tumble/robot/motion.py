@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import abc
 from collections.abc import Callable
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -45,7 +45,6 @@ from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra
 
 if TYPE_CHECKING:
-    from tumble.robot.tree import RobotTree
     from tumble.trajectory import Trajectory
 
 __all__ = ["ChainMotion"]
@@ -205,12 +204,11 @@ class ChainMotion(Model):
                        totals={"energy": energies[..., 0] + energies[..., 1]}, info=info)
 
     def _base_extras(self, q, qd) -> dict:
-        """The floating base's motion and the centroidal momentum (world axes) at every sample."""
-        from tumble.robot.kinematics import centroidal_momentum
-
-        tree = cast("RobotTree", self)  # the model interface of RobotTree, its one subclass
-        flat_q, flat_qd = q.reshape(-1, self.nq), qd.reshape(-1, self.nv)
-        h = np.array([centroidal_momentum(tree, a, b) for a, b in zip(flat_q, flat_qd)]).reshape(*q.shape[:-1], 6)
+        """The floating base's motion and the centroidal momentum (world axes) at every sample (compiled:
+        :func:`tumble.kernels.featherstone.centroidal_momentum_batch`)."""
+        h = np.empty((*q.shape[:-1], 6))
+        _featherstone.centroidal_momentum_batch(self._params, q.reshape(-1, self.nq), qd.reshape(-1, self.nv),
+                                                h.reshape(-1, 6))
         vector = ("xyz",)
         return {
             "base_position": Extra(q[..., 0:3], vector, "m", "origin of the floating base, world frame"),
