@@ -290,3 +290,20 @@ def test_massless_last_link_loads_but_does_not_move():
     np.testing.assert_allclose(robot.forward_dynamics(regular, [0.3], [0.0], [2e-3]), [2.0], rtol=1e-14)
     with pytest.raises(ValidationError, match=r"^min_inertia: must be a finite number >= 0 kg m\^2, got -1\.0$"):
         robot.SerialChain.from_urdf(doc, min_inertia=-1)
+
+
+def test_the_cli_prints_the_torque_about_a_huge_axis(tmp_path):
+    """``tumble robot torques`` on ``<axis xyz="1e200 1e200 0">``: the torque about (1, 1, 0)/√2, not 0."""
+    from typer.testing import CliRunner
+
+    from tumble.robot.cli import app
+
+    body = link("base") + link("a", 1.0, xyz="0.3 0 0.2") + joint("j1", "base", "a", axis="{axis}")
+    taus = []
+    for axis in ("1e200 1e200 0", "1 1 0"):
+        path = tmp_path / "arm.urdf"
+        path.write_text(urdf(body.replace("{axis}", axis)))
+        result = CliRunner().invoke(app, ["torques", str(path), "--q", "0.4", "--qdd", "1.3"])
+        assert result.exit_code == 0, result.output
+        taus.append(float(result.stdout.split("tau =")[1].split()[0]))
+    assert taus[0] == taus[1] and abs(taus[0]) > 0.1

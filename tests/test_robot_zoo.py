@@ -172,3 +172,25 @@ def test_romeo_with_massless_fingers_loads_and_only_what_needs_m_inverse_refuses
     assert robot.mass_matrix(regular, q)[hands[0], hands[0]] >= 1e-6
     qdd = robot.forward_dynamics(regular, q, np.zeros(regular.nv), np.zeros(regular.nv))
     assert np.isfinite(qdd).all()
+
+
+def test_the_cli_repairs_tiago_on_request_and_says_so():
+    """``tumble robot torques``: TIAGo refused (exit 2, one line naming the link and the option), then loaded with
+    ``--inertia clip``: one ``warning:`` line per repair message on stderr, the torques on stdout."""
+    from typer.testing import CliRunner
+
+    from tumble.robot.cli import app
+
+    path = str(ERD / "tiago_description/robots/tiago_no_hand.urdf")
+    with pytest.warns(UrdfRepairWarning):
+        dof = _load("tiago_description/robots/tiago_no_hand.urdf").dof
+    q = ", ".join(["0.1"] * dof)
+    refused = CliRunner().invoke(app, ["torques", path, "--q", q])
+    assert refused.exit_code == 2
+    assert refused.stderr.startswith("error: link 'base_antenna_left_link' <inertial> <inertia>: must be positive "
+                                     "semi-definite")
+    repaired = CliRunner().invoke(app, ["torques", path, "--q", q, "--inertia", "clip"])
+    assert repaired.exit_code == 0, repaired.output
+    assert repaired.stderr.startswith("warning: tiago_no_hand.urdf: non-physical inertia repaired: link "
+                                      "'base_antenna_left_link'")
+    assert repaired.stderr.count("\n") == 1 and repaired.stdout.count("tau =") == dof
