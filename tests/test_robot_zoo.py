@@ -194,3 +194,15 @@ def test_the_cli_repairs_tiago_on_request_and_says_so():
     assert repaired.stderr.startswith("warning: tiago_no_hand.urdf: non-physical inertia repaired: link "
                                       "'base_antenna_left_link'")
     assert repaired.stderr.count("\n") == 1 and repaired.stdout.count("tau =") == dof
+
+
+def test_a_quadrotor_is_a_free_body_that_falls_and_keeps_its_spin():
+    """The hector quadrotor (one link, no joint) as a floating base: nq = 7, nv = 6, no joint coordinate to give;
+    its centre of mass falls as g t²/2 and its angular momentum about it stays (dop853 at rtol = atol = 1e-12;
+    measured 4.3e-13 m and 1.1e-13 relative)."""
+    quad = robot.RobotTree.from_urdf(ERD / "hector_description/robots/quadrotor_base.urdf", floating_base=True)
+    assert (quad.nq, quad.nv, quad.dof) == (7, 6, 0)
+    run = tumble.simulate(quad, t=[0.0, 0.5], method="dop853", rtol=1e-12, atol=1e-12, base_omega0=[0.1, 2.0, 0.3])
+    centre = robot.center_of_mass(quad, np.concatenate([run.base_position, run.base_attitude], axis=1))
+    np.testing.assert_allclose(centre[-1] - centre[0], [0.0, 0.0, -9.81 * 0.5 ** 2 / 2], rtol=0, atol=1e-10)
+    np.testing.assert_allclose(run.angular_momentum[-1], run.angular_momentum[0], rtol=1e-10)

@@ -119,7 +119,8 @@ class ChainMotion(Model):
         n = self.dof
         joints = (
             StateField("q0", n, f"initial joint coordinates, the joint vector ({n},), not a quaternion: rad "
-                                "(revolute) or m (prismatic), base to tip"),
+                                "(revolute) or m (prismatic), base to tip",
+                       default=np.zeros(0) if n == 0 else None),  # a single free body has no joint
             StateField("qd0", n, f"initial joint rates ({n},), rad/s or m/s (default 0: released at rest)",
                        default=np.zeros(n)),
         )

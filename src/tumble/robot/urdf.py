@@ -65,7 +65,7 @@ import numpy as np
 from defusedxml import DefusedXmlException
 from defusedxml import ElementTree
 
-from tumble._validate import ValidationError
+from tumble._validate import ValidationError, require_non_negative
 from tumble._inertia import _DEFINITE_RTOL, parallel_axis, principal_axes
 from tumble.robot.link import Frame, Link
 
@@ -219,9 +219,7 @@ def read_urdf(source: str | os.PathLike[str], *, check_triangle: bool = True, fl
     moving body. Each repair is warned (:class:`UrdfRepairWarning`) and listed in ``repairs``."""
     if inertia not in _INERTIA_RULES:
         raise ValidationError(f"inertia: must be one of {_INERTIA_RULES}, got {inertia!r}")
-    min_inertia = float(min_inertia)
-    if not (math.isfinite(min_inertia) and min_inertia >= 0.0):
-        raise ValidationError(f"min_inertia: must be a finite number >= 0 kg m^2, got {min_inertia}")
+    min_inertia = require_non_negative(min_inertia, "min_inertia")  # kg·m²
     root, label = _parse(source)
     if root.tag != "robot":
         raise ValidationError(f"{label}: the root element must be <robot>, got <{root.tag}>")
@@ -298,10 +296,9 @@ class _Builder:
         self.base_link = root
         self._attach(root, base, np.eye(3), np.zeros(3))
         self._walk(root, base)
-        if not any(s["joint"] != "floating" for s in self.specs):
-            if not self.floating_base:
-                raise ValidationError(f"{label}: no revolute, continuous or prismatic joint: nothing moves on a "
-                                      "fixed base (for a single free body, a quadrotor, pass floating_base=True)")
+        if not self.specs:  # a fixed base and no moving joint
+            raise ValidationError(f"{label}: no revolute, continuous or prismatic joint: nothing moves on a fixed "
+                                  "base (for a single free body, a quadrotor, pass floating_base=True)")
         links = tuple(self._merged(i) for i in range(len(self.specs)))
         mimic = {i: self._mimicked(i, *spec) for i, spec in self.mimic_of.items()}
         body_links = {-1: root, **{i: m[0] for i, m in enumerate(self.members)}}
@@ -422,8 +419,8 @@ class _Builder:
         merged = f" with the fixed link(s) {members[1:]} merged into it" if len(members) > 1 else ""
         moved = "the floating base" if spec["joint"] == "floating" else f"moved by joint {spec['name']!r}"
         where = f"link {members[0]!r} <inertial>{merged} ({moved})"
-        inertia, moments, axes = principal_axes(inertia, where, definite=False, check_triangle=False)
-        if moments[0] < self.min_inertia:
+        if self.min_inertia > 0.0:
+            inertia, moments, axes = principal_axes(inertia, where, definite=False, check_triangle=False)
             inertia = (axes * np.maximum(moments, self.min_inertia)) @ axes.T
         principal_axes(inertia, where, definite=False, check_triangle=self.check_triangle)
         return Link(mass=mass, com=com, inertia=inertia, check_triangle=self.check_triangle, **spec)
