@@ -62,7 +62,7 @@ def _load(name, **extra):
 @pytest.mark.parametrize("name", sorted(set(URDFS) - EMPTY))
 def test_every_urdf_loads_and_names_its_repairs(name):
     """Loaded with its options; the warning names every repaired link and nothing else warns; the joints and
-    the total mass are Pinocchio's (its parser reads mimic joints as joints, so tumble too, here)."""
+    the mass of the moving bodies are Pinocchio's (its parser reads mimic joints as joints, so tumble too, here)."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", UrdfRepairWarning)
         tree = _load(name, mimic=False)

@@ -35,6 +35,8 @@ import math
 import os
 import warnings
 from collections.abc import Mapping, Sequence
+from typing import Self
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -143,7 +145,7 @@ class RobotTree(ChainMotion):
                       inertia=inertia, min_inertia=min_inertia)
         return cls(d.links, d.parents, gravity=gravity, name=d.name, frames=d.frames, mimic=d.mimic)._warn_massless()
 
-    def _warn_massless(self) -> RobotTree:
+    def _warn_massless(self) -> Self:
         """This robot, after a :class:`~tumble.robot.urdf.UrdfRepairWarning` naming its :attr:`massless_joints`
         when it has any (the readers of robot files call it)."""
         if self._massless:
