@@ -81,8 +81,8 @@ _INLINE = {**_JIT, "inline": "always"}
 # of a one-link RNEA called from Python 0.43 → 0.22 µs).
 _NO_REFCOUNT = {**_JIT, "_nrt": False}
 # Scratch columns per body: transform (0–11), v (12–17), a or c (18–23), f or I^A (24–59),
-# p^A (60–65), U (66–71), D, u (72, 73), p^a (74–79), ABA's a (80–85); CRBA's composite inertia
-# (m, h, I_O) at 12–24 and I_O Rᵀ at 25–33; world poses at 12–23.
+# p^A or the body momentum I v of centroidal_momentum_one (60–65), U (66–71), D, u (72, 73), p^a (74–79),
+# ABA's a (80–85); CRBA's composite inertia (m, h, I_O) at 12–24 and I_O Rᵀ at 25–33; world poses at 12–23.
 _WIDTH = 86
 
 
