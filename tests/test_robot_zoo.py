@@ -10,8 +10,8 @@ import warnings
 import numpy as np
 import pytest
 
-from robot_oracle import ERD, Pair, close
 import tumble
+from robot_oracle import ERD, Pair, close
 from tumble import ValidationError, robot
 from tumble.robot.urdf import UrdfRepairWarning
 
