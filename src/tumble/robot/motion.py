@@ -103,7 +103,7 @@ class ChainMotion(Model):
 
     @property
     @abc.abstractmethod
-    def massless_joints(self) -> tuple[str | None, ...]: ...
+    def massless_joints(self) -> tuple[str, ...]: ...
 
     @property
     @abc.abstractmethod

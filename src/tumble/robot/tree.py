@@ -193,7 +193,7 @@ class RobotTree(ChainMotion):
         return tuple(self._links[i].name for i in self._coordinate_links)
 
     @property
-    def massless_joints(self) -> tuple[str | None, ...]:
+    def massless_joints(self) -> tuple[str, ...]:
         """Names of the independent joints that move neither mass nor (for a revolute joint) inertia, with their
         mimic joints: M(q) has a zero row and column for each, for every q (empty for a physical robot)."""
         return self._massless
