@@ -1,6 +1,7 @@
 """Speed of tumble.robot's RNEA, CRBA and forward dynamics beside Pinocchio, in one run, from the same URDFs.
 
     PYTHONPATH=src python benchmarks/bench_robot.py [--batch 20000] [--calls 2000] [--repeats 7]
+    PYTHONPATH=src python benchmarks/bench_robot.py --centroidal     # only the centroidal momentum row
 
 Robots: tumble's 6-axis industrial6.urdf and 7-DOF panda.urdf (``tumble.examples``), UR5 and Panda with its
 two fingers (9 DOF; fixed base) and the Talos humanoid and Solo12 quadruped (floating base) from
@@ -16,6 +17,10 @@ scaling; on N threads of a loaded machine the CPU time also counts OpenMP thread
 a descheduled one) and the wall time on N threads. Each figure: min and median over ``--repeats`` repeats
 (≥ 5). Prints the CPU, the cores and the load average first, then the ratios the issue's goals name, and
 last where one ``rnea`` call's time goes (the Python layer, the compiled entry, the sweep inside Numba).
+``--centroidal``: the centroidal momentum that a floating-base ``tumble.simulate`` outputs at every sample,
+Talos, µs per sample (thread CPU, min/median): compiled over a batch of samples, the same as ``A_G(q) q̇`` in
+NumPy (what the output cost before it was compiled), and Pinocchio's ``computeCentroidalMomentum`` and ``aba``
+per call.
 """
 
 from __future__ import annotations
@@ -142,6 +147,34 @@ def anatomy(tree, calls: int, repeats: int) -> str:
             "per joint)")
 
 
+def centroidal(calls: int, repeats: int) -> str:
+    """The ``--centroidal`` row (Talos, floating base, 20 random states)."""
+    from tumble.robot import kinematics
+
+    path = robots()["talos"][0]
+    tree = robot.RobotTree.from_urdf(path, floating_base=True, mimic=False, check_triangle=False)
+    rng = np.random.default_rng(2)
+    Q = np.tile(tree.neutral(), (calls, 1))
+    Q[:, 7:] = rng.uniform(-1.0, 1.0, (calls, tree.dof))
+    QD = rng.uniform(-1.0, 1.0, (calls, tree.nv))
+    compiled = single(lambda: kinematics.centroidal_momentum(tree, Q, QD), 1, repeats)
+    numpy = single(lambda: kinematics.centroidal_momentum_matrix(tree, Q[0]) @ QD[0], max(calls // 100, 1),
+                   repeats)
+    row = (f"talos centroidal momentum, µs per sample: compiled {fmt(tuple(t / calls for t in compiled))}, "
+           f"A_G q̇ in NumPy {fmt(numpy)}")
+    if pin is not None:
+        model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+        data = model.createData()
+        pq, pv, _ = pin_state(model, tree, Q[0], QD[0])
+        hg = pin.computeCentroidalMomentum(model, data, pq, pv)
+        delta = np.abs(np.concatenate([hg.angular, hg.linear]) - kinematics.centroidal_momentum(tree, Q[0], QD[0]))
+        timed = singles({"h": lambda: pin.computeCentroidalMomentum(model, data, pq, pv),
+                         "aba": lambda: pin.aba(model, data, pq, pv, pv)}, calls, repeats)
+        row += (f", pin.computeCentroidalMomentum {fmt(timed['h'])}, pin.aba {fmt(timed['aba'])}; "
+                f"max|Δh| = {delta.max():.1e}")
+    return row
+
+
 def fmt(pair) -> str:
     return f"{pair[0]:5.2f}/{pair[1]:<5.2f}"
 
@@ -159,8 +192,12 @@ def main():
     parser.add_argument("--batch", type=int, default=20000, help="samples per batched call")
     parser.add_argument("--calls", type=int, default=2000, help="single calls per repeat")
     parser.add_argument("--repeats", type=int, default=7, help="repeats (min and median are printed), >= 5")
+    parser.add_argument("--centroidal", action="store_true", help="only the centroidal momentum row (Talos)")
     args = parser.parse_args()
     r, B = args.repeats, args.batch
+    if args.centroidal:
+        print(f"{machine()}\n{centroidal(args.calls, r)}")
+        return
     threads = numba.get_num_threads()
     print(f"{machine()}; {threads} Numba threads")
     print(f"tumble.robot vs {'Pinocchio ' + pin.__version__ if pin else 'no Pinocchio'}; µs per call of one state "

@@ -127,9 +127,10 @@ def test_info_refuses_damaged_and_hostile_files_in_one_line(saved, tmp_path, dam
 
 @pytest.mark.parametrize("name, content, message", [
     ("bad.toml", b"name = \"\xff\"\n", "bad.toml"),
-    ("bad.urdf", b'<robot name="r"><link name="base"/><link name="a"/><joint name="j1" type="revolute">'
-                 b'<parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>',
-     "link 'a' <inertial>: the link moved by joint 'j1' and every link beyond it have no mass"),
+    ("bad.urdf", b'<robot name="r"><link name="base"/><link name="a"><inertial><mass value="1"/><mass value="2"/>'
+                 b'<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><joint name="j1" '
+                 b'type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint></robot>',
+     "link 'a' <inertial>: has 2 <mass> elements; at most one is allowed"),
     ("deep.toml", b"a = " + b"[" * 1000 + b"]" * 1000 + b"\n", "deep.toml"),
 ])
 def test_robot_torques_refuses_bad_robot_files_in_one_line(tmp_path, name, content, message):

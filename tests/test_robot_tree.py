@@ -5,19 +5,16 @@ frame placements, centre of mass and centroidal momentum matrix must agree on 20
 The URDFs come from ``example-robot-data`` (both in the ``test`` extra) and tumble.examples.path("industrial6.urdf").
 """
 
-from importlib import metadata
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 import tumble
+from robot_oracle import ERD, Pair, close
 from tumble import ValidationError, robot
 
 pin = pytest.importorskip("pinocchio")
 
 ROBOTS = tumble.examples.directory() / "robots"
-ERD = Path(metadata.distribution("example-robot-data").locate_file("cmeel.prefix/share/example-robot-data/robots"))
 STATES = 20
 # Two implementations of the same algorithms in float64 agree to rounding: measured worst 3e-13 relative to
 # the largest entry (Talos' mass matrix, ~1e1); the issue's criterion is 1e-10.
@@ -36,81 +33,15 @@ CASES = {  # name: (URDF, floating base, Pinocchio's mimic option)
 }
 
 
-class Pair:
-    """One robot as a tumble RobotTree and a Pinocchio model, with the maps between their coordinates."""
-
-    def __init__(self, name):
-        path, floating, mimic = CASES[name]
-        self.tree = robot.RobotTree.from_urdf(path, floating_base=floating, mimic=mimic, check_triangle=False)
-        root = (pin.JointModelFreeFlyer(),) if floating else ()
-        self.model = pin.buildModelFromUrdf(str(path), *root, mimic=mimic)
-        self.data = self.model.createData()
-        self.floating = floating
-        self.mimic = mimic
-        # Pinocchio's velocity index of each of tumble's joint coordinates, found by joint name
-        index = {self.model.names[j]: self.model.joints[j].idx_v for j in range(1, self.model.njoints)
-                 if self.model.joints[j].nv == 1}
-        self.v_of = np.array([index[n] for n in self.tree.joint_names])
-        assert self.model.nv == self.tree.nv and self.model.nq == self.tree.nq
-
-    def states(self, seed):
-        """(q, v, a) in tumble's coordinates and in Pinocchio's, 20 random states."""
-        rng = np.random.default_rng(seed)
-        out = []
-        for _ in range(STATES):
-            joints = rng.uniform(-np.pi, np.pi, self.tree.dof)
-            base = rng.standard_normal(7) if self.floating else np.zeros(0)
-            if self.floating:
-                base[3:7] /= np.linalg.norm(base[3:7])
-            q = np.concatenate([base, joints])
-            v, a = rng.standard_normal((2, self.tree.nv))
-            out.append((q, v, a))
-        return out
-
-    def to_pin_q(self, q):
-        out = np.zeros(self.model.nq)
-        if self.floating:
-            out[0:3], out[3:6], out[6] = q[0:3], q[4:7], q[3]  # quaternion [x, y, z, w]
-        out[self.v_of + self.floating] = q[7 * self.floating:]
-        return out
-
-    def to_pin_v(self, v):
-        """Tumble's (ω, v_B, joints) as Pinocchio's (v_B, ω, joints); forces likewise (n, f) → (f, n)."""
-        out = np.zeros(self.model.nv)
-        if self.floating:
-            out[0:3], out[3:6] = v[3:6], v[0:3]
-        out[self.v_of] = v[6 * self.floating:]
-        return out
-
-    def from_pin_v(self, x):
-        out = np.zeros(self.tree.nv)
-        if self.floating:
-            out[0:3], out[3:6] = x[3:6], x[0:3]
-        out[6 * self.floating:] = x[self.v_of]
-        return out
-
-    def from_pin_matrix(self, M):
-        """Pinocchio's M (upper triangle filled) in tumble's coordinates."""
-        M = np.triu(M) + np.triu(M, 1).T
-        order = np.concatenate([[3, 4, 5, 0, 1, 2] if self.floating else [], self.v_of]).astype(int)
-        return M[np.ix_(order, order)]
-
-
-def close(actual, expected, tol):
-    """``|actual − expected| ≤ tol · max(1, max |expected|)``: absolute below 1, relative to the scale above."""
-    scale = max(1.0, float(np.abs(expected).max()))
-    np.testing.assert_allclose(actual, expected, rtol=0, atol=tol * scale)
-
-
 @pytest.fixture(scope="module", params=list(CASES))
 def pair(request):
-    return Pair(request.param)
+    return Pair(*CASES[request.param])
 
 
 def test_dynamics_match_pinocchio(pair):
     """RNEA, CRBA and ABA (ABA: Pinocchio has none with mimic joints; tumble's CRBA solve is then compared with
     Pinocchio's M⁻¹(τ − h)) on 20 random states, in one batch per algorithm."""
-    states = pair.states(15)
+    states = pair.states(15, STATES)
     Q, V, A = (np.array([s[k] for s in states]) for k in range(3))
     tau = robot.rnea(pair.tree, Q, V, A)
     M = robot.mass_matrix(pair.tree, Q)
@@ -134,7 +65,7 @@ def test_frames_and_centroidal_quantities_match_pinocchio(pair):
     and Orin's centroidal momentum matrix, on 20 random states."""
     frames = {f.name: k for k, f in enumerate(pair.model.frames) if f.type == pin.FrameType.BODY}
     assert set(pair.tree.frame_names) == set(frames)
-    states = pair.states(16)
+    states = pair.states(16, STATES)
     poses = robot.frame_poses(pair.tree, np.array([s[0] for s in states]))
     for k, (q, v, _) in enumerate(states[:5] if len(pair.tree.links) > 20 else states):
         pq = pair.to_pin_q(q)
@@ -155,7 +86,7 @@ def _cmm(pair, Ag):
 
 def test_identities(pair):
     """M from RNEA columns = CRBA; RNEA = M q̈ + RNEA(q, q̇, 0); gravity = RNEA(q, 0, 0)."""
-    q, v, a = pair.states(17)[0]
+    q, v, a = pair.states(17, 1)[0]
     tree = pair.tree
     h = robot.rnea(tree, q, v, np.zeros(tree.nv))
     g = robot.rnea(tree, q, np.zeros(tree.nv), np.zeros(tree.nv))
@@ -204,6 +135,13 @@ def test_frame_jacobian_is_the_derivative_of_the_frame_pose():
     np.testing.assert_allclose((J @ v)[3:], d[:3, 3], atol=1e-8)
 
 
+_TWO_LINKS = ('<robot name="r"><link name="a"/><link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" '
+              'ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><link name="c"><inertial><mass value="1"/>'
+              '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><link name="d"/>'
+              '<joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>'
+              '<joint name="f" type="fixed"><parent link="a"/><child link="d"/></joint>'
+              '<joint name="k" type="revolute"><parent link="b"/><child link="c"/>{mimic}</joint></robot>')
+
 BAD = [
     ('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="revolute"><parent link="a"/>'
      '<child link="b"/></joint><joint name="k" type="revolute"><parent link="b"/><child link="a"/></joint></robot>',
@@ -223,7 +161,17 @@ BAD = [
      'ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link><joint name="j" type="revolute">'
      '<parent link="a"/><child link="b"/></joint><joint name="k" type="revolute"><parent link="b"/>'
      '<child link="c"/><mimic joint="nope"/></joint></robot>',
-     r"joint 'k' <mimic>: joint='nope' must name a moving joint"),
+     r"^joint 'k' <mimic>: joint='nope' names no joint of the robot \(mimic=False reads the <mimic> joints as "
+     r"independent joints"),
+    (_TWO_LINKS.format(mimic='<mimic joint="f"/>'), r"^joint 'k' <mimic>: joint='f' names a 'fixed' joint; a mimic "
+                                                    r"joint copies a moving joint$"),
+    (_TWO_LINKS.format(mimic='<mimic joint="k"/>'), r"^joint 'k' <mimic>: joint='k' names a mimic joint; a mimic "
+                                                    r"joint copies an independent joint$"),
+    ('<robot name="r"/>', r"^URDF: <robot> has no <link> element; a robot needs at least one link$"),
+    ('<robot name="r"><link name="a"/><link name="b"/><link name="c"/><joint name="j" type="revolute">'
+     '<parent link="b"/><child link="c"/></joint><joint name="k" type="revolute"><parent link="c"/>'
+     '<child link="b"/></joint></robot>',
+     r"^link 'b': not reached from the root link 'a' \(the joints close a loop\)$"),
 ]
 
 
@@ -231,3 +179,15 @@ BAD = [
 def test_bad_trees_are_refused_naming_the_element_and_the_rule(text, message):
     with pytest.raises(ValidationError, match=message):
         robot.RobotTree.from_urdf(text)
+
+
+def test_centroidal_momentum_matches_pinocchio(pair):
+    """The compiled ``h_G = (k_G, l)``, batched (what a floating-base simulate outputs at every sample), against
+    Pinocchio's computeCentroidalMomentum on 20 random states."""
+    states = pair.states(18, STATES)
+    h = robot.centroidal_momentum(pair.tree, np.array([s[0] for s in states]), np.array([s[1] for s in states]))
+    assert h.shape == (STATES, 6)
+    for k, (q, v, _) in enumerate(states):
+        expected = pin.computeCentroidalMomentum(pair.model, pair.data, pair.to_pin_q(q), pair.to_pin_v(v))
+        close(h[k], np.concatenate([expected.angular, expected.linear]), ORACLE_TOL)
+        np.testing.assert_array_equal(robot.centroidal_momentum(pair.tree, q, v), h[k])

@@ -114,6 +114,20 @@ BAD = [
      r"no revolute, continuous or prismatic joint"),
     ('<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;">]><robot name="&b;"/>',
      r"URDF: refused unsafe XML"),
+    # an element read once, given twice: which one counts would be a guess (a second <mass> was taken silently)
+    (urdf(link("base") + link("a", 1.0).replace('<mass value="1.0"/>', '<mass value="1.0"/><mass value="2"/>')
+          + joint("j1", "base", "a")),
+     r"^link 'a' <inertial>: has 2 <mass> elements; at most one is allowed$"),
+    (urdf(link("base") + link("a", 1.0).replace("</inertial>", '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+                                                              'izz="1"/></inertial>') + joint("j1", "base", "a")),
+     r"^link 'a' <inertial>: has 2 <inertia> elements; at most one is allowed$"),
+    (urdf(link("base") + link("a", 1.0) + joint("j1", "base", "a", extra='<axis xyz="1 0 0"/>')),
+     r"^joint 'j1': has 2 <axis> elements; at most one is allowed$"),
+    (urdf(link("base") + link("a", 1.0) + joint("j1", "base", "a", extra='<origin xyz="1 0 0"/>')),
+     r"^joint 'j1': has 2 <origin> elements; at most one is allowed$"),
+    (urdf(link("base") + link("a", 1.0, inertia=(1, 2, 0, 1, 0, 1)) + joint("j1", "base", "a")),
+     r"^link 'a' <inertial> <inertia>: must be positive semi-definite \(principal moments \[-1\.0.*\] kg m\^2\); "
+     r"inertia='clip' sets its negative principal moments to zero$"),
 ]
 
 
@@ -197,3 +211,99 @@ def test_urdf_arm_matches_pinocchio():
                                atol=PEER_TOL)
     np.testing.assert_allclose(robot.forward_dynamics(chain, Q, QD, QDD, f_ext=W)[1], PEER["aba_wrench"], rtol=0,
                                atol=PEER_TOL)
+
+
+def test_a_huge_axis_is_the_direction_it_points_in():
+    """``<axis xyz="1e200 1e200 0">`` is the axis (1, 1, 0)/√2 (its norm overflowed: a zero axis, τ = 0)."""
+    def chain(axis):
+        return robot.SerialChain.from_urdf(urdf(link("base") + link("a", 1.0, xyz="0.3 0 0.2")
+                                                + joint("j1", "base", "a", axis=axis)))
+    q, qd, qdd = [0.4], [0.7], [1.3]
+    tau = robot.rnea(chain("1e200 1e200 0"), q, qd, qdd)
+    assert abs(tau[0]) > 0.1
+    np.testing.assert_array_equal(tau, robot.rnea(chain("1 1 0"), q, qd, qdd))
+
+
+def test_a_chain_of_1500_links_loads_and_holds_its_weight():
+    """The tree is walked without recursion (1500 links hit RecursionError). A horizontal chain of 1 kg points
+    0.1 m apart, joints about y: joint i (0-based) carries the n − i points at 0, 0.1, …, 0.1 (n − i − 1) m from
+    its axis; their weight turns it about +y, so it holds τᵢ = −0.1 g (n − i)(n − i − 1)/2."""
+    n, g = 1500, 9.81
+    inertia = '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
+    links = "".join(f'<link name="l{i}"><inertial><mass value="1"/>{inertia}</inertial></link>' for i in range(n + 1))
+    joints = "".join(joint(f"j{i}", f"l{i}", f"l{i + 1}", xyz="0.1 0 0", axis="0 1 0") for i in range(n))
+    chain = robot.SerialChain.from_urdf(urdf(links + joints), check_triangle=False)
+    assert chain.dof == n
+    remaining = n - np.arange(n)
+    np.testing.assert_allclose(robot.gravity_torques(chain, np.zeros(n)), -0.1 * g * remaining * (remaining - 1) / 2,
+                               rtol=1e-12)
+
+
+def test_round_off_inertia_is_clipped_and_named():
+    """iCub's l_ankle_2: zero but for ixz = 1.35525e-20 (principal moments ±1.36e-20), within 1e-14 × the robot's
+    largest entry: set to zero, with a warning naming the link and the rule; the same tensor in a robot whose
+    largest entry is 1e-6 kg m^2 is not round-off, and refused."""
+    ankle = link("ankle", 0.2675, inertia=(0, 0, 1.35525e-20, 0, 0, 0))
+    doc = urdf(link("base") + link("a", 1.0) + ankle + joint("j1", "base", "a") + joint("j2", "a", "ankle"))
+    with pytest.warns(robot.UrdfRepairWarning, match=r"link 'ankle' <inertial> <inertia>: principal moment "
+                                                     r"-1\.35525e-20 kg m\^2 set to 0 by round-off, at most 1e-14 x "
+                                                     r"the robot's largest entry 0\.3 kg m\^2$"):
+        chain = robot.SerialChain.from_urdf(doc, check_triangle=False)
+    half = 1.35525e-20 / 2  # the positive moment 1.35525e-20 kept on its axis (x + z)/√2
+    np.testing.assert_allclose(chain.links[1].inertia, [[half, 0, half], [0, 0, 0], [half, 0, half]], rtol=1e-14)
+    small = doc.replace('ixx="0.1" ixy="0.0" ixz="0.0" iyy="0.2" iyz="0.0" izz="0.3"',
+                        'ixx="1e-7" ixy="0.0" ixz="0.0" iyy="2e-7" iyz="0.0" izz="1e-6"')
+    with pytest.raises(ValidationError, match=r"^link 'ankle' <inertial> <inertia>: must be positive semi-definite"):
+        robot.SerialChain.from_urdf(small, check_triangle=False)
+
+
+def test_clip_makes_the_nearest_semidefinite_tensor_and_names_it():
+    """``inertia="clip"``: the moments (−1, 1, 3) of a tensor become (0, 1, 3) about the same axes, the nearest
+    positive semi-definite tensor (Frobenius norm), with a warning naming the link."""
+    axes = Rotation.from_euler("xyz", [0.3, -0.2, 0.5]).as_matrix()
+    tensor = axes @ np.diag([-1.0, 1.0, 3.0]) @ axes.T
+    values = (tensor[0, 0], tensor[0, 1], tensor[0, 2], tensor[1, 1], tensor[1, 2], tensor[2, 2])
+    doc = urdf(link("base") + link("a", 1.0, inertia=tuple(repr(float(v)) for v in values)) + joint("j1", "base", "a"))
+    with pytest.warns(robot.UrdfRepairWarning, match=r"^URDF: non-physical inertia repaired: link 'a' <inertial> "
+                                                     r"<inertia>: principal moment -1 kg m\^2 set to 0 by "
+                                                     r"inertia='clip'$"):
+        chain = robot.SerialChain.from_urdf(doc, inertia="clip", check_triangle=False)
+    np.testing.assert_allclose(chain.links[0].inertia, axes @ np.diag([0.0, 1.0, 3.0]) @ axes.T, rtol=0, atol=4e-15)
+    with pytest.raises(ValidationError, match=r"^inertia: must be one of \('check', 'clip'\), got 'fix'$"):
+        robot.SerialChain.from_urdf(doc, inertia="fix")
+
+
+def test_massless_last_link_loads_but_does_not_move():
+    """A last link without <inertial>: M(q) = 0, named at load (a warning) and by simulate (was refused at load,
+    and before that a NaN run); min_inertia gives it a least principal moment, and it then turns under a torque
+    as I θ̈ = τ."""
+    doc = urdf(link("base") + link("a") + joint("j1", "base", "a"))
+    with pytest.warns(robot.UrdfRepairWarning, match=r"^test: joint\(s\) \['j1'\] move no mass or inertia"):
+        chain = robot.SerialChain.from_urdf(doc)
+    assert chain.massless_joints == ("j1",)
+    np.testing.assert_array_equal(robot.mass_matrix(chain, [0.3]), [[0.0]])
+    with pytest.raises(ValidationError, match=r"^model: joint\(s\) \['j1'\] move no mass or inertia, so M\(q\) is "
+                                              r"singular and the motion undefined \(load the URDF with min_inertia"):
+        tumble.simulate(chain, q0=[0.0], t=[0.0, 0.1], method="rk4", dt=0.1)
+    regular = robot.SerialChain.from_urdf(doc, min_inertia=1e-3)
+    assert regular.massless_joints == ()
+    np.testing.assert_allclose(robot.forward_dynamics(regular, [0.3], [0.0], [2e-3]), [2.0], rtol=1e-14)
+    with pytest.raises(ValidationError, match=r"^min_inertia: must be a finite number >= 0, got -1\.0$"):
+        robot.SerialChain.from_urdf(doc, min_inertia=-1)
+
+
+def test_the_cli_prints_the_torque_about_a_huge_axis(tmp_path):
+    """``tumble robot torques`` on ``<axis xyz="1e200 1e200 0">``: the torque about (1, 1, 0)/√2, not 0."""
+    from typer.testing import CliRunner
+
+    from tumble.robot.cli import app
+
+    body = link("base") + link("a", 1.0, xyz="0.3 0 0.2") + joint("j1", "base", "a", axis="{axis}")
+    taus = []
+    for axis in ("1e200 1e200 0", "1 1 0"):
+        path = tmp_path / "arm.urdf"
+        path.write_text(urdf(body.replace("{axis}", axis)))
+        result = CliRunner().invoke(app, ["torques", str(path), "--q", "0.4", "--qdd", "1.3"])
+        assert result.exit_code == 0, result.output
+        taus.append(float(result.stdout.split("tau =")[1].split()[0]))
+    assert taus[0] == taus[1] and abs(taus[0]) > 0.1

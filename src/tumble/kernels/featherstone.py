@@ -81,8 +81,8 @@ _INLINE = {**_JIT, "inline": "always"}
 # of a one-link RNEA called from Python 0.43 → 0.22 µs).
 _NO_REFCOUNT = {**_JIT, "_nrt": False}
 # Scratch columns per body: transform (0–11), v (12–17), a or c (18–23), f or I^A (24–59),
-# p^A (60–65), U (66–71), D, u (72, 73), p^a (74–79), ABA's a (80–85); CRBA's composite inertia
-# (m, h, I_O) at 12–24 and I_O Rᵀ at 25–33; world poses at 12–23.
+# p^A or the body momentum I v of centroidal_momentum_one (60–65), U (66–71), D, u (72, 73), p^a (74–79),
+# ABA's a (80–85); CRBA's composite inertia (m, h, I_O) at 12–24 and I_O Rᵀ at 25–33; world poses at 12–23.
 _WIDTH = 86
 
 
@@ -781,6 +781,45 @@ def energy_batch(P, Q, QD, g, OUT):
     W = scratch(P.shape[0])
     for b in range(Q.shape[0]):
         OUT[b, 0], OUT[b, 1] = energy_one(P, Q[b], QD[b], g, W)
+
+
+@njit(**_JIT)
+def centroidal_momentum_one(P, q, qd, W, out):
+    """``out = (k_G, l)``: the angular momentum about the centre of mass and the linear momentum, world axes.
+
+    Each body's spatial momentum about its origin, body axes, is ``(n, f) = I v = (I_O ω + h × v, m v −
+    h × ω)``; in the world ``f_W = R f``, and about the world origin ``n_W = R n + p × f_W``. Summed: ``l = Σ
+    f_W``, ``k_O = Σ n_W``, and with the centre of mass ``c = Σ (m p + R h) / Σ m``, ``k_G = k_O − c × l``
+    (N·m·s, N·s; Orin, Goswami & Lee, Auton. Robots 35, 2013, eq. 1).
+    """
+    nb = P.shape[0]
+    rnea_one(P, q, qd, np.zeros(qd.shape[0]), np.zeros(3), np.zeros(6), W, np.empty(qd.shape[0]))
+    for i in range(nb):  # the body velocities are at W[:, 12:18]; their momenta go to W[:, 60:66]
+        h = _inertia_times(P, i, W[i, 12], W[i, 13], W[i, 14], W[i, 15], W[i, 16], W[i, 17])
+        for k in range(6):
+            W[i, 60 + k] = h[k]
+    world_poses(P, q, W)  # R at W[:, 12:21], p at W[:, 21:24]
+    kx = ky = kz = lx = ly = lz = cx = cy = cz = mass = 0.0  # k_O, l, Σ (m p + R h)
+    for i in range(nb):
+        nx, ny, nz = _rot(W, i, 12, W[i, 60], W[i, 61], W[i, 62])
+        fx, fy, fz = _rot(W, i, 12, W[i, 63], W[i, 64], W[i, 65])
+        hx, hy, hz = _rot(W, i, 12, P[i, 18], P[i, 19], P[i, 20])
+        ax, ay, az = cross(W[i, 21], W[i, 22], W[i, 23], fx, fy, fz)
+        kx, ky, kz = kx + nx + ax, ky + ny + ay, kz + nz + az
+        lx, ly, lz = lx + fx, ly + fy, lz + fz
+        m = P[i, 17]
+        cx, cy, cz = cx + m * W[i, 21] + hx, cy + m * W[i, 22] + hy, cz + m * W[i, 23] + hz
+        mass += m
+    bx, by, bz = cross(cx / mass, cy / mass, cz / mass, lx, ly, lz)
+    out[0], out[1], out[2], out[3], out[4], out[5] = kx - bx, ky - by, kz - bz, lx, ly, lz
+
+
+@njit(**_JIT)
+def centroidal_momentum_batch(P, Q, QD, OUT):
+    """``OUT[b] = (k_G, l)`` of sample b (serial: the output samples of a run)."""
+    W = scratch(P.shape[0])
+    for b in range(Q.shape[0]):
+        centroidal_momentum_one(P, Q[b], QD[b], W, OUT[b])
 
 
 @njit(**_JIT)

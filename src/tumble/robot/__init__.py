@@ -44,6 +44,7 @@ from tumble.robot.kinematics import (
 from tumble.robot.link import Frame, Link
 from tumble.robot.space import space_manipulator
 from tumble.robot.tree import RobotTree
+from tumble.robot.urdf import UrdfRepairWarning
 
 if TYPE_CHECKING:
     import numpy as np
@@ -52,7 +53,7 @@ if TYPE_CHECKING:
     from tumble.trajectory import Trajectory
 
 __all__ = [
-    "Link", "Frame", "RobotTree", "SerialChain", "load", "space_manipulator",
+    "Link", "Frame", "RobotTree", "SerialChain", "load", "space_manipulator", "UrdfRepairWarning",
     "frame_poses", "frame_pose", "frame_jacobian", "center_of_mass", "centroidal_momentum_matrix",
     "centroidal_momentum",
     "rnea", "gravity_torques", "coriolis", "mass_matrix", "forward_dynamics",

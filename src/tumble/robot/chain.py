@@ -144,14 +144,15 @@ class SerialChain(RobotTree):
 
     @classmethod
     def from_urdf(  # type: ignore[override]  # a chain has no floating base and no mimic joints to ask for
-            cls, source: str | os.PathLike[str], *, check_triangle: bool = True,
-            gravity: ArrayLike = DEFAULT_GRAVITY) -> SerialChain:
+            cls, source: str | os.PathLike[str], *, check_triangle: bool = True, inertia: str = "check",
+            min_inertia: float = 0.0, gravity: ArrayLike = DEFAULT_GRAVITY) -> SerialChain:
         """A chain from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         Refused when the URDF describes a tree or has mimic joints (use :meth:`RobotTree.from_urdf`)."""
-        description = read_urdf(source, check_triangle=check_triangle)
+        description = read_urdf(source, check_triangle=check_triangle, inertia=inertia, min_inertia=min_inertia)
         description.require_serial()
-        return cls(description.links, gravity=gravity, name=description.name, frames=description.frames)
+        return cls(description.links, gravity=gravity, name=description.name,
+                   frames=description.frames)._warn_massless()
 
     def with_gravity(self, gravity: ArrayLike) -> SerialChain:
         """The same chain under the gravitational acceleration ``gravity`` (3,), m/s², base frame.
@@ -170,12 +171,13 @@ class SerialChain(RobotTree):
 _TOML_KEYS = {"name", "convention", "gravity", "check_triangle", "source", "link"}
 
 
-def load(path: str | os.PathLike[str]) -> RobotTree:
+def load(path: str | os.PathLike[str], *, inertia: str = "check", min_inertia: float = 0.0) -> RobotTree:
     """A robot from a robot file: a DH table in TOML (``.toml``) or a URDF (``.urdf``, ``.xml``).
 
     A URDF gives a :class:`SerialChain` when it describes a serial chain
     without mimic joints, else a :class:`~tumble.robot.RobotTree`
-    (:func:`tumble.robot.urdf.read_urdf`).
+    (:func:`tumble.robot.urdf.read_urdf`, which ``inertia`` and
+    ``min_inertia`` are passed to).
 
     The TOML file holds ``convention`` (``"standard"`` or ``"modified"``),
     optional ``name``, ``gravity``, ``check_triangle`` and ``source`` (a
@@ -184,10 +186,10 @@ def load(path: str | os.PathLike[str]) -> RobotTree:
     """
     path = Path(path)
     if path.suffix.lower() in (".urdf", ".xml"):
-        d = read_urdf(path)
+        d = read_urdf(path, inertia=inertia, min_inertia=min_inertia)
         if d.serial:
-            return SerialChain(d.links, name=d.name, frames=d.frames)
-        return RobotTree(d.links, d.parents, name=d.name, frames=d.frames, mimic=d.mimic)
+            return SerialChain(d.links, name=d.name, frames=d.frames)._warn_massless()
+        return RobotTree(d.links, d.parents, name=d.name, frames=d.frames, mimic=d.mimic)._warn_massless()
     if path.suffix.lower() != ".toml":
         raise ValidationError(f"robot file: must end in .toml (DH table) or .urdf/.xml, got {path.name!r}")
     try:

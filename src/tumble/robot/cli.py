@@ -1,15 +1,18 @@
 """``tumble robot``: joint torques of a serial chain from the command line.
 
     tumble robot torques ROBOT_FILE --q "0.1, 0.2, ..." [--qd ...] [--qdd ...] [--gravity "0,0,-9.81"]
-                         [--mass-matrix]
+                         [--mass-matrix] [--inertia clip] [--min-inertia 1e-6]
 
 ``ROBOT_FILE`` is a DH table (``.toml``) or a URDF (``.urdf``); see
 ``docs/robot.md``. Exit codes as the ``tumble`` command: 0 success, 2 bad
-input (one line on stderr naming the field and the rule).
+input (one line on stderr naming the field and the rule). A repair of a
+URDF's data (:class:`tumble.robot.UrdfRepairWarning`) is one ``warning:``
+line on stderr.
 """
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -20,6 +23,7 @@ from tumble._cli_errors import exit_codes
 from tumble._validate import ValidationError
 from tumble.robot.chain import load
 from tumble.robot.dynamics import mass_matrix, rnea
+from tumble.robot.urdf import UrdfRepairWarning
 
 __all__ = ["app"]
 
@@ -54,13 +58,22 @@ def torques(
     gravity: Annotated[str | None, typer.Option("--gravity", help="m/s², base frame (default: the file's, "
                                                 "else 0,0,-9.81).")] = None,
     show_mass_matrix: Annotated[bool, typer.Option("--mass-matrix", help="Also print M(q).")] = False,
+    inertia: Annotated[str, typer.Option("--inertia", help="URDF link inertias that are not positive "
+                                         "semi-definite: 'check' refuses them (round-off is repaired), 'clip' sets "
+                                         "their negative principal moments to zero.")] = "check",
+    min_inertia: Annotated[float, typer.Option("--min-inertia", help="Least principal moment of every moving URDF "
+                                               "link, kg m^2 (default 0).")] = 0.0,
 ) -> None:
     """Print the joint torques ``τ = M(q) q̈ + C(q, q̇) q̇ + g(q)`` (recursive Newton–Euler)."""
     with exit_codes(robot_file):
         try:
-            chain = load(robot_file)
+            with warnings.catch_warnings(record=True) as repairs:
+                warnings.simplefilter("always", UrdfRepairWarning)
+                chain = load(robot_file, inertia=inertia, min_inertia=min_inertia)
         except OSError as exc:
             raise ValidationError(f"{robot_file}: cannot be read ({exc})") from None
+        for repair in repairs:
+            typer.echo(f"warning: {repair.message}", err=True)
         n = chain.dof
         state = _vector(q, "q", n), _vector(qd, "qd", n), _vector(qdd, "qdd", n)
         g = None if gravity is None else _vector(gravity, "gravity", 3)

@@ -244,7 +244,9 @@ def forward_dynamics(model: RobotTree, q: ArrayLike, qd: ArrayLike, tau: ArrayLi
         _kernels.aba_batch(model._params, q, qd, tau, g, f, qdd, _chunks(len(q)))
         ok = bool(np.isfinite(qdd).all())
     if not ok:
-        _explain("forward_dynamics", _SINGULAR, q=q, qd=qd, tau=tau, gravity=g, f_ext=f)
+        cause = f"joint(s) {list(model.massless_joints)} move no mass or inertia: M(q) is singular" \
+            if model.massless_joints else _SINGULAR
+        _explain("forward_dynamics", cause, q=q, qd=qd, tau=tau, gravity=g, f_ext=f)
     return qdd
 
 

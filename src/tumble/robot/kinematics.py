@@ -6,7 +6,8 @@ Frames and conventions: :mod:`tumble.robot.tree`. All results are in world
 Featherstone (2008) and the rest of :mod:`tumble.robot`. Computed in NumPy
 from the body poses of the compiled forward kinematics
 (:func:`tumble.kernels.featherstone.body_poses_batch`): these functions are
-for analysis, not hot loops.
+for analysis, not hot loops; :func:`centroidal_momentum`, which a
+floating-base simulation evaluates at every output sample, is compiled.
 
 * :func:`frame_poses`: ``T_WF`` (4, 4) of every named frame.
 * :func:`frame_jacobian`: ``J`` (6, nv) with ``(ω_F, v_F) = J q̇`` in world
@@ -172,8 +173,12 @@ def centroidal_momentum_matrix(model: RobotTree, q: ArrayLike) -> np.ndarray:
 
 
 def centroidal_momentum(model: RobotTree, q: ArrayLike, qd: ArrayLike) -> np.ndarray:
-    """``h_G = (k_G, l) = A_G(q) q̇`` (6,): angular momentum about the centre of mass and linear momentum,
-    world axes (N·m·s, N·s); one state."""
+    """``h_G = (k_G, l) = A_G(q) q̇`` (6,) or (B, 6): angular momentum about the centre of mass and linear
+    momentum, world axes (N·m·s, N·s); one state (nq,), (nv,) or a batch (B, ·). Compiled, summed body by
+    body (:func:`tumble.kernels.featherstone.centroidal_momentum_one`) without forming ``A_G``."""
     q = _joints(model, q, "q", model._nq)
     qd = _like(model, q, qd, "qd")
-    return centroidal_momentum_matrix(model, q) @ qd
+    h = np.empty((*q.shape[:-1], 6))
+    _kernels.centroidal_momentum_batch(model._params, q.reshape(-1, model._nq), qd.reshape(-1, model._nv),
+                                       h.reshape(-1, 6))
+    return h

@@ -85,10 +85,12 @@ class Link:
         if self.joint not in JOINT_TYPES:
             raise ValidationError(f"{where}.joint: must be one of {JOINT_TYPES}, got {self.joint!r}")
         axis = as_shape(self.axis, f"{where}.axis", (3,))
-        norm = float(np.linalg.norm(axis))
-        if norm < _MIN_AXIS_NORM:
+        # scaled before squaring: the norm of (1e200, 1e200, 0) overflowed to inf and the axis became zero
+        largest = float(np.abs(axis).max())
+        scaled = axis / largest if largest > 0.0 else axis
+        if largest * float(np.linalg.norm(scaled)) < _MIN_AXIS_NORM:
             raise ValidationError(f"{where}.axis: must be a non-zero vector, got {axis.tolist()}")
-        set_(self, "axis", frozen(axis / norm))
+        set_(self, "axis", frozen(scaled / np.linalg.norm(scaled)))
         for field in ("origin", "frame"):
             set_(self, f"{field}_position", frozen(as_shape(getattr(self, f"{field}_position"),
                                                               f"{where}.{field}_position", (3,))))

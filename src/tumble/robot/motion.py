@@ -24,15 +24,15 @@ extra ``beyond_limits`` says, per sample, whether a joint has left its range.
 
 :class:`ChainMotion` implements the model interface for
 :class:`tumble.robot.RobotTree`, which provides ``nq``, ``nv``, ``dof``,
-``joint_names``, ``name``, the limits and the compiled arrays ``_params`` and
-``_gravity``.
+``joint_names``, ``massless_joints``, ``name``, the limits and the compiled
+arrays ``_params`` and ``_gravity``.
 """
 
 from __future__ import annotations
 
 import abc
 from collections.abc import Callable
-from typing import TYPE_CHECKING, cast
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -45,7 +45,6 @@ from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra
 
 if TYPE_CHECKING:
-    from tumble.robot.tree import RobotTree
     from tumble.trajectory import Trajectory
 
 __all__ = ["ChainMotion"]
@@ -104,6 +103,10 @@ class ChainMotion(Model):
 
     @property
     @abc.abstractmethod
+    def massless_joints(self) -> tuple[str, ...]: ...
+
+    @property
+    @abc.abstractmethod
     def lower(self) -> np.ndarray: ...
 
     @property
@@ -116,7 +119,8 @@ class ChainMotion(Model):
         n = self.dof
         joints = (
             StateField("q0", n, f"initial joint coordinates, the joint vector ({n},), not a quaternion: rad "
-                                "(revolute) or m (prismatic), base to tip"),
+                                "(revolute) or m (prismatic), base to tip",
+                       default=np.zeros(0) if n == 0 else None),  # a single free body has no joint
             StateField("qd0", n, f"initial joint rates ({n},), rad/s or m/s (default 0: released at rest)",
                        default=np.zeros(n)),
         )
@@ -136,6 +140,10 @@ class ChainMotion(Model):
 
     def compile(self, torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None,
                 t0: float) -> _kernel.RobotModel:
+        if self.massless_joints:
+            raise ValidationError(f"model: joint(s) {list(self.massless_joints)} move no mass or inertia, so M(q) "
+                                  "is singular and the motion undefined (load the URDF with min_inertia > 0 to give "
+                                  "the links a least inertia)")
         law, slot, constant = self._torque_law(torque)
         return _kernel.RobotModel(params=self._params, sizes=np.array([self.nq, self.nv], dtype=np.int64),
                                   gravity=self._gravity, law=np.array([law, slot], dtype=np.int64),
@@ -197,12 +205,11 @@ class ChainMotion(Model):
                        totals={"energy": energies[..., 0] + energies[..., 1]}, info=info)
 
     def _base_extras(self, q, qd) -> dict:
-        """The floating base's motion and the centroidal momentum (world axes) at every sample."""
-        from tumble.robot.kinematics import centroidal_momentum
-
-        tree = cast("RobotTree", self)  # the model interface of RobotTree, its one subclass
-        flat_q, flat_qd = q.reshape(-1, self.nq), qd.reshape(-1, self.nv)
-        h = np.array([centroidal_momentum(tree, a, b) for a, b in zip(flat_q, flat_qd)]).reshape(*q.shape[:-1], 6)
+        """The floating base's motion and the centroidal momentum (world axes) at every sample (compiled:
+        :func:`tumble.kernels.featherstone.centroidal_momentum_batch`)."""
+        h = np.empty((*q.shape[:-1], 6))
+        _featherstone.centroidal_momentum_batch(self._params, q.reshape(-1, self.nq), qd.reshape(-1, self.nv),
+                                                h.reshape(-1, 6))
         vector = ("xyz",)
         return {
             "base_position": Extra(q[..., 0:3], vector, "m", "origin of the floating base, world frame"),

@@ -33,7 +33,10 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Mapping, Sequence
+from typing import Self
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -42,7 +45,7 @@ from tumble._validate import ValidationError, as_array
 from tumble.kernels import featherstone as _kernels
 from tumble.robot.link import Frame, Link
 from tumble.robot.motion import ChainMotion
-from tumble.robot.urdf import read_urdf
+from tumble.robot.urdf import UrdfRepairWarning, read_urdf
 
 __all__ = ["Frame", "RobotTree", "DEFAULT_GRAVITY"]
 
@@ -65,7 +68,8 @@ class RobotTree(ChainMotion):
     """
 
     __slots__ = ("_links", "_parents", "_gravity", "_name", "_frames", "_mimic", "_params", "_lower", "_upper",
-                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links", "_workspace")
+                 "_no_wrench", "_no_wrenches", "_nq", "_nv", "_floating", "_coordinate_links", "_workspace",
+                 "_massless")
     _links: tuple[Link, ...]
     _parents: tuple[int, ...]
     _gravity: np.ndarray  # (3,) m/s², world frame
@@ -82,6 +86,7 @@ class RobotTree(ChainMotion):
     _floating: bool
     _coordinate_links: tuple[int, ...]  # the links of the independent joint coordinates
     _workspace: np.ndarray  # scratch of the single-state entries (tumble.robot.dynamics)
+    _massless: tuple[str, ...]  # the joints that move neither mass nor inertia
 
     def __init__(self, links: Sequence[Link], parents: Sequence[int], *, gravity: ArrayLike = DEFAULT_GRAVITY,
                  name: str | None = None, frames: Sequence[Frame] = (), mimic: Mapping | None = None) -> None:
@@ -115,6 +120,7 @@ class RobotTree(ChainMotion):
         set_(self, "_params", _pack(links, parents, coordinate, multiplier, offset))
         independent = [i for i in range(len(links)) if i not in mimic and not (floating and i == 0)]
         set_(self, "_coordinate_links", tuple(independent))
+        set_(self, "_massless", _massless_joints(links, parents, coordinate, mimic))
         set_(self, "_lower", frozen([links[i].lower for i in independent]))
         set_(self, "_upper", frozen([links[i].upper for i in independent]))
         set_(self, "_no_wrench", np.zeros(6))
@@ -128,13 +134,26 @@ class RobotTree(ChainMotion):
 
     @classmethod
     def from_urdf(cls, source: str | os.PathLike[str], *, floating_base: bool = False, mimic: bool = True,
-                  check_triangle: bool = True, gravity: ArrayLike = DEFAULT_GRAVITY) -> RobotTree:
+                  check_triangle: bool = True, inertia: str = "check", min_inertia: float = 0.0,
+                  gravity: ArrayLike = DEFAULT_GRAVITY) -> RobotTree:
         """A tree from a URDF file (path) or document (a string starting with ``<``); see :mod:`.urdf`.
 
         ``floating_base=True`` makes the root link a free body (configuration ``[r, quat, joints]``);
-        ``mimic=False`` reads ``<mimic>`` joints as independent joints."""
-        d = read_urdf(source, check_triangle=check_triangle, floating_base=floating_base, mimic=mimic)
-        return cls(d.links, d.parents, gravity=gravity, name=d.name, frames=d.frames, mimic=d.mimic)
+        ``mimic=False`` reads ``<mimic>`` joints as independent joints; ``inertia="clip"`` and
+        ``min_inertia`` (kg·m²) repair non-physical link inertias (:func:`tumble.robot.urdf.read_urdf`)."""
+        d = read_urdf(source, check_triangle=check_triangle, floating_base=floating_base, mimic=mimic,
+                      inertia=inertia, min_inertia=min_inertia)
+        return cls(d.links, d.parents, gravity=gravity, name=d.name, frames=d.frames, mimic=d.mimic)._warn_massless()
+
+    def _warn_massless(self) -> Self:
+        """This robot, after a :class:`~tumble.robot.urdf.UrdfRepairWarning` naming its :attr:`massless_joints`
+        when it has any (the readers of robot files call it)."""
+        if self._massless:
+            warnings.warn(f"{self._name or 'robot'}: joint(s) {list(self._massless)} move no mass or inertia: "
+                          "M(q) is singular, so forward dynamics and simulate refuse this robot (torques, gravity "
+                          "torques and M(q) are defined; min_inertia gives the links a least inertia)",
+                          UrdfRepairWarning, stacklevel=3)
+        return self
 
     # -- data -----------------------------------------------------------------
 
@@ -172,6 +191,12 @@ class RobotTree(ChainMotion):
     def joint_names(self) -> tuple[str | None, ...]:
         """Names of the independent joints (one per joint coordinate)."""
         return tuple(self._links[i].name for i in self._coordinate_links)
+
+    @property
+    def massless_joints(self) -> tuple[str, ...]:
+        """Names of the independent joints that move neither mass nor (for a revolute joint) inertia, with their
+        mimic joints: M(q) has a zero row and column for each, for every q (empty for a physical robot)."""
+        return self._massless
 
     @property
     def joint_types(self) -> tuple[str, ...]:
@@ -292,6 +317,24 @@ def _coordinates(links, mimic: dict, floating: bool):
             raise ValidationError(f"{where}: multiplier and offset must be finite, got {k} and {o}")
         coordinate[i], multiplier[i], offset[i] = coordinate[j], k, offset[i] + o
     return coordinate, multiplier, offset
+
+
+def _massless_joints(links, parents, coordinate, mimic) -> tuple[str, ...]:
+    """The names of the independent joints whose coordinate moves nothing: every link it turns or slides (its own
+    and its mimic joints' subtrees) has no mass and, for a revolute joint, no inertia, so that ``Mᵢᵢ(q) = 0``."""
+    mass = [link.mass for link in links]
+    inertia = [bool(link.inertia.any()) for link in links]
+    for i in range(len(links) - 1, 0, -1):
+        if parents[i] >= 0:
+            mass[parents[i]] += mass[i]
+            inertia[parents[i]] = inertia[parents[i]] or inertia[i]
+    moves: dict[int, bool] = {}
+    for i, link in enumerate(links):
+        if link.joint != "floating":
+            moving = mass[i] > 0.0 or (link.joint == "revolute" and inertia[i])
+            moves[coordinate[i]] = moves.get(coordinate[i], False) or moving
+    return tuple(str(link.name if link.name is not None else f"links[{i}]") for i, link in enumerate(links)
+                 if link.joint != "floating" and i not in mimic and not moves[coordinate[i]])
 
 
 def _axis_frame(axis) -> np.ndarray:
