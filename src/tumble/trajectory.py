@@ -32,23 +32,17 @@ described in ``docs/trajectory.md``.
 
 from __future__ import annotations
 
-import contextlib
 import datetime
-import glob
 import operator
 import os
-import signal
-import stat
-import tempfile
-import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
 
-import filelock
 import numpy as np
 
+from ._files import require_regular, write_atomic
 from ._validate import ValidationError, as_array
 from .attitude import rotate
 from .dynamics import angular_momentum, kinetic_energy
@@ -549,8 +543,13 @@ class Trajectory:
         interrupted save leaves any previous file at ``path`` untouched. Read it
         back with :func:`tumble.load`.
         """
-        ds = self.to_xarray()
-        write_atomic(path, lambda tmp_path: ds.to_netcdf(tmp_path, engine=_ENGINE))
+        write_atomic(path, self._write_netcdf)
+
+    def _write_netcdf(self, path: str) -> None:
+        """Write the NetCDF-4 file to ``path`` in place, not atomically: the writer that :meth:`save` hands
+        to :func:`write_atomic`, and that a command writing several files hands to
+        :func:`tumble._files.write_atomic_all`."""
+        self.to_xarray().to_netcdf(path, engine=_ENGINE)
 
     # -- viewer ------------------------------------------------------------------------
 
@@ -683,8 +682,7 @@ def load(path: str | os.PathLike) -> Trajectory:
     from ._inertia import principal_axes
     from ._validate import require_memory
 
-    if not stat.S_ISREG(os.stat(path).st_mode):
-        raise ValidationError(f"{os.fspath(path)}: not a regular file")
+    require_regular(path)
     try:
         with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False, phony_dims="access") as lazy:
             nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
@@ -710,102 +708,3 @@ def load(path: str | os.PathLike) -> Trajectory:
         except ValidationError as exc:
             raise ValidationError(f"{os.fspath(path)}: {exc}") from None
     return traj
-
-
-def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
-    """Write a file atomically: ``write(tmp_path)`` fills a temporary file, renamed onto ``path``.
-
-    The temporary file (suffix ``.tmp``) is made in the directory of ``path``,
-    so :func:`os.replace` is an atomic rename: readers see either the old file
-    or the complete new one, never a partial file. On any exception, including
-    ``KeyboardInterrupt`` (SIGINT) and SIGTERM (turned into ``SystemExit(143)``
-    while the write runs, in the main thread), the temporary file is removed, a
-    pre-existing ``path`` is left untouched, and the exception propagates. The
-    new file gets the permissions of the file it replaces, or the default
-    ``0o666 & ~umask``.
-
-    One writer at a time: a writer holds an exclusive lock on the sibling
-    ``.NAME.lock`` (:class:`filelock.FileLock`: ``flock`` on POSIX,
-    ``msvcrt.locking`` on Windows; removed when it is done; the operating system
-    releases the lock of a killed process), and a second writer to the same path is refused
-    at once with :class:`FileExistsError` naming it (it neither waits nor
-    silently wins). Holding the lock, a writer removes the ``.NAME.*.tmp``
-    siblings left by killed runs (``kill -9``): no live writer owns them.
-
-    ``write`` must not infer the format from the file name, which ends in
-    ``.tmp``: e.g. ``write_atomic("fig.png", lambda p: fig.savefig(p, format="png"))``.
-
-    Raises ``FileNotFoundError`` if the directory of ``path`` does not exist.
-    """
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise FileNotFoundError(f"path: directory {directory!r} does not exist (writing {path!r})")
-    name = os.path.basename(path)
-    with _exclusive(os.path.join(directory, f".{name}.lock"), path), _terminate_as_exit():
-        for stale in glob.glob(os.path.join(glob.escape(directory), f".{glob.escape(name)}.*.tmp")):
-            with contextlib.suppress(FileNotFoundError):
-                os.remove(stale)
-        with tempfile.NamedTemporaryFile(dir=directory, prefix=f".{name}.", suffix=".tmp", delete=False) as tmp:
-            tmp_path = tmp.name
-        try:
-            write(tmp_path)
-            _set_mode(tmp_path, path)
-            fd = os.open(tmp_path, os.O_RDWR)
-            try:
-                os.fsync(fd)  # the data reach the disk before the rename makes them visible
-            finally:
-                os.close(fd)
-            os.replace(tmp_path, path)
-        except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                os.remove(tmp_path)
-            raise
-
-
-@contextlib.contextmanager
-def _exclusive(lock_path: str, path: str):
-    """Hold an exclusive lock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
-    lock = filelock.FileLock(lock_path, timeout=0, is_singleton=False)
-    try:
-        lock.acquire()
-    except filelock.Timeout:
-        raise FileExistsError(f"{path}: another process is writing it now (it holds {lock_path}); wait for it "
-                              "to finish, or write elsewhere") from None
-    try:
-        yield
-    finally:
-        with contextlib.suppress(FileNotFoundError, PermissionError):  # Windows: a new holder has it open
-            os.remove(lock_path)
-        lock.release()
-
-
-@contextlib.contextmanager
-def _terminate_as_exit():
-    """While the block runs in the main thread, SIGTERM raises ``SystemExit(143)`` (so cleanups run)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def exit_(signum, frame):
-        raise SystemExit(128 + signal.SIGTERM)
-
-    previous = signal.signal(signal.SIGTERM, exit_)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
-
-
-def _set_mode(tmp_path: str, path: str) -> None:
-    """Give ``tmp_path`` the permissions of ``path``, or those a plain ``open`` would give.
-
-    ``NamedTemporaryFile`` creates files readable by their owner only (0o600).
-    """
-    try:
-        mode = stat.S_IMODE(os.stat(path).st_mode)
-    except FileNotFoundError:
-        umask = os.umask(0)  # the umask can only be read by setting it
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    os.chmod(tmp_path, mode)
