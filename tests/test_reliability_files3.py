@@ -9,6 +9,7 @@ refuse a damaged or edited file by name. Symbolic links, FIFOs and device nodes 
 
 import contextlib
 import os
+import re
 import stat
 import subprocess
 from pathlib import Path
@@ -17,7 +18,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from tumble._files import read_input, write_atomic, write_atomic_all
+from tumble._files import MAX_INPUT_BYTES, read_input, write_atomic, write_atomic_all
 from tumble._validate import ValidationError
 from tumble.cli import app
 
@@ -180,3 +181,57 @@ def test_a_read_only_file_system_is_named_not_taken_for_another_writer(tmp_path,
         assert_one_line_error(invoke("run", scenario, "-o", ro / "out.nc"),
                               f"--output: cannot write in directory {str(ro)!r} (read-only file system)")
         assert list(ro.iterdir()) == []
+
+
+# -- 6. one reader for every input document: a regular file of bounded size ---------------------------
+
+
+def _special(path: Path, node: str, tmp_path: Path) -> None:
+    """Make ``path`` a FIFO (no writer: a reader would wait for ever), or a symbolic link to a sparse
+    regular file one byte past the bound (no disk used) or to a character device (``/dev/zero``'s numbers,
+    a node of our own in tmp_path; root only)."""
+    if node == "fifo":
+        os.mkfifo(path)
+    elif node == "too large":
+        big = tmp_path / "big"
+        with open(big, "wb") as fh:
+            fh.truncate(MAX_INPUT_BYTES + 1)
+        path.symlink_to(big)
+    else:
+        if os.geteuid() != 0:
+            pytest.skip("making a device node needs root")
+        os.mknod(tmp_path / "zero", stat.S_IFCHR | 0o600, os.makedev(1, 5))
+        path.symlink_to(tmp_path / "zero")
+
+
+RULES = {"fifo": "not a regular file (a FIFO)", "too large": f"larger than {MAX_INPUT_BYTES} bytes",
+         "device": "not a regular file (a character device)"}
+
+
+@pytest.mark.parametrize("node", list(RULES))
+def test_scenario_and_robot_files_are_refused_unless_regular_and_bounded(tmp_path, node):
+    for name, args in [("s.toml", ("run", "{}", "-o", tmp_path / "out.nc")),
+                       ("arm.toml", ("robot", "torques", "{}", "--q", "0")),
+                       ("arm.urdf", ("robot", "torques", "{}", "--q", "0"))]:
+        path = tmp_path / name
+        (tmp_path / name.replace(".", "_")).mkdir()
+        _special(path, node, tmp_path / name.replace(".", "_"))
+        assert_one_line_error(invoke(*(str(path) if a == "{}" else a for a in args)), f"{path}: {RULES[node]}")
+    assert not (tmp_path / "out.nc").exists()
+
+
+@pytest.mark.parametrize("node", list(RULES))
+def test_ins_csv_tables_are_refused_unless_regular_and_bounded(tmp_path, node):
+    from tumble.ins import read_csv
+
+    _special(tmp_path / "imu.csv", node, tmp_path)
+    with pytest.raises(ValidationError, match=re.escape(f"imu.csv: {RULES[node]}")):
+        read_csv(tmp_path / "imu.csv")
+
+
+def test_read_input_reads_a_regular_file_through_a_symbolic_link(tmp_path):
+    (tmp_path / "a.toml").write_bytes(b"x = 1\n")
+    (tmp_path / "link.toml").symlink_to(tmp_path / "a.toml")
+    assert read_input(tmp_path / "link.toml") == b"x = 1\n"
+    with pytest.raises(ValidationError, match="larger than 5 bytes"):
+        read_input(tmp_path / "link.toml", limit=5)
