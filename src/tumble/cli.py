@@ -538,14 +538,20 @@ def _racket_figure(traj: Trajectory, body: RigidBody, flips: np.ndarray):
 
 
 def _drift(drift: np.ndarray, initial: np.ndarray) -> str:
-    """Largest |relative change|, or "n/a" where the initial value is 0 (the drift is then absolute)."""
-    return "n/a" if np.any(initial == 0.0) else f"{np.max(np.abs(drift)):.3g}"
+    """Largest |relative change|, or "n/a" where the initial value is 0 (the drift is then absolute) or there
+    is no body (an empty batch)."""
+    return "n/a" if drift.size == 0 or np.any(initial == 0.0) else f"{np.max(np.abs(drift)):.3g}"
+
+
+def _setting(value: float | int | str) -> str:
+    """A solver setting as printed: a number in ``%g``, a string as it is."""
+    return value if isinstance(value, str) else f"{value:g}"
 
 
 def _summary(traj: Trajectory) -> list[tuple[str, str]]:
     """Rows: output times, method and its settings, the largest relative change of the energy, |L| and L_I
     (the energy alone for a model without an attitude, e.g. a robot arm)."""
-    options = ", ".join(f"{key} {traj.info[key]:g}" for key in ("rtol", "atol", "dt") if key in traj.info)
+    options = ", ".join(f"{key} {_setting(traj.info[key])}" for key in ("rtol", "atol", "dt") if key in traj.info)
     steps = f", {traj.info['n_steps']} steps" if "n_steps" in traj.info else ""
     torque = traj.info.get("torque", "none")
     drift = f"energy {_drift(traj.energy_drift, traj.energy[0])}"

@@ -672,39 +672,104 @@ def load(path: str | os.PathLike) -> Trajectory:
 
     Refused with a :class:`ValidationError` naming the file: a path that is not a regular file (a FIFO, a
     device: reading it could block for ever), variables larger than the memory can hold (checked from the
-    header, before reading them), any file the NetCDF/HDF5 readers cannot read, and contents that break the
-    rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤`` :data:`UNIT_Q_TOL`, and an
-    inertia tensor that is symmetric, positive semi-definite and meets the triangle inequality
-    (:func:`tumble._inertia.principal_axes`). A missing or unreadable path raises :class:`OSError`.
+    header, before reading them), any file the NetCDF/HDF5 readers cannot read, variables that do not hold
+    real numbers (complex, strings), units other than those :meth:`save` writes (``time`` excepted: any unit
+    of time, read in seconds, see :func:`_time_in_seconds`), extras that are not finite, and contents that
+    break the rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤``
+    :data:`UNIT_Q_TOL`, an inertia tensor that is symmetric, positive semi-definite and meets the triangle
+    inequality (:func:`tumble._inertia.principal_axes`), and an energy and angular momentum within float64's
+    range. A missing or unreadable path raises :class:`OSError`.
     """
-    import xarray as xr
-
-    from ._inertia import principal_axes
-    from ._validate import require_memory
-
+    name = os.fspath(path)
     require_regular(path)
     try:
-        with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False, phony_dims="access") as lazy:
-            nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
-            require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
-            ds = lazy.load()
         with np.errstate(all="ignore"):
-            traj = Trajectory.from_xarray(ds)
+            traj = Trajectory.from_xarray(_checked_dataset(_read_dataset(path)))
+            _check_physics(traj)
     except ValidationError as exc:  # the file named first; the field's own error stays as the cause
-        raise ValidationError(f"{os.fspath(path)}: {exc}") from exc
-    except (OSError, MemoryError):
+        raise ValidationError(f"{name}: {exc}") from exc
+    except MemoryError:
         raise
     except Exception as exc:  # noqa: BLE001 - a hostile file may make h5py/xarray raise anything
-        raise ValidationError(f"{os.fspath(path)}: not a readable tumble trajectory "
-                              f"({type(exc).__name__}: {exc})") from None
+        if isinstance(exc, OSError) and exc.errno is not None:  # the system's own error (permission, I/O)
+            raise
+        raise ValidationError(f"{name}: not a readable tumble trajectory ({type(exc).__name__}: {exc})") from None
+    return traj
+
+
+def _read_dataset(path: str | os.PathLike) -> xarray.Dataset:
+    """The variables of the NetCDF file ``path``, loaded once their size is known to fit in memory; times
+    left as the numbers stored (their units are read by :func:`_time_in_seconds`)."""
+    import xarray as xr
+
+    from ._validate import require_memory
+
+    with xr.open_dataset(path, engine=_ENGINE, decode_times=False, decode_timedelta=False,
+                         phony_dims="access") as lazy:
+        nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
+        require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
+        return lazy.load()
+
+
+#: The units :meth:`Trajectory.to_xarray` writes; a file that says other units for them is refused.
+_UNITS = {"q": "1", "omega": "rad/s", "inertia": "kg m2", "energy": "J", "momentum_body": "N m s",
+          "momentum_inertial": "N m s"}
+#: Seconds per unit of time, by the UDUNITS names a NetCDF file may give (``time:units``).
+_SECONDS = {**dict.fromkeys(("s", "sec", "secs", "second", "seconds"), 1.0),
+            **dict.fromkeys(("ms", "msec", "millisecond", "milliseconds"), 1e-3),
+            **dict.fromkeys(("us", "microsecond", "microseconds"), 1e-6),
+            **dict.fromkeys(("min", "minute", "minutes"), 60.0),
+            **dict.fromkeys(("h", "hr", "hour", "hours"), 3600.0),
+            **dict.fromkeys(("d", "day", "days"), 86400.0)}
+_LABELS = {"axis", "axis2", "component"}  # the coordinates of names (x, y, z; w, x, y, z)
+
+
+def _checked_dataset(ds: xarray.Dataset) -> xarray.Dataset:
+    """``ds`` with its times in seconds, once every variable holds real numbers (no complex part to drop,
+    no strings), tumble's own variables say tumble's units, and every extra is finite."""
+    from ._validate import require_finite
+
+    for name, var in ds.variables.items():
+        if name in _LABELS:
+            continue
+        if var.dtype.kind not in "fiu":
+            raise ValidationError(f"{name}: must hold real numbers, got {var.dtype} values")
+        units = var.attrs.get("units")
+        if name in _UNITS and units is not None and str(units) != _UNITS[name]:
+            raise ValidationError(f"{name}: units must be {_UNITS[name]!r} (as tumble writes them), got {units!r}")
+        if var.attrs.get(_EXTRA_ATTR) == 1:
+            require_finite(var.values, str(name))
+    if "time" not in ds.variables:
+        return ds
+    return ds.assign_coords(time=("time", _time_in_seconds(ds["time"]), ds["time"].attrs))
+
+
+def _time_in_seconds(time: xarray.DataArray) -> np.ndarray:
+    """The output times in seconds: the stored numbers times the seconds of their ``units`` (``"s"`` when
+    absent); CF's ``"UNIT since EPOCH"`` gives the times from the epoch (the origin of a trajectory's times
+    is its own). Units that are not a unit of time are refused."""
+    units = str(time.attrs.get("units", "s"))
+    unit = units.partition(" since ")[0].strip()
+    if unit not in _SECONDS:
+        raise ValidationError(f"time: units must be a unit of time ({', '.join(sorted(set(_SECONDS)))}, "
+                              f"optionally 'UNIT since EPOCH'), got {units!r}")
+    seconds = np.asarray(time.values, dtype=np.float64)
+    return seconds if _SECONDS[unit] == 1.0 else seconds * _SECONDS[unit]
+
+
+def _check_physics(traj: Trajectory) -> None:
+    """Refuse what a run cannot make: ``||q| − 1| >`` :data:`UNIT_Q_TOL`, an inertia that is not physical,
+    an energy or angular momentum past float64's range."""
+    from ._inertia import principal_axes
+    from ._validate import require_finite
+
     if traj.q is not None:
         error = np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0)
         if error.max(initial=0.0) > UNIT_Q_TOL:
             k = tuple(int(i) for i in np.unravel_index(np.argmax(error), error.shape))
-            raise ValidationError(f"{os.fspath(path)}: q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
+            raise ValidationError(f"q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
                                   f"|q{list(k)}| = {np.linalg.norm(traj.q[k]):.17g}")
-        try:
-            principal_axes(traj.inertia, "inertia", definite=False)
-        except ValidationError as exc:
-            raise ValidationError(f"{os.fspath(path)}: {exc}") from None
-    return traj
+        principal_axes(traj.inertia, "inertia", definite=False)
+    require_finite(traj.energy, "energy")
+    if traj.q is not None or "momentum_body" in traj.totals:
+        require_finite(traj.momentum_body, "momentum_body")
