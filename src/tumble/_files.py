@@ -157,7 +157,7 @@ def write_atomic_all(writes: Sequence[tuple[str | os.PathLike, Callable[[str], N
         try:
             for path, write in targets:
                 temporaries.append(_new_temporary(path))
-                write(temporaries[-1])
+                _write_naming(path, write, temporaries[-1])
                 _set_mode(temporaries[-1], path)
                 _sync(temporaries[-1])  # the data reach the disk before the rename makes them visible
             for tmp_path, (path, _) in zip(temporaries, targets, strict=True):
@@ -167,6 +167,17 @@ def write_atomic_all(writes: Sequence[tuple[str | os.PathLike, Callable[[str], N
                 with contextlib.suppress(FileNotFoundError):
                     os.remove(tmp_path)
             raise
+
+
+def _write_naming(path: str, write: Callable[[str], None], tmp_path: str) -> None:
+    """``write(tmp_path)``; an :class:`OSError` that names no file (a full disk: ``ENOSPC``) is raised again
+    naming ``path``."""
+    try:
+        write(tmp_path)
+    except OSError as exc:
+        if exc.filename is not None or exc.errno is None:
+            raise
+        raise type(exc)(exc.errno, exc.strerror, path) from None
 
 
 def _temporary_pattern(name: str) -> re.Pattern:

@@ -548,8 +548,18 @@ class Trajectory:
     def _write_netcdf(self, path: str) -> None:
         """Write the NetCDF-4 file to ``path`` in place, not atomically: the writer that :meth:`save` hands
         to :func:`write_atomic`, and that a command writing several files hands to
-        :func:`tumble._files.write_atomic_all`."""
-        self.to_xarray().to_netcdf(path, engine=_ENGINE)
+        :func:`tumble._files.write_atomic_all`. Every numeric variable carries HDF5's Fletcher-32 checksum,
+        verified on each read, so that a damaged byte of the data is refused, not read as another number.
+
+        The file is made in memory and written with plain file I/O, so that a full disk is one
+        :class:`OSError` (``ENOSPC``): HDF5 writing to the disk itself left its file open after the error,
+        and the process died of SIGSEGV when the garbage collector closed it.
+        """
+        ds = self.to_xarray()
+        checksums = {name: {"fletcher32": True} for name, var in ds.variables.items() if var.dtype.kind in "fiu"}
+        contents = ds.to_netcdf(engine=_ENGINE, encoding=checksums)
+        with open(path, "wb") as fh:
+            fh.write(contents)
 
     # -- viewer ------------------------------------------------------------------------
 
@@ -700,10 +710,16 @@ def load(path: str | os.PathLike) -> Trajectory:
 def _read_dataset(path: str | os.PathLike) -> xarray.Dataset:
     """The variables of the NetCDF file ``path``, loaded once their size is known to fit in memory; times
     left as the numbers stored (their units are read by :func:`_time_in_seconds`)."""
+    import h5py
     import xarray as xr
 
     from ._validate import require_memory
 
+    # Every object's header and attributes read first, in a file that is closed on any error: h5netcdf leaves
+    # a file it fails to open to the garbage collector, which prints "Exception ignored ..." tracebacks.
+    with h5py.File(path, "r") as f:
+        dict(f.attrs)
+        f.visititems(lambda name, obj: dict(obj.attrs))
     with xr.open_dataset(path, engine=_ENGINE, decode_times=False, decode_timedelta=False,
                          phony_dims="access") as lazy:
         nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
