@@ -12,15 +12,20 @@ import os
 import re
 import stat
 import subprocess
+import sys
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
+import xarray as xr
 from typer.testing import CliRunner
 
+import tumble
 from tumble._files import MAX_INPUT_BYTES, read_input, write_atomic, write_atomic_all
 from tumble._validate import ValidationError
 from tumble.cli import app
+from tumble.trajectory import Extra, Trajectory
 
 runner = CliRunner()
 
@@ -235,3 +240,146 @@ def test_read_input_reads_a_regular_file_through_a_symbolic_link(tmp_path):
     assert read_input(tmp_path / "link.toml") == b"x = 1\n"
     with pytest.raises(ValidationError, match="larger than 5 bytes"):
         read_input(tmp_path / "link.toml", limit=5)
+
+
+# -- 5. a full disk ------------------------------------------------------------------------------------
+
+
+def test_a_full_disk_is_one_error_line_and_the_old_results_stay(tmp_path):
+    with tmpfs(tmp_path / "small", "size=64k") as small:
+        scenario = small / "s.toml"  # 2001 samples: a NetCDF file of some 300 kB, past the 64 kB
+        scenario.write_text(SCENARIO.replace("samples = 3", "samples = 2001").replace("dt = 0.5", "dt = 0.0005"))
+        out = small / "out.nc"
+        out.write_text("old results")
+        env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+        done = subprocess.run([sys.executable, "-m", "tumble", "run", str(scenario), "-o", str(out)],
+                              capture_output=True, text=True, env=env, timeout=300)
+        assert (done.returncode, done.stdout) == (2, ""), done.stderr  # it died of SIGSEGV (-11)
+        assert done.stderr == f"error: [Errno 28] No space left on device: {str(out)!r}\n"
+        assert listing(small) == {"s.toml": scenario.read_bytes(), "out.nc": b"old results"}
+
+
+# -- 9, 10, 11. result files: honest readings, named refusals -----------------------------------------
+
+
+@pytest.fixture(scope="module")
+def result(tmp_path_factory):
+    """A real saved result: 5 samples of rk4 on a torque-free RigidBody, and a vector extra."""
+    body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+    run = tumble.simulate(body, [0.1, 1.0, 0.1], t=np.linspace(0.0, 1.0, 5), method="rk4", dt=0.25)
+    traj = Trajectory(run.t, run.q, run.omega, run.inertia, run.method, run.info,
+                      {"wheel_speed": Extra(np.arange(10.0).reshape(5, 2), ("wheel",), "rad/s", "wheel rates")},
+                      model="RigidBody")
+    path = tmp_path_factory.mktemp("result") / "run.nc"
+    traj.save(path)
+    return path, traj
+
+
+def _edited(saved: Path, path: Path, change) -> None:
+    """``saved`` read with xarray (times as stored), changed by ``change(ds)``, written to ``path``."""
+    ds = change(xr.load_dataset(saved, engine="h5netcdf", decode_times=False))
+    ds.to_netcdf(path, engine="h5netcdf")
+
+
+def _flipped(saved: Path, path: Path, variable: str | None) -> None:
+    """``saved`` with one bit changed: in the first chunk of ``variable``'s data, or in the HDF5 signature."""
+    offset = 0
+    if variable is not None:
+        with h5py.File(saved) as f:
+            offset = f[variable].id.get_chunk_info(0).byte_offset + 3
+    raw = bytearray(saved.read_bytes())
+    raw[offset] ^= 0x10
+    path.write_bytes(bytes(raw))
+
+
+def _units(name, units):
+    def change(ds):
+        ds[name].attrs["units"] = units
+        return ds
+    return change
+
+
+UNREADABLE = "not a readable tumble trajectory"
+DAMAGES = {
+    "empty": (lambda saved, path: path.write_bytes(b""), UNREADABLE),
+    "truncated to 100 bytes": (lambda saved, path: path.write_bytes(saved.read_bytes()[:100]), UNREADABLE),
+    "half of it": (lambda saved, path: path.write_bytes(saved.read_bytes()[:saved.stat().st_size // 2]),
+                   UNREADABLE),
+    "last byte cut": (lambda saved, path: path.write_bytes(saved.read_bytes()[:-1]), UNREADABLE),
+    "signature bit": (lambda saved, path: _flipped(saved, path, None), UNREADABLE),
+    **{f"bit of {name}": ((lambda name: lambda saved, path: _flipped(saved, path, name))(name),
+                          "filter returned failure during read")  # the Fletcher-32 checksum
+       for name in ("time", "q", "omega", "inertia", "wheel_speed")},
+    **{f"{name} deleted": ((lambda name: lambda saved, path: _edited(saved, path, lambda ds: ds.drop_vars(name)))(name),
+                           f"not a tumble trajectory (missing {name})") for name in ("time", "q", "omega", "inertia")},
+    "q on 4 times of another dimension": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(
+        q=ds.q.isel(time=slice(0, 4)).rename(time="t2"))), "Dimensions {'time'} do not exist"),
+    "omega's axis renamed": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(
+        omega=ds.omega.rename(axis="ax"))), "ax: must hold real numbers, got <U1 values"),
+    "omega as strings": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(omega=ds.omega.astype(str))),
+                         "omega: must hold real numbers, got <U"),
+    "omega complex": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(omega=ds.omega * (1 + 1e-3j))),
+                      "omega: must hold real numbers, got complex128 values"),
+    "omega in deg/s": (lambda saved, path: _edited(saved, path, _units("omega", "deg/s")),
+                       "omega: units must be 'rad/s' (as tumble writes them), got 'deg/s'"),
+    "time in furlongs": (lambda saved, path: _edited(saved, path, _units("time", "furlongs")),
+                         "time: units must be a unit of time"),
+    "extra NaN": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(wheel_speed=ds.wheel_speed * np.nan)),
+                  "wheel_speed: must be finite (found nan at index (0, 0))"),
+    "extra inf": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(wheel_speed=ds.wheel_speed / 0.0)),
+                  "wheel_speed: must be finite (found nan at index (0, 0))"),
+    "times out of order": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign_coords(
+        time=ds.time.values[[0, 2, 1, 3, 4]])), "t: must be strictly increasing or strictly decreasing"),
+    "component labels twice": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign_coords(
+        component=["w", "w", "y", "z"])), "InvalidIndexError"),
+    "rates of 1e160 rad/s": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign(omega=ds.omega * 1e160)),
+                             "energy: must be finite (found inf at index 0)"),
+    "solver setting an array": (lambda saved, path: _edited(saved, path, lambda ds: ds.assign_attrs(
+        solver_dt=np.array([0.25, 0.5]))), "info['dt']: must be a float, an int or a string, got ndarray"),
+}
+
+
+@pytest.mark.parametrize("damage", list(DAMAGES))
+def test_a_damaged_result_is_refused_by_name_by_load_info_and_view(result, tmp_path, damage):
+    saved, _ = result
+    make, message = DAMAGES[damage]
+    path = tmp_path / "bad.nc"
+    make(saved, path)
+    with pytest.raises(ValidationError, match=re.escape(message)) as refusal:
+        tumble.load(path)
+    assert str(refusal.value).startswith(f"{path}: ")
+    assert_one_line_error(invoke("info", path), f"{path}: ")
+    assert_one_line_error(invoke("view", path, "-o", tmp_path / "bad.html"), f"traj: {str(path)!r} is not")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.nc"]
+
+
+@pytest.mark.parametrize("units, seconds", [("s", 1.0), ("seconds since 2000-01-01 00:00:00", 1.0),
+                                            ("ms", 1e-3), ("hours", 3600.0)])
+def test_time_is_read_in_seconds_from_its_units(result, tmp_path, units, seconds):
+    saved, traj = result
+    _edited(saved, tmp_path / "t.nc", _units("time", units))
+    back = tumble.load(tmp_path / "t.nc")
+    np.testing.assert_array_equal(back.t, traj.t * seconds)  # 0, 0.25, ... s: exact in binary
+    np.testing.assert_array_equal(back.omega, traj.omega)
+
+
+def test_a_saved_result_reads_back_bit_for_bit_with_its_checksums(result):
+    saved, traj = result
+    back = tumble.load(saved)
+    for name in ("t", "q", "omega", "inertia", "wheel_speed"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(traj, name))
+    with h5py.File(saved) as f:
+        assert all(f[name].fletcher32 for name in ("time", "q", "omega", "inertia", "wheel_speed"))
+
+
+def test_info_prints_files_tumble_writes_an_empty_batch_and_a_string_setting(tmp_path):
+    body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+    tumble.simulate(body, np.zeros((0, 3)), t=[0.0, 0.5, 1.0], method="rk4", dt=0.5).save(tmp_path / "empty.nc")
+    result = invoke("info", tmp_path / "empty.nc")
+    assert result.exit_code == 0, result.stderr
+    assert "bodies    0 (batch)" in result.stdout and "drift     energy n/a, |L| n/a, L_I n/a" in result.stdout
+    run = tumble.simulate(body, [0.1, 1.0, 0.1], t=[0.0, 0.5, 1.0], method="rk4", dt=0.5)
+    Trajectory(run.t, run.q, run.omega, run.inertia, "rk4", {"dt": "half a second"}).save(tmp_path / "s.nc")
+    result = invoke("info", tmp_path / "s.nc")
+    assert result.exit_code == 0, result.stderr
+    assert "method    rk4 (dt half a second)" in result.stdout
