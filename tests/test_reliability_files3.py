@@ -26,6 +26,7 @@ from tumble._files import MAX_INPUT_BYTES, read_input, write_atomic, write_atomi
 from tumble._validate import ValidationError
 from tumble.cli import app
 from tumble.trajectory import Extra, Trajectory
+from tumble.viewer._frames import MAX_FRAMES, check_budget
 
 runner = CliRunner()
 
@@ -383,3 +384,15 @@ def test_info_prints_files_tumble_writes_an_empty_batch_and_a_string_setting(tmp
     result = invoke("info", tmp_path / "s.nc")
     assert result.exit_code == 0, result.stderr
     assert "method    rk4 (dt half a second)" in result.stdout
+
+
+# -- 7. the viewer's frame budget is bounded ----------------------------------------------------------
+
+
+def test_view_refuses_a_frame_budget_past_the_bound(result, tmp_path):
+    saved, _ = result
+    assert check_budget(MAX_FRAMES) == MAX_FRAMES == 100_000
+    assert_one_line_error(invoke("view", saved, "-o", tmp_path / "v.html", "--frames", MAX_FRAMES + 1),
+                          f"frames: must be at most 100000 (a page of about 80 MB; a browser animates no more), "
+                          f"got {MAX_FRAMES + 1}")
+    assert list(tmp_path.iterdir()) == []

@@ -398,7 +398,7 @@ def view(
         "--scenario", help="The scenario file of the run: its model draws what a trajectory alone cannot tell "
                            "(a robot's links, a spacecraft's wheels and thrusters).")] = None,
     frames: Annotated[int, typer.Option("--frames", help="Frame budget: at most this many samples are shown "
-                                                         "(>= 2).")] = 600,
+                                                         "(2 to 100000).")] = 600,
     axis: Annotated[str | None, typer.Option("--axis", help="Body axis whose trace on the unit sphere is drawn: "
                                                             "x, y or z (default: the one along omega(0)).")] = None,
 ) -> None:
@@ -406,7 +406,8 @@ def view(
 
     The body (the uniform box of its principal moments), its axes, omega and L as arrows, the trace of a body
     axis, the model's parts, the body rates beside it; play/pause, speed and a time slider (docs/viewer.md).
-    Bad input (not a tumble trajectory, an empty one, --frames < 2) exits with code 2 and writes nothing.
+    Bad input (not a tumble trajectory, an empty one, --frames < 2 or > 100000) exits with code 2 and writes
+    nothing.
     """
     from tumble.viewer import write_html
 
