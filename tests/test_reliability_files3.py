@@ -219,9 +219,9 @@ def test_scenario_and_robot_files_are_refused_unless_regular_and_bounded(tmp_pat
     for name, args in [("s.toml", ("run", "{}", "-o", tmp_path / "out.nc")),
                        ("arm.toml", ("robot", "torques", "{}", "--q", "0")),
                        ("arm.urdf", ("robot", "torques", "{}", "--q", "0"))]:
-        path = tmp_path / name
-        (tmp_path / name.replace(".", "_")).mkdir()
-        _special(path, node, tmp_path / name.replace(".", "_"))
+        path, beside = tmp_path / name, tmp_path / name.replace(".", "_")  # beside: its big file or device node
+        beside.mkdir()
+        _special(path, node, beside)
         assert_one_line_error(invoke(*(str(path) if a == "{}" else a for a in args)), f"{path}: {RULES[node]}")
     assert not (tmp_path / "out.nc").exists()
 
