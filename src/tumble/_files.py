@@ -39,6 +39,7 @@ def _kind(mode: int) -> str:
 
 
 def _require_regular_mode(name: str, mode: int) -> None:
+    """Refuse, naming ``name``, a file of mode ``mode`` that is not a regular file, saying what it is."""
     if not stat.S_ISREG(mode):
         raise ValidationError(f"{name}: not a regular file ({_kind(mode)}); give the path of a file")
 
@@ -208,6 +209,7 @@ def _remove_stale(directory: str, name: str) -> None:
 
 
 def _sync(path: str) -> None:
+    """Flush the file ``path`` to the disk (``fsync``)."""
     fd = os.open(path, os.O_RDWR)
     try:
         os.fsync(fd)
