@@ -515,7 +515,10 @@ def _png(figure, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:
 
 def _text(text: str) -> Callable[[str], None]:
     """A writer of ``text`` (UTF-8) for :func:`~tumble._files.write_atomic_all`."""
-    return lambda tmp_path: Path(tmp_path).write_text(text, encoding="utf-8")
+    def write(tmp_path: str) -> None:
+        Path(tmp_path).write_text(text, encoding="utf-8")
+
+    return write
 
 
 def _racket_figure(traj: Trajectory, body: RigidBody, flips: np.ndarray):
