@@ -396,3 +396,10 @@ def test_view_refuses_a_frame_budget_past_the_bound(result, tmp_path):
                           f"frames: must be at most 100000 (a page of about 80 MB; a browser animates no more), "
                           f"got {MAX_FRAMES + 1}")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_demo_top_checks_its_three_files_before_it_runs(tmp_path):
+    os.mkfifo(tmp_path / "top.png")
+    assert_one_line_error(invoke("demo", "top", "-o", tmp_path),
+                          f"--output: {str(tmp_path / 'top.png')!r} is a FIFO")
+    assert listing(tmp_path) == {"top.png": stat.S_IFIFO}

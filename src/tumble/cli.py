@@ -233,6 +233,7 @@ def top(
         require_positive(duration, "--duration")
         if not output.is_dir():
             raise ValidationError(f"--output: {str(output)!r} is not an existing directory")
+        _check_outputs([("--output", output / name) for name in ("top.nc", "top.png", "top.html")])
         summary = demo_top(output, duration=duration)
     _print_rows([
         ("nutation", f"theta from {summary['theta_min_deg']:.6g} to {summary['theta_max_deg']:.6g} deg (exact), "
