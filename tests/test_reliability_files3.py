@@ -246,6 +246,7 @@ def test_read_input_reads_a_regular_file_through_a_symbolic_link(tmp_path):
 # -- 5. a full disk ------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # a fresh process importing tumble: some 10 s on 2 busy cores
 def test_a_full_disk_is_one_error_line_and_the_old_results_stay(tmp_path):
     with tmpfs(tmp_path / "small", "size=64k") as small:
         scenario = small / "s.toml"  # 2001 samples: a NetCDF file of some 300 kB, past the 64 kB
