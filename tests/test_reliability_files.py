@@ -14,12 +14,14 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 
 
 def test_stale_temporary_siblings_of_killed_runs_are_removed(tmp_path):
-    stale = [tmp_path / ".out.txt.k2j3.tmp", tmp_path / ".out.txt.x9.tmp"]
-    other = tmp_path / ".other.txt.k2j3.tmp"  # another output's: not touched
-    for p in [*stale, other]:
+    stale = [tmp_path / ".out.txt.0a1b2c3d.tmp", tmp_path / ".out.txt.ffffffff.tmp"]  # the writer's own pattern
+    others = [tmp_path / ".other.txt.0a1b2c3d.tmp",  # another output's
+              tmp_path / ".out.txt.html.0a1b2c3d.tmp",  # the file out.txt.html's, whose name begins with out.txt
+              tmp_path / ".out.txt.k2j3.tmp"]  # not a name the writer makes
+    for p in [*stale, *others]:
         p.write_text("partial")
     write_atomic(tmp_path / "out.txt", lambda tmp: Path(tmp).write_text("done"))
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".other.txt.k2j3.tmp", "out.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([p.name for p in others] + ["out.txt"])
     assert (tmp_path / "out.txt").read_text() == "done"
 
 

@@ -355,10 +355,11 @@ def test_save_refuses_a_missing_directory(tmp_path):
     assert not (tmp_path / "no").exists()
 
 
-def _failing_to_netcdf(self, path, *args, **kwargs):
-    """Stand-in writer that leaves a partial file, then fails."""
-    with open(path, "wb") as f:
-        f.write(b"\x89HDF\r\n partial")
+def _failing_to_netcdf(self, path=None, *args, **kwargs):
+    """Stand-in writer that leaves a partial file where it is given one, then fails."""
+    if path is not None:
+        with open(path, "wb") as f:
+            f.write(b"\x89HDF\r\n partial")
     raise OSError("disk full (simulated)")
 
 

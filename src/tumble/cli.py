@@ -17,7 +17,8 @@ Exit codes: 0 success; 2 an error (a one-line message per problem on
 stderr, naming the file, the key and the rule; nothing is written): bad
 input, the integrator giving up, a file that cannot be read or written; 1 a
 bug.
-Results are written atomically (:func:`tumble.trajectory.write_atomic`).
+Results are written atomically, the outputs of a command together (:func:`tumble._files.write_atomic_all`),
+after every output path was checked (a new name or a regular file, in a writable directory, one file each).
 Documented in ``docs/cli.md``.
 """
 
@@ -39,13 +40,14 @@ from tumble import examples as _examples
 from tumble import scenario as scenarios
 from tumble._cli_errors import exit_codes as _exit_codes
 from tumble._demos import DEMOS, Demo
+from tumble._files import check_distinct, check_output, write_atomic_all
 from tumble._validate import ValidationError, require_memory, require_positive
 from tumble.analysis import flip_times, intermediate_rate
 from tumble.analytic._stability import flip_interval, stability
 from tumble.body import RigidBody
 from tumble.robot.cli import app as robot_app
 from tumble.simulate import simulate
-from tumble.trajectory import Trajectory, load, write_atomic
+from tumble.trajectory import Trajectory, load
 
 __all__ = ["app"]
 
@@ -122,11 +124,11 @@ def run(
     with _exit_codes(scenario):
         spec = scenarios.load(scenario)  # the file is read and parsed once; its kind picks the model
         problem = spec.build()  # every rule of the file is checked before anything runs
-        _check_outputs(output, plot, inputs=(scenario,))
+        _check_outputs([("--output", output), ("--plot", plot)], inputs=(scenario,))
         with _progress_bar("simulating", enabled=not quiet) as progress:
             traj = problem.simulate(progress=progress)
         figure = spec.figure(traj) if plot is not None else None
-        _save(traj, output, figure, plot)
+        write_atomic_all([(output, traj._write_netcdf), *_png(figure, plot)])
     _print_rows([("scenario", f"{scenario}" + (f" ({spec.name})" if spec.name else "")),
                  *_summary(traj), *spec.rows(traj), ("wrote", _written(output, plot))])
 
@@ -147,11 +149,12 @@ def racket(
     solution, 2K(m)/lambda. Beside the figure it writes the flips in the offline 3-D viewer
     (the figure's name with .html).
     """
-    from tumble.viewer import Cylinder
+    from tumble.viewer import Cylinder, html_page
 
     with _exit_codes():
         require_positive(duration, "--duration")
-        _check_outputs(output, plot)
+        page = plot.with_suffix(".html")
+        _check_outputs([("--output", output), ("--plot", plot), ("--plot's viewer page", page)])
         body = RigidBody.t_handle()
         omega0 = body.axes @ np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
         # t, q, omega and the totals (energy, momentum): 11 float64 per sample, twice over (states and result)
@@ -163,9 +166,9 @@ def racket(
             traj = simulate(body, omega0, t=np.linspace(0.0, duration, n + 1),
                             method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE, progress=progress)
         flips = flip_times(traj, body)
-        _save(traj, output, _racket_figure(traj, body, flips), plot)
-        page = plot.with_suffix(".html")
-        traj.to_html(page, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
+        html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
+        write_atomic_all([(output, traj._write_netcdf), *_png(_racket_figure(traj, body, flips), plot),
+                          (page, _text(html))])
     mean = f", mean time between flips {np.diff(flips).mean():.6g} s" if flips.size > 1 else ""
     _print_rows([*_summary(traj), ("flips", f"{flips.size} in {duration:g} s{mean}"),
                  ("predicted", f"time between flips 2K/lambda = {flip_interval(body, omega0):.6g} s (exact solution)"),
@@ -185,20 +188,20 @@ def polhode(
     predicted times. Beside the PNG, the same name with .html: the 3-D viewer of one polhode
     period of the motion (the T-handle turning, omega and L, and its polhode on the energy ellipsoid).
     """
-    from tumble.viewer import Cylinder
+    from tumble.viewer import Cylinder, html_page
     from tumble.viz.polhode import polhode_figure
 
     with _exit_codes():
-        _check_outputs(output, None)
+        page = output.with_suffix(".html")
+        _check_outputs([("--output", output), ("--output's viewer page", page)])
         body = RigidBody.t_handle()
         omega0 = body.axes @ np.array(_POLHODE_OMEGA)
         report = stability(body, omega0)
         figure = polhode_figure(body, omega0)
-        write_atomic(output, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
-        page = output.with_suffix(".html")
         traj = simulate(body, omega0, t=np.linspace(0.0, report.polhode_period, _POLHODE_FRAMES),
                         method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE)
-        traj.to_html(page, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
+        html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
+        write_atomic_all([*_png(figure, output), (page, _text(html))])
     moments = ", ".join(f"{m:.4g}" for m in report.moments)
     _print_rows([
         ("body", f"T-handle, principal moments {moments} kg m^2"),
@@ -230,6 +233,7 @@ def top(
         require_positive(duration, "--duration")
         if not output.is_dir():
             raise ValidationError(f"--output: {str(output)!r} is not an existing directory")
+        _check_outputs([("--output", output / name) for name in ("top.nc", "top.png", "top.html")])
         summary = demo_top(output, duration=duration)
     _print_rows([
         ("nutation", f"theta from {summary['theta_min_deg']:.6g} to {summary['theta_max_deg']:.6g} deg (exact), "
@@ -310,11 +314,10 @@ def sweep_command(
 
     with _exit_codes():
         spec = scenarios.load(scenario)
-        for option, path in (("--output", output), ("--plot", plot)):
-            if path is not None and not path.parent.is_dir():
-                raise ValidationError(f"{option}: directory {str(path.parent)!r} does not exist")
-        if plot is not None and (plot.is_dir() or plot.resolve() in (scenario.resolve(), output.resolve())):
-            raise ValidationError(f"--plot: {str(plot)!r} is a directory, the scenario or the store")
+        if not output.parent.is_dir():
+            raise ValidationError(f"--output: directory {str(output.parent)!r} does not exist")
+        if plot is not None:
+            _check_outputs([("--plot", plot)], inputs=(scenario, output))
         if scheduler is not None and workers is not None:
             raise ValidationError("--workers: give it only without --scheduler (a scheduler has its own workers)")
         client = None
@@ -334,7 +337,7 @@ def sweep_command(
                 client.close()
         if plot is not None:
             figure = sweep_figure(ds, title=spec.name)
-            write_atomic(plot, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+            write_atomic_all(_png(figure, plot))
     _print_rows([("scenario", f"{scenario}" + (f" ({spec.name})" if spec.name else "")), *_sweep_rows(ds),
                  ("wrote", _written(output, plot))])
 
@@ -396,7 +399,7 @@ def view(
         "--scenario", help="The scenario file of the run: its model draws what a trajectory alone cannot tell "
                            "(a robot's links, a spacecraft's wheels and thrusters).")] = None,
     frames: Annotated[int, typer.Option("--frames", help="Frame budget: at most this many samples are shown "
-                                                         "(>= 2).")] = 600,
+                                                         "(2 to 100000).")] = 600,
     axis: Annotated[str | None, typer.Option("--axis", help="Body axis whose trace on the unit sphere is drawn: "
                                                             "x, y or z (default: the one along omega(0)).")] = None,
 ) -> None:
@@ -404,12 +407,13 @@ def view(
 
     The body (the uniform box of its principal moments), its axes, omega and L as arrows, the trace of a body
     axis, the model's parts, the body rates beside it; play/pause, speed and a time slider (docs/viewer.md).
-    Bad input (not a tumble trajectory, an empty one, --frames < 2) exits with code 2 and writes nothing.
+    Bad input (not a tumble trajectory, an empty one, --frames < 2 or > 100000) exits with code 2 and writes
+    nothing.
     """
     from tumble.viewer import write_html
 
     with _exit_codes(path):
-        _check_outputs(output, None, inputs=(path,) + (() if scenario is None else (scenario,)))
+        _check_outputs([("--output", output)], inputs=(path,) + (() if scenario is None else (scenario,)))
         model = None if scenario is None else scenarios.load(scenario).model
         write_html(path, output, model=model, frames=frames, axis=axis)
     _print_rows([("trajectory", str(path)), ("wrote", str(output))])
@@ -480,19 +484,14 @@ def _info_store(path: Path) -> None:
 # --------------------------------------------------------------------------
 
 
-def _check_outputs(output: Path, plot: Path | None, *, inputs: tuple[Path, ...] = ()) -> None:
-    """Refuse output paths that cannot be written or would overwrite an input (before any work)."""
-    for option, path in (("--output", output), ("--plot", plot)):
-        if path is None:
-            continue
-        if not path.parent.is_dir():
-            raise ValidationError(f"{option}: directory {str(path.parent)!r} does not exist")
-        if path.is_dir():
-            raise ValidationError(f"{option}: {str(path)!r} is a directory")
-        if any(path.resolve() == src.resolve() for src in inputs):
-            raise ValidationError(f"{option}: {str(path)!r} would overwrite the input file")
-    if plot is not None and output.resolve() == plot.resolve():
-        raise ValidationError("--plot: must differ from --output")
+def _check_outputs(outputs: list[tuple[str, Path | None]], *, inputs: tuple[Path, ...] = ()) -> None:
+    """Refuse, before any work, the ``(option, path)`` outputs of a command (``None``: not asked for) that
+    cannot be written (:func:`tumble._files.check_output`: a missing or unwritable directory, a name that is
+    not a regular file or new), two that are one file, and one that is an input."""
+    given = [(option, path) for option, path in outputs if path is not None]
+    for option, path in given:
+        check_output(path, option)
+    check_distinct([*((f"the input {str(path)!r}", path) for path in inputs), *given])
 
 
 @contextmanager
@@ -509,11 +508,18 @@ def _progress_bar(description: str, *, enabled: bool,
         yield lambda done, total: bar.update(task, completed=done, total=total)
 
 
-def _save(traj: Trajectory, output: Path, figure, plot: Path | None) -> None:
-    """Write the NetCDF file and, if asked, the PNG figure, each atomically."""
-    traj.save(output)
-    if plot is not None:
-        write_atomic(plot, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
+def _png(figure, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:
+    """The write of ``figure`` as a PNG file at ``path`` for :func:`~tumble._files.write_atomic_all`; none
+    without a path."""
+    return [] if path is None else [(path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))]
+
+
+def _text(text: str) -> Callable[[str], None]:
+    """A writer of ``text`` (UTF-8) for :func:`~tumble._files.write_atomic_all`."""
+    def write(tmp_path: str) -> None:
+        Path(tmp_path).write_text(text, encoding="utf-8")
+
+    return write
 
 
 def _racket_figure(traj: Trajectory, body: RigidBody, flips: np.ndarray):
@@ -537,14 +543,20 @@ def _racket_figure(traj: Trajectory, body: RigidBody, flips: np.ndarray):
 
 
 def _drift(drift: np.ndarray, initial: np.ndarray) -> str:
-    """Largest |relative change|, or "n/a" where the initial value is 0 (the drift is then absolute)."""
-    return "n/a" if np.any(initial == 0.0) else f"{np.max(np.abs(drift)):.3g}"
+    """Largest |relative change|, or "n/a" where the initial value is 0 (the drift is then absolute) or there
+    is no body (an empty batch)."""
+    return "n/a" if drift.size == 0 or np.any(initial == 0.0) else f"{np.max(np.abs(drift)):.3g}"
+
+
+def _setting(value: float | int | str) -> str:
+    """A solver setting as printed: a number in ``%g``, a string as it is."""
+    return value if isinstance(value, str) else f"{value:g}"
 
 
 def _summary(traj: Trajectory) -> list[tuple[str, str]]:
     """Rows: output times, method and its settings, the largest relative change of the energy, |L| and L_I
     (the energy alone for a model without an attitude, e.g. a robot arm)."""
-    options = ", ".join(f"{key} {traj.info[key]:g}" for key in ("rtol", "atol", "dt") if key in traj.info)
+    options = ", ".join(f"{key} {_setting(traj.info[key])}" for key in ("rtol", "atol", "dt") if key in traj.info)
     steps = f", {traj.info['n_steps']} steps" if "n_steps" in traj.info else ""
     torque = traj.info.get("torque", "none")
     drift = f"energy {_drift(traj.energy_drift, traj.energy[0])}"

@@ -32,23 +32,17 @@ described in ``docs/trajectory.md``.
 
 from __future__ import annotations
 
-import contextlib
 import datetime
-import glob
 import operator
 import os
-import signal
-import stat
-import tempfile
-import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
 
-import filelock
 import numpy as np
 
+from ._files import require_regular, write_atomic
 from ._validate import ValidationError, as_array
 from .attitude import rotate
 from .dynamics import angular_momentum, kinetic_energy
@@ -549,8 +543,23 @@ class Trajectory:
         interrupted save leaves any previous file at ``path`` untouched. Read it
         back with :func:`tumble.load`.
         """
+        write_atomic(path, self._write_netcdf)
+
+    def _write_netcdf(self, path: str) -> None:
+        """Write the NetCDF-4 file to ``path`` in place, not atomically: the writer that :meth:`save` hands
+        to :func:`write_atomic`, and that a command writing several files hands to
+        :func:`tumble._files.write_atomic_all`. Every numeric variable carries HDF5's Fletcher-32 checksum,
+        verified on each read, so that a damaged byte of the data is refused, not read as another number.
+
+        The file is made in memory and written with plain file I/O, so that a full disk is one
+        :class:`OSError` (``ENOSPC``): HDF5 writing to the disk itself left its file open after the error,
+        and the process died of SIGSEGV when the garbage collector closed it.
+        """
         ds = self.to_xarray()
-        write_atomic(path, lambda tmp_path: ds.to_netcdf(tmp_path, engine=_ENGINE))
+        checksums = {name: {"fletcher32": True} for name, var in ds.variables.items() if var.dtype.kind in "fiu"}
+        contents = ds.to_netcdf(engine=_ENGINE, encoding=checksums)
+        with open(path, "wb") as fh:
+            fh.write(contents)
 
     # -- viewer ------------------------------------------------------------------------
 
@@ -673,139 +682,110 @@ def load(path: str | os.PathLike) -> Trajectory:
 
     Refused with a :class:`ValidationError` naming the file: a path that is not a regular file (a FIFO, a
     device: reading it could block for ever), variables larger than the memory can hold (checked from the
-    header, before reading them), any file the NetCDF/HDF5 readers cannot read, and contents that break the
-    rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤`` :data:`UNIT_Q_TOL`, and an
-    inertia tensor that is symmetric, positive semi-definite and meets the triangle inequality
-    (:func:`tumble._inertia.principal_axes`). A missing or unreadable path raises :class:`OSError`.
+    header, before reading them), any file the NetCDF/HDF5 readers cannot read, variables that do not hold
+    real numbers (complex, strings), units other than those :meth:`save` writes (``time`` excepted: any unit
+    of time, read in seconds, see :func:`_time_in_seconds`), extras that are not finite, and contents that
+    break the rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤``
+    :data:`UNIT_Q_TOL`, an inertia tensor that is symmetric, positive semi-definite and meets the triangle
+    inequality (:func:`tumble._inertia.principal_axes`), and an energy and angular momentum within float64's
+    range. A missing or unreadable path raises :class:`OSError`.
     """
-    import xarray as xr
-
-    from ._inertia import principal_axes
-    from ._validate import require_memory
-
-    if not stat.S_ISREG(os.stat(path).st_mode):
-        raise ValidationError(f"{os.fspath(path)}: not a regular file")
+    name = os.fspath(path)
+    require_regular(path)
     try:
-        with xr.open_dataset(path, engine=_ENGINE, decode_timedelta=False, phony_dims="access") as lazy:
-            nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
-            require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
-            ds = lazy.load()
         with np.errstate(all="ignore"):
-            traj = Trajectory.from_xarray(ds)
+            traj = Trajectory.from_xarray(_checked_dataset(_read_dataset(path)))
+            _check_physics(traj)
     except ValidationError as exc:  # the file named first; the field's own error stays as the cause
-        raise ValidationError(f"{os.fspath(path)}: {exc}") from exc
-    except (OSError, MemoryError):
+        raise ValidationError(f"{name}: {exc}") from exc
+    except MemoryError:
         raise
     except Exception as exc:  # noqa: BLE001 - a hostile file may make h5py/xarray raise anything
-        raise ValidationError(f"{os.fspath(path)}: not a readable tumble trajectory "
-                              f"({type(exc).__name__}: {exc})") from None
+        if isinstance(exc, OSError) and exc.errno is not None:  # the system's own error (permission, I/O)
+            raise
+        raise ValidationError(f"{name}: not a readable tumble trajectory ({type(exc).__name__}: {exc})") from None
+    return traj
+
+
+def _read_dataset(path: str | os.PathLike) -> xarray.Dataset:
+    """The variables of the NetCDF file ``path``, loaded once their size is known to fit in memory; times
+    left as the numbers stored (their units are read by :func:`_time_in_seconds`)."""
+    import h5py
+    import xarray as xr
+
+    from ._validate import require_memory
+
+    # Every object's header and attributes read first, in a file that is closed on any error: h5netcdf leaves
+    # a file it fails to open to the garbage collector, which prints "Exception ignored ..." tracebacks.
+    with h5py.File(path, "r") as f:
+        dict(f.attrs)
+        f.visititems(lambda name, obj: dict(obj.attrs))
+    with xr.open_dataset(path, engine=_ENGINE, decode_times=False, decode_timedelta=False,
+                         phony_dims="access") as lazy:
+        nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
+        require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
+        return lazy.load()
+
+
+#: The units :meth:`Trajectory.to_xarray` writes; a file that says other units for them is refused.
+_UNITS = {"q": "1", "omega": "rad/s", "inertia": "kg m2", "energy": "J", "momentum_body": "N m s",
+          "momentum_inertial": "N m s"}
+#: Seconds per unit of time, by the UDUNITS names a NetCDF file may give (``time:units``).
+_SECONDS = {**dict.fromkeys(("s", "sec", "secs", "second", "seconds"), 1.0),
+            **dict.fromkeys(("ms", "msec", "millisecond", "milliseconds"), 1e-3),
+            **dict.fromkeys(("us", "microsecond", "microseconds"), 1e-6),
+            **dict.fromkeys(("min", "minute", "minutes"), 60.0),
+            **dict.fromkeys(("h", "hr", "hour", "hours"), 3600.0),
+            **dict.fromkeys(("d", "day", "days"), 86400.0)}
+_LABELS = {"axis", "axis2", "component"}  # the coordinates of names (x, y, z; w, x, y, z)
+
+
+def _checked_dataset(ds: xarray.Dataset) -> xarray.Dataset:
+    """``ds`` with its times in seconds, once every variable holds real numbers (no complex part to drop,
+    no strings), tumble's own variables say tumble's units, and every extra is finite."""
+    from ._validate import require_finite
+
+    for name, var in ds.variables.items():
+        if name in _LABELS:
+            continue
+        if var.dtype.kind not in "fiu":
+            raise ValidationError(f"{name}: must hold real numbers, got {var.dtype} values")
+        units = var.attrs.get("units")
+        if name in _UNITS and units is not None and str(units) != _UNITS[name]:
+            raise ValidationError(f"{name}: units must be {_UNITS[name]!r} (as tumble writes them), got {units!r}")
+        if var.attrs.get(_EXTRA_ATTR) == 1:
+            require_finite(var.values, str(name))
+    if "time" not in ds.variables:
+        return ds
+    return ds.assign_coords(time=("time", _time_in_seconds(ds["time"]), ds["time"].attrs))
+
+
+def _time_in_seconds(time: xarray.DataArray) -> np.ndarray:
+    """The output times in seconds: the stored numbers times the seconds of their ``units`` (``"s"`` when
+    absent); CF's ``"UNIT since EPOCH"`` gives the times from the epoch (the origin of a trajectory's times
+    is its own). Units that are not a unit of time are refused."""
+    units = str(time.attrs.get("units", "s"))
+    unit = units.partition(" since ")[0].strip()
+    if unit not in _SECONDS:
+        raise ValidationError(f"time: units must be a unit of time ({', '.join(sorted(set(_SECONDS)))}, "
+                              f"optionally 'UNIT since EPOCH'), got {units!r}")
+    seconds = np.asarray(time.values, dtype=np.float64)
+    return seconds if _SECONDS[unit] == 1.0 else seconds * _SECONDS[unit]
+
+
+def _check_physics(traj: Trajectory) -> None:
+    """Refuse what a run cannot make: ``||q| − 1| >`` :data:`UNIT_Q_TOL`, an inertia that is not physical,
+    an energy or angular momentum past float64's range."""
+    from ._inertia import principal_axes
+    from ._validate import require_finite
+
     if traj.q is not None:
         error = np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0)
         if error.max(initial=0.0) > UNIT_Q_TOL:
             k = tuple(int(i) for i in np.unravel_index(np.argmax(error), error.shape))
-            raise ValidationError(f"{os.fspath(path)}: q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
+            raise ValidationError(f"q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
                                   f"|q{list(k)}| = {np.linalg.norm(traj.q[k]):.17g}")
-        try:
-            principal_axes(traj.inertia, "inertia", definite=False)
-        except ValidationError as exc:
-            raise ValidationError(f"{os.fspath(path)}: {exc}") from None
-    return traj
-
-
-def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
-    """Write a file atomically: ``write(tmp_path)`` fills a temporary file, renamed onto ``path``.
-
-    The temporary file (suffix ``.tmp``) is made in the directory of ``path``,
-    so :func:`os.replace` is an atomic rename: readers see either the old file
-    or the complete new one, never a partial file. On any exception, including
-    ``KeyboardInterrupt`` (SIGINT) and SIGTERM (turned into ``SystemExit(143)``
-    while the write runs, in the main thread), the temporary file is removed, a
-    pre-existing ``path`` is left untouched, and the exception propagates. The
-    new file gets the permissions of the file it replaces, or the default
-    ``0o666 & ~umask``.
-
-    One writer at a time: a writer holds an exclusive lock on the sibling
-    ``.NAME.lock`` (:class:`filelock.FileLock`: ``flock`` on POSIX,
-    ``msvcrt.locking`` on Windows; removed when it is done; the operating system
-    releases the lock of a killed process), and a second writer to the same path is refused
-    at once with :class:`FileExistsError` naming it (it neither waits nor
-    silently wins). Holding the lock, a writer removes the ``.NAME.*.tmp``
-    siblings left by killed runs (``kill -9``): no live writer owns them.
-
-    ``write`` must not infer the format from the file name, which ends in
-    ``.tmp``: e.g. ``write_atomic("fig.png", lambda p: fig.savefig(p, format="png"))``.
-
-    Raises ``FileNotFoundError`` if the directory of ``path`` does not exist.
-    """
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(directory):
-        raise FileNotFoundError(f"path: directory {directory!r} does not exist (writing {path!r})")
-    name = os.path.basename(path)
-    with _exclusive(os.path.join(directory, f".{name}.lock"), path), _terminate_as_exit():
-        for stale in glob.glob(os.path.join(glob.escape(directory), f".{glob.escape(name)}.*.tmp")):
-            with contextlib.suppress(FileNotFoundError):
-                os.remove(stale)
-        with tempfile.NamedTemporaryFile(dir=directory, prefix=f".{name}.", suffix=".tmp", delete=False) as tmp:
-            tmp_path = tmp.name
-        try:
-            write(tmp_path)
-            _set_mode(tmp_path, path)
-            fd = os.open(tmp_path, os.O_RDWR)
-            try:
-                os.fsync(fd)  # the data reach the disk before the rename makes them visible
-            finally:
-                os.close(fd)
-            os.replace(tmp_path, path)
-        except BaseException:
-            with contextlib.suppress(FileNotFoundError):
-                os.remove(tmp_path)
-            raise
-
-
-@contextlib.contextmanager
-def _exclusive(lock_path: str, path: str):
-    """Hold an exclusive lock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
-    lock = filelock.FileLock(lock_path, timeout=0, is_singleton=False)
-    try:
-        lock.acquire()
-    except filelock.Timeout:
-        raise FileExistsError(f"{path}: another process is writing it now (it holds {lock_path}); wait for it "
-                              "to finish, or write elsewhere") from None
-    try:
-        yield
-    finally:
-        with contextlib.suppress(FileNotFoundError, PermissionError):  # Windows: a new holder has it open
-            os.remove(lock_path)
-        lock.release()
-
-
-@contextlib.contextmanager
-def _terminate_as_exit():
-    """While the block runs in the main thread, SIGTERM raises ``SystemExit(143)`` (so cleanups run)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def exit_(signum, frame):
-        raise SystemExit(128 + signal.SIGTERM)
-
-    previous = signal.signal(signal.SIGTERM, exit_)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
-
-
-def _set_mode(tmp_path: str, path: str) -> None:
-    """Give ``tmp_path`` the permissions of ``path``, or those a plain ``open`` would give.
-
-    ``NamedTemporaryFile`` creates files readable by their owner only (0o600).
-    """
-    try:
-        mode = stat.S_IMODE(os.stat(path).st_mode)
-    except FileNotFoundError:
-        umask = os.umask(0)  # the umask can only be read by setting it
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    os.chmod(tmp_path, mode)
+        principal_axes(traj.inertia, "inertia", definite=False)
+    require_finite(traj.energy, "energy")
+    if traj.q is not None or "momentum_body" in traj.totals:
+        require_finite(traj.momentum_body, "momentum_body")

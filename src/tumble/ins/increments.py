@@ -30,6 +30,7 @@ columns                                        meaning
 from __future__ import annotations
 
 import csv
+import io
 import os
 from dataclasses import dataclass
 
@@ -37,6 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import attitude
+from tumble._files import read_input
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.trajectory import Trajectory, write_atomic
 
@@ -172,9 +174,9 @@ def read_csv(path: str | os.PathLike) -> Increments:
     and the column.
     """
     path = os.fspath(path)
-    with open(path, newline="", encoding="utf-8") as handle:
-        rows = [(number, row) for number, row in enumerate(csv.reader(handle), start=1)
-                if row and not row[0].lstrip().startswith("#")]
+    text = read_input(path).decode("utf-8")
+    rows = [(number, row) for number, row in enumerate(csv.reader(io.StringIO(text, newline="")), start=1)
+            if row and not row[0].lstrip().startswith("#")]
     if not rows:
         raise ValidationError(f"{path}: no header row (expected e.g. 't,dtheta_x,dtheta_y,dtheta_z')")
     header_line, header = rows[0]

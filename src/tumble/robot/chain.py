@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble._files import read_input
 from tumble._inertia import as_shape
 from tumble._validate import ValidationError, as_array
 from tumble.robot.link import Frame, Link
@@ -193,8 +194,7 @@ def load(path: str | os.PathLike[str], *, inertia: str = "check", min_inertia: f
     if path.suffix.lower() != ".toml":
         raise ValidationError(f"robot file: must end in .toml (DH table) or .urdf/.xml, got {path.name!r}")
     try:
-        with open(path, "rb") as fh:
-            doc = tomllib.load(fh)
+        doc = tomllib.loads(read_input(path).decode("utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise ValidationError(f"{path.name}: malformed TOML ({exc})") from None
     unknown = sorted(set(doc) - _TOML_KEYS)

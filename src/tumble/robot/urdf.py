@@ -65,6 +65,7 @@ import numpy as np
 from defusedxml import DefusedXmlException
 from defusedxml import ElementTree
 
+from tumble._files import read_input
 from tumble._validate import ValidationError, require_non_negative
 from tumble._inertia import _DEFINITE_RTOL, parallel_axis, principal_axes
 from tumble.robot.link import Frame, Link
@@ -169,8 +170,7 @@ def _parse(source):
     try:
         if isinstance(source, str) and source.lstrip().startswith("<"):
             return ElementTree.fromstring(source), "URDF"
-        path = Path(source)
-        return ElementTree.parse(path).getroot(), path.name
+        return ElementTree.fromstring(read_input(source)), Path(source).name
     except ElementTree.ParseError as exc:
         raise ValidationError(f"URDF: malformed XML ({exc})") from None
     except DefusedXmlException as exc:

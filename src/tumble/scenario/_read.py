@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import tomllib
 from collections.abc import Callable
-from pathlib import Path
-
 import pydantic
 
+from tumble._files import read_input
+from tumble._validate import ValidationError
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError, describe, in_file, toml_problem
 from tumble.scenario.kinds import kind_of, scenario_class
@@ -47,7 +47,9 @@ def load(path) -> Scenario:
     """Read and validate the scenario file ``path`` (UTF-8 TOML); raises :class:`ScenarioError`."""
     source = str(path)
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = read_input(path).decode("utf-8")
+    except ValidationError as exc:  # not a regular file, or too large
+        raise ScenarioError(source, [("", exc.rule)]) from None
     except OSError as exc:
         raise ScenarioError(source, [("", f"cannot read the file ({exc.strerror or exc})")]) from None
     except UnicodeDecodeError as exc:
