@@ -429,7 +429,13 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     (``λ = 0``) and the fixed point ``ω ∥ e₂`` of the separatrix. The mean
     precession rate is ``Ω = rate + λ B(K)/K`` with the bracket over a half
     period ``B(K) = coef (half_pi − β π/(2√(1 − n)))`` (``sn K = 1``, ``cn K = 0``).
+
+    The motion depends on the ratios of the moments only: they are first multiplied by the power of two that
+    brings ``I₃`` into [0.5, 1), an exact scaling (the same numbers, bit for bit, at any ordinary size), so
+    that ``L² = Σ Iᵢ²ωᵢ²`` and the ``Δᵢ`` neither underflow (``I ~ 1e-200 kg·m²``) nor overflow.
     """
+    unit = math.ldexp(1.0, -math.frexp(i3)[1])
+    i1, i2, i3 = i1 * unit, i2 * unit, i3 * unit
     code, _, momentum, m, m1, lam, d1, d2, d3 = _parameters(i1, i2, i3, w1, w2, w3)
     moments, omega, deltas, q0 = (i1, i2, i3), (w1, w2, w3), (d1, d2, d3), (qw, qx, qy, qz)
     if code == _REST or code == _SPHERE or lam == 0.0:

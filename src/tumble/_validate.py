@@ -43,11 +43,17 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
     """Return ``value`` as a float64 array whose trailing axes are ``tail``.
 
     Raises :class:`ValidationError` naming ``name`` when the value is not
-    numeric, has the wrong trailing shape, or (with ``finite``) holds NaN/inf.
+    numeric (text such as ``["0", "1", "0"]`` included, which NumPy would
+    convert), has the wrong trailing shape, or (with ``finite``) holds NaN/inf.
     """
     try:
-        arr = np.asarray(value, dtype=np.float64)
+        arr = value if isinstance(value, np.ndarray) else np.asarray(value)
+        if arr.dtype.kind in "USO" and _holds_text(arr):
+            raise ValidationError(f"{name}: must be an array of numbers, not text, got {value!r}")
+        arr = arr.astype(np.float64, copy=False)
     except (TypeError, ValueError) as exc:
+        if isinstance(exc, ValidationError):
+            raise
         raise ValidationError(f"{name}: must be an array of numbers ({exc})") from None
     if tail and (arr.ndim < len(tail) or arr.shape[arr.ndim - len(tail):] != tail):
         want = "(…, " + ", ".join(map(str, tail)) + ")"
@@ -55,6 +61,11 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
     if finite:
         require_finite(arr, name)
     return arr
+
+
+def _holds_text(arr: np.ndarray) -> bool:
+    """Whether an array of strings, bytes or objects holds text (a ``str`` or ``bytes`` element)."""
+    return arr.dtype.kind in "US" or any(isinstance(x, (str, bytes)) for x in arr.flat)
 
 
 def readonly(arr: np.ndarray) -> np.ndarray:
