@@ -54,14 +54,16 @@ _EXPONENT = -1.0 / 8.0  # the error estimate is of order 7
 _EPS, _TINY = float(np.finfo(np.float64).eps), 5e-324  # float64's relative spacing, and its smallest step (at t = 0)
 
 # Status codes written to stats[b, 3].
-OK, STEP_TOO_SMALL, TOO_MANY_STEPS, TOO_MANY_PROJECTED, NO_PROGRESS = 0, 1, 2, 3, 4
+OK, STEP_TOO_SMALL, TOO_MANY_STEPS, TOO_MANY_PROJECTED = 0, 1, 2, 3
 #: A run stops early (``TOO_MANY_PROJECTED``) when, after at least ``PROJECT_AFTER`` steps, the rest of its
 #: span at the mean step size so far would take more than ``PROJECT_MARGIN × max_steps`` steps: a run that
 #: could only end at ``max_steps`` hours later (``stop = 1e300``, rates of 1e19 rad/s) fails in a fraction of
 #: a second. The mean step, not the last one, so that a step cut short at a discontinuity does not trigger it.
-#: A run whose steps have not moved ``t`` at all by then (each below the float64 spacing of ``t``) stops
-#: there (``NO_PROGRESS``).
-PROJECT_AFTER, PROJECT_MARGIN = 1000, 100.0
+#: Once a run has used ``PROJECT_LATE`` of ``max_steps`` (1 %: a second or two of a rigid body), its projection
+#: rests on that many steps and the margin drops to ``PROJECT_LATE_MARGIN``: a run projected past twice
+#: ``max_steps`` stops then, not a minute later at ``max_steps``. (A run whose rest goes more than twice as
+#: fast as its start is stopped too: the message gives the projection; a larger ``max_steps`` lets it run.)
+PROJECT_AFTER, PROJECT_MARGIN, PROJECT_LATE, PROJECT_LATE_MARGIN = 1000, 100.0, 0.01, 2.0
 
 
 #: Sums of squares above this are recomputed from the terms divided by the largest (they may have overflowed).
@@ -222,12 +224,10 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
             stats[3] = TOO_MANY_STEPS
             break
         taken = stats[0] - steps0
-        if taken >= PROJECT_AFTER and t == t_out[0]:
-            stats[3] = NO_PROGRESS
-            break
-        if taken >= PROJECT_AFTER:
+        if taken >= PROJECT_AFTER and t > t_out[0]:
             projected = stats[0] + taken * ((t_out[-1] - t) / (t - t_out[0]))
-            if projected > PROJECT_MARGIN * max_steps:
+            margin = PROJECT_MARGIN if stats[0] < PROJECT_LATE * max_steps else PROJECT_LATE_MARGIN
+            if projected > margin * max_steps:
                 stats[3] = TOO_MANY_PROJECTED
                 h = projected
                 break
