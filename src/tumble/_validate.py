@@ -48,13 +48,13 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
     """
     try:
         arr = value if isinstance(value, np.ndarray) else np.asarray(value)
-        if arr.dtype.kind in "USO" and _holds_text(arr):
-            raise ValidationError(f"{name}: must be an array of numbers, not text, got {value!r}")
-        arr = arr.astype(np.float64, copy=False)
+        text = arr.dtype.kind in "USO" and _holds_text(arr)
+        if not text:
+            arr = arr.astype(np.float64, copy=False)
     except (TypeError, ValueError) as exc:
-        if isinstance(exc, ValidationError):
-            raise
         raise ValidationError(f"{name}: must be an array of numbers ({exc})") from None
+    if text:
+        raise ValidationError(f"{name}: must be an array of numbers, not text, got {value!r}")
     if tail and (arr.ndim < len(tail) or arr.shape[arr.ndim - len(tail):] != tail):
         want = "(…, " + ", ".join(map(str, tail)) + ")"
         raise ValidationError(f"{name}: must have shape {want}, got {arr.shape}")

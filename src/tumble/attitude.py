@@ -124,9 +124,10 @@ def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
 
 
 def _scaled(q: np.ndarray) -> np.ndarray:
-    """``q`` divided by its largest |component| (non-zero): the same rotation, with components in [−1, 1] so that
-    squares neither underflow (``q = [1e-200, 1e-200, 0, 0]``) nor overflow."""
-    return q / np.abs(q).max(axis=-1, keepdims=True)
+    """``q`` (non-zero) times the power of two that brings its largest |component| into [0.5, 1): the same
+    rotation, scaled exactly (no rounding: formulas homogeneous in ``q`` give the same bits), with squares that
+    neither underflow (``q = [1e-200, 1e-200, 0, 0]``) nor overflow (``[1e308, 1e308, 1e308, 1e308]``)."""
+    return np.ldexp(q, -np.frexp(np.abs(q).max(axis=-1, keepdims=True))[1])
 
 
 def _flat(arr: np.ndarray, batch: tuple[int, ...], tail: tuple[int, ...]) -> np.ndarray:
