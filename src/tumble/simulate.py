@@ -435,8 +435,8 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
     if model.batch_size is not None:
         sizes["model"] = model.batch_size
     if len(set(sizes.values())) > 1:
-        (first, n_first), (other, n_other) = next(iter(sizes.items())), next(
-            (name, size) for name, size in sizes.items() if size != sizes[next(iter(sizes))])
+        first, n_first = next(iter(sizes.items()))
+        other, n_other = next((name, size) for name, size in sizes.items() if size != n_first)
         raise ValidationError(f"{other}: a batch of {n_other} does not match the {n_first} of {first}; every "
                               f"batched value (and the model's bodies) must have the same leading length "
                               f"(batch sizes: {', '.join(f'{k} {v}' for k, v in sizes.items())})")

@@ -278,7 +278,9 @@ class Time(_Table):
         if step is not None and {"start", "stop"} <= info.data.keys():
             n = _step_count(info.data["start"], info.data["stop"], step) + 1
             if n > MAX_SAMPLES:
-                raise ValueError(f"makes {n} output times, more than the limit {MAX_SAMPLES}; use a larger step")
+                # exact while float64 counts every whole number; past float64's range, said so
+                count = f"{n:.0f}" if n < 2**53 else f"{n:.3g}" if n < np.inf else "more than 1e308"
+                raise ValueError(f"makes {count} output times, more than the limit {MAX_SAMPLES}; use a larger step")
         return step
 
     def times(self) -> np.ndarray:
