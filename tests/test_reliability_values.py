@@ -130,6 +130,31 @@ def test_the_exact_motion_at_any_rate_is_the_same_motion_in_its_own_time(scale):
     assert np.abs(scaled.q - unit.q).max() < 1e-13
 
 
+@pytest.mark.parametrize("omega0, t, turned", [
+    (OMEGA0, [0.0, 1e17], "1.01e+17 rad"),
+    ([1e150, 1e149, 1e148], [0.0, 1.0], "1.01e+150 rad"),
+    (OMEGA0, [-1e308, 1e308], "more than 1.8e308 rad"),
+])
+def test_the_exact_motion_refuses_a_turn_past_1e16_rad(omega0, t, turned):
+    # before: an attitude and a rate that looked like any other (float64 phases there are 2 rad apart or more)
+    with pytest.raises(ValidationError, match=rf"^t: the exact motion from t = .* would turn {re.escape(turned)}, "
+                                              r"past 1e\+16 rad"):
+        tumble.simulate(BODY, omega0, t=t, method="exact")
+    traj = tumble.simulate(BODY, OMEGA0, t=[0.0, 9.9e15], method="exact")  # within the bound: a finite state
+    assert np.isfinite(traj.q).all() and abs(np.linalg.norm(traj.q[-1]) - 1.0) < 1e-15
+
+
+@pytest.mark.parametrize("method, options, message", [
+    ("rk4", {"dt": 1.0}, "max_steps: the run needs more than 1.8e308 steps of dt = 1 s from t = -1e+308 to 1e+308 s"),
+    ("dop853", {}, "the step size fell below the float64 resolution of t"),
+])
+def test_output_times_from_minus_to_plus_1e308_are_one_clean_error(method, options, message):
+    # before: t[1] − t[0] overflowed in the check of increasing times and in the step count (a RuntimeWarning,
+    # an error under this suite's filters)
+    with pytest.raises((ValidationError, SolverError), match=f"^{re.escape(message)}"):
+        tumble.simulate(BODY, OMEGA0, t=[-1e308, 1e308], method=method, **options)
+
+
 def test_scenario_times_from_minus_to_plus_1e308_are_finite_and_even():
     # before: linspace gave NaN (stop - start = inf), reported as "time: must be finite (found nan …)", and
     # step = 1e307 raised OverflowError (int of inf)

@@ -132,9 +132,9 @@ def increasing_times(t, name: str = "t", *, what: str = "output times", at_least
     if times.ndim != 1 or times.size < at_least:
         count = "one" if at_least == 1 else f"at least {at_least}"
         raise ValidationError(f"{name}: must be a 1-D array of {count} {what}, got shape {times.shape}")
-    steps = times[1:] - times[:-1]
-    if (steps <= 0.0).any():
-        k = int(np.flatnonzero(steps <= 0.0)[0])
+    stalled = times[1:] <= times[:-1]  # compared, not subtracted: t = [-1e308, 1e308] is increasing
+    if stalled.any():
+        k = int(np.flatnonzero(stalled)[0])
         raise ValidationError(f"{name}: {what} must be strictly increasing ({name}[{k + 1}] = {times[k + 1]} "
                               f"<= {name}[{k}] = {times[k]})")
     return times
