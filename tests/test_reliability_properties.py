@@ -37,6 +37,10 @@ HOSTILE = st.one_of(ANY_FLOAT, st.text(max_size=3), st.lists(ANY_FLOAT, max_size
 FIELD = re.compile(r"^[A-Za-z_][\w\[\].]*: \S")  # "FIELD: rule"
 
 
+# Initial quaternions of any length, on purpose: their normalisation's warning is expected
+pytestmark = pytest.mark.filterwarnings("ignore::tumble.attitude.NonUnitQuaternionWarning")
+
+
 def assert_names_a_field(error: ValidationError):
     assert FIELD.match(str(error)) and error.field, str(error)
 
@@ -135,7 +139,6 @@ def test_attitude_functions_refuse_what_is_not_a_quaternion_naming_it(value):
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
 
 
-@pytest.mark.filterwarnings("ignore::tumble.attitude.NonUnitQuaternionWarning")  # q0 of any length, on purpose
 @fixed(25)
 @given(st.lists(st.floats(-10.0, 10.0), min_size=3, max_size=3),
        st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4).filter(lambda q: np.linalg.norm(q) > 1e-3))

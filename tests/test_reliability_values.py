@@ -238,8 +238,14 @@ def test_a_torque_function_of_the_wrong_arity_is_refused_naming_the_signature():
 @pytest.mark.parametrize("omega0", [["0", "1", "0"], [b"0", 1.0, 0.0], np.array(["0", "1", "0"])])
 def test_numbers_given_as_text_are_refused(omega0):
     # before: NumPy converted the strings and the run went ahead
-    with pytest.raises(ValidationError, match=r"^omega0: must be an array of numbers, not text"):
+    with pytest.raises(ValidationError, match=r"^omega0: must be an array of real numbers, not text"):
         tumble.simulate(BODY, omega0, t=[0.0, 1.0])
+
+
+def test_a_complex_array_is_refused_not_cut_to_its_real_part():
+    # before: a NumPy complex array was cast to its real part with only a ComplexWarning
+    with pytest.raises(ValidationError, match=r"^omega0: must be an array of real numbers, not complex"):
+        tumble.simulate(BODY, np.array([0.1, 1.0 + 1.0j, 0.1]), t=[0.0, 1.0])
 
 
 def test_an_initial_quaternion_off_unit_length_is_normalised_with_a_warning_beyond_1e_6():

@@ -43,18 +43,19 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
     """Return ``value`` as a float64 array whose trailing axes are ``tail``.
 
     Raises :class:`ValidationError` naming ``name`` when the value is not
-    numeric (text such as ``["0", "1", "0"]`` included, which NumPy would
-    convert), has the wrong trailing shape, or (with ``finite``) holds NaN/inf.
+    real numbers (text such as ``["0", "1", "0"]`` and complex numbers
+    included, which NumPy would convert), has the wrong trailing shape, or
+    (with ``finite``) holds NaN/inf.
     """
     try:
         arr = value if isinstance(value, np.ndarray) else np.asarray(value)
-        text = arr.dtype.kind in "USO" and _holds_text(arr)
-        if not text:
+        kind = "text" if arr.dtype.kind in "USO" and _holds_text(arr) else "complex" if arr.dtype.kind == "c" else ""
+        if not kind:
             arr = arr.astype(np.float64, copy=False)
     except (TypeError, ValueError) as exc:
         raise ValidationError(f"{name}: must be an array of numbers ({exc})") from None
-    if text:
-        raise ValidationError(f"{name}: must be an array of numbers, not text, got {value!r}")
+    if kind:
+        raise ValidationError(f"{name}: must be an array of real numbers, not {kind}, got {value!r}")
     if tail and (arr.ndim < len(tail) or arr.shape[arr.ndim - len(tail):] != tail):
         want = "(…, " + ", ".join(map(str, tail)) + ")"
         raise ValidationError(f"{name}: must have shape {want}, got {arr.shape}")
