@@ -469,12 +469,13 @@ def _checked_value(f: StateField, value: ArrayLike) -> np.ndarray:
 def _warn_non_unit(q: np.ndarray, name: str) -> None:
     """One :class:`~tumble.attitude.NonUnitQuaternionWarning` when a quaternion of ``q`` (…, 4) is further than
     :data:`UNIT_Q0_TOL` from unit length (it is then normalised: the rotation of ``q / |q|`` is meant)."""
-    off = np.abs(norm(q) - 1.0)
+    lengths = norm(q.reshape(-1, 4))
+    off = np.abs(lengths - 1.0)
     if np.all(off <= UNIT_Q0_TOL):
         return
     k = int(np.argmax(off))
     where = f"[{k}]" if q.ndim == 2 else ""
-    warnings.warn(f"{name}: |{name}{where}| = {float(norm(q.reshape(-1, 4)[k])):.17g} is not 1 (further than "
+    warnings.warn(f"{name}: |{name}{where}| = {lengths[k]:.17g} is not 1 (further than "
                   f"{UNIT_Q0_TOL:g}): normalised to {name} / |{name}|; give a unit quaternion [w, x, y, z]",
                   attitude.NonUnitQuaternionWarning, stacklevel=5)  # the caller of simulate
 
