@@ -166,7 +166,7 @@ def test_kovalevskaya_invariant_by_hand():
     assert k == 1.5625
     g = goryachev_chaplygin_invariant(tumble.RigidBody(np.diag([4.0, 4.0, 1.0])), Gravity(com=[1.0, 0.0, 0.0], **UNIT),
                                       [1.0, 0.5, 0.0], [1.0, 0.0, 0.0, 0.0])
-    assert g == -1.0  # r = 0 (so L_z = 0), c = p = γ₃ = 1: G = -c p γ₃
+    assert g == 1.0  # r = 0 (so L_z = 0), c = p = γ₃ = 1: G = |-c p γ₃|
 
 
 @pytest.mark.parametrize("inertia, com, field", [

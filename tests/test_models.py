@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble import integrate, robot
+from tumble import attitude, integrate, robot
 from tumble.flexible import FlexibleBody, Mode
 from tumble.ins import GimbaledGyro, Gyroscope
 from tumble.slosh import Pendulum, SloshBody
@@ -20,6 +20,7 @@ from helpers import read_by
 
 INERTIA = np.array([[2.0, 0.1, -0.05], [0.1, 3.0, 0.2], [-0.05, 0.2, 4.0]])  # kg m², body axes
 OMEGA0 = np.array([0.3, 1.0, -0.4])  # rad/s: a generic tumble
+Q0 = attitude.normalize([0.9, 0.1, -0.3, 0.2])  # a generic attitude, unit (simulate warns on one that is not)
 ROBOTS = tumble.examples.directory() / "robots"
 
 
@@ -88,7 +89,7 @@ KEPT = {
 # torque-free, the exact-flow splittings are the exact motion. Measured: dop853 8.7e-13, rk4 and cf4
 # 8.0e-15, splitting2 3.7e-9 (its O(dt²) energy error), splitting4 2.8e-14, exact_split2/4 1.7e-15,
 # exact 6.8e-16.
-CASES["RigidBody"] = (lambda: tumble.RigidBody(INERTIA), dict(omega0=OMEGA0, q0=[0.9, 0.1, -0.3, 0.2]), 5.0, 1e-3,
+CASES["RigidBody"] = (lambda: tumble.RigidBody(INERTIA), dict(omega0=OMEGA0, q0=Q0), 5.0, 1e-3,
                       {"dop853": 1e-11, "rk4": 1e-12, "cf4": 1e-12, "splitting2": 1e-7, "splitting4": 1e-12,
                        "exact_split2": 1e-13, "exact_split4": 1e-13, "exact": 1e-14})
 KEPT["RigidBody"] = {"energy", "momentum_inertial"}
@@ -112,7 +113,7 @@ CASES["Spacecraft"] = (
     lambda: Spacecraft(inertia=np.diag([900.0, 800.0, 600.0]),
                        wheels=[ReactionWheel(axis=a, inertia=0.1) for a in np.eye(3)],
                        controller=MRPFeedback(K=10.0, P=150.0)),
-    dict(omega0=[0.01, -0.01, 0.005], q0=[0.9, 0.1, -0.3, 0.2], wheel_speeds0=[20.0, -10.0, 5.0]), 60.0, 0.05,
+    dict(omega0=[0.01, -0.01, 0.005], q0=Q0, wheel_speeds0=[20.0, -10.0, 5.0]), 60.0, 0.05,
     {"dop853": 1e-10, "rk4": 2e-7})
 KEPT["Spacecraft"] = {"momentum_inertial", "energy_minus_wheel_work"}
 # cf4 (Lie group, order 4) on the models that give a body rate, at the rk4 steps: measured at or below

@@ -37,6 +37,10 @@ HOSTILE = st.one_of(ANY_FLOAT, st.text(max_size=3), st.lists(ANY_FLOAT, max_size
 FIELD = re.compile(r"^[A-Za-z_][\w\[\].]*: \S")  # "FIELD: rule"
 
 
+# Initial quaternions of any length, on purpose: their normalisation's warning is expected
+pytestmark = pytest.mark.filterwarnings("ignore::tumble.attitude.NonUnitQuaternionWarning")
+
+
 def assert_names_a_field(error: ValidationError):
     assert FIELD.match(str(error)) and error.field, str(error)
 

@@ -32,7 +32,7 @@ __version__ = "0.2.1"
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
 _LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep", "examples")
+         "robot", "sweep", "examples", "viewer")
 
 
 def __getattr__(name):
@@ -68,5 +68,6 @@ __all__ = [
     "sweep",
     "torques",
     "variable",
+    "viewer",
     "viz",
 ]

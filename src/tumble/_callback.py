@@ -16,6 +16,7 @@ run, which holds it through :func:`keep_alive`.
 
 from __future__ import annotations
 
+import inspect
 import itertools
 import weakref
 from collections.abc import Callable
@@ -63,12 +64,30 @@ def register(owner, function: Callable, *, field: str, signature: str, returns: 
     """
     if not callable(function):
         raise ValidationError(f"{field}: must be a callable f{signature}, got {function!r}")
+    _require_arity(function, field, signature)
     slot = next(_SLOTS)
     _ENTRIES[slot] = _Entry(function, field, signature, returns)
     weakref.finalize(owner, _ENTRIES.pop, slot, None)
     if _KEPT:
         _KEPT[-1].append(owner)
     return slot
+
+
+def _require_arity(function: Callable, field: str, signature: str) -> None:
+    """Refuse a function that cannot be called with the arguments of ``signature`` (e.g. ``"(t, q, omega)"``,
+    passed by position), naming ``field`` and the function's own signature; a callable whose signature Python
+    cannot read (some built-ins) is taken as it is."""
+    names = [name.strip() for name in signature.strip("()").split(",")]
+    try:
+        own = inspect.signature(function)
+    except (TypeError, ValueError):
+        return
+    try:
+        own.bind(*names)
+    except TypeError:
+        name = getattr(function, "__name__", type(function).__name__)
+        raise ValidationError(f"{field}: the function {name}{own} must take the {len(names)} arguments "
+                              f"{signature}") from None
 
 
 def invoke(slot: int, t: float, args: tuple, out: np.ndarray) -> None:

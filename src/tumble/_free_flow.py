@@ -234,6 +234,7 @@ class _Motion(NamedTuple):
     theta: np.ndarray     # (N, 2) nome-series coefficients (c_j, σ s_j)
     moments: tuple        # (I₁, I₂, I₃)
     omega0: tuple         # rate at t0 (principal axes)
+    unit: float           # u: every rate above is of ω̃ = u ω (a power of two), whose motion is ω(t0 + dt) = ω̃(dt/u)/u
     bracket0: float       # B(tau0) (R_J path)
     phase0: tuple         # (S(τ0)*/|S(τ0)|)^σ as (re, im) (nome series)
     h: tuple              # quaternion q_NP(t0) ⊗ p(t0)
@@ -291,7 +292,18 @@ def _nome_sum(theta, sin_z, cos_z):
 
 @njit(cache=True)
 def _evaluate(mo, dt):
-    """``(ω₁, ω₂, ω₃, q_w, q_x, q_y, q_z)``: rate (P axes) and ``q_NP`` at ``t0 + dt``."""
+    """``(ω₁, ω₂, ω₃, q_w, q_x, q_y, q_z)``: rate (P axes) and ``q_NP`` at ``t0 + dt``.
+
+    The motion is that of the scaled rate ``ω̃ = u ω`` (:func:`_setup`) at ``dt/u``, its rates divided by ``u``:
+    Euler's equations are quadratic in ω, so ``ω(t0 + dt) = ω̃(dt/u)/u`` and ``q(t0 + dt) = q̃(dt/u)``.
+    """
+    w1, w2, w3, qw, qx, qy, qz = _evaluate_scaled(mo, dt / mo.unit)
+    return w1 / mo.unit, w2 / mo.unit, w3 / mo.unit, qw, qx, qy, qz
+
+
+@njit(cache=True)
+def _evaluate_scaled(mo, dt):
+    """:func:`_evaluate` of the scaled motion: the rates ``ω̃`` and ``q̃`` at ``t0 + dt``."""
     w1, w2, w3 = mo.omega0
     hw, hx, hy, hz = mo.h
     if mo.steady:
@@ -411,11 +423,11 @@ def _phase_constants(separatrix, moments, k, j, m, m1, lam, momentum, beta, cn0,
 
 
 @njit(cache=True)
-def _steady(moments, omega, q):
+def _steady(moments, omega, unit, q):
     """The :class:`_Motion` of a constant rate: ``q(t) = q0 ⊗ exp(½ ω0 (t − t0))``."""
     return _Motion(True, False, 2, 0.0, 0.0, np.zeros(1), np.ones(1), 0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
                    1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, False, 0.0, np.zeros((0, 2)),
-                   moments, omega, 0.0, (1.0, 0.0), q)
+                   moments, omega, unit, 0.0, (1.0, 0.0), q)
 
 
 @njit(cache=True)
@@ -429,11 +441,21 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     (``λ = 0``) and the fixed point ``ω ∥ e₂`` of the separatrix. The mean
     precession rate is ``Ω = rate + λ B(K)/K`` with the bracket over a half
     period ``B(K) = coef (half_pi − β π/(2√(1 − n)))`` (``sn K = 1``, ``cn K = 0``).
+
+    The motion depends on the ratios of the moments only, and the rates set its time scale: the moments are
+    first multiplied by the power of two that brings ``I₃`` into [0.5, 1), and the rates by the power of two
+    ``u`` that brings the largest into [0.5, 1) (:func:`_evaluate` undoes it). Both scalings are exact (the
+    same numbers, bit for bit, at any ordinary size), so that ``L² = Σ Iᵢ²ωᵢ²`` and the ``Δᵢ`` neither
+    underflow (``I ~ 1e-200 kg·m²``, ``|ω| ~ 1e-160 rad/s``) nor overflow.
     """
+    scale = math.ldexp(1.0, -math.frexp(i3)[1])
+    i1, i2, i3 = i1 * scale, i2 * scale, i3 * scale
+    unit = math.ldexp(1.0, -math.frexp(max(abs(w1), abs(w2), abs(w3)))[1])
+    w1, w2, w3 = w1 * unit, w2 * unit, w3 * unit
     code, _, momentum, m, m1, lam, d1, d2, d3 = _parameters(i1, i2, i3, w1, w2, w3)
     moments, omega, deltas, q0 = (i1, i2, i3), (w1, w2, w3), (d1, d2, d3), (qw, qx, qy, qz)
     if code == _REST or code == _SPHERE or lam == 0.0:
-        return _steady(moments, omega, q0)
+        return _steady(moments, omega, unit, q0)
     k, j = _axes_of(code)
     ik, ij = moments[k], moments[j]
     separatrix = code == _SEPARATRIX
@@ -447,7 +469,7 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
         scale = math.hypot(cn0, sn0)
         cn0, sn0 = cn0 / scale, sn0 / scale
     if separatrix and cn0 == 0.0:
-        return _steady(moments, omega, q0)
+        return _steady(moments, omega, unit, q0)
     ks, kcs, nlev, agm = _elliptic.landen(m, m1) if not separatrix else (np.zeros(1), np.ones(1), 0, 1.0)
     quarter = 0.5 * math.pi / agm if not separatrix else math.inf
     beta = ik * amp_k / momentum
@@ -461,7 +483,7 @@ def _setup(i1, i2, i3, w1, w2, w3, qw, qx, qy, qz):
     precession = rate + lam * coef * (half_pi - 0.5 * math.pi * beta / sqrt1n) / quarter
     mo = _Motion(
         False, separatrix, k, lam, quarter, ks, kcs, nlev, agm, sj * amp_j, sj * sk * amp_2, sk * amp_k, sk,
-        1.0 / momentum, beta, sqrt1n, *phase, series, precession, theta, moments, omega, 0.0, (1.0, 0.0), q0,
+        1.0 / momentum, beta, sqrt1n, *phase, series, precession, theta, moments, omega, unit, 0.0, (1.0, 0.0), q0,
     )
     if series:
         j0, s, c, d, sin_z, cos_z = _elliptic.jacobi_angle(tau0, quarter, ks, kcs, nlev, agm)

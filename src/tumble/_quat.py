@@ -88,6 +88,26 @@ def qnorm(qw, qx, qy, qz):
 
 
 @njit(cache=True)
+def qunit(qw, qx, qy, qz):
+    """Unit quaternion ``q / |q|`` of a non-zero, finite ``q``, for any magnitude of its components.
+
+    ``|q|`` itself overflows when the components are near the float64 maximum
+    (``|[1e308, 1e308, 1e308, 1e308]| = 2e308``) and the squares underflow
+    below 1e-154, so outside the range where :func:`qnorm` is plain the
+    components are first divided by the largest magnitude ``s``:
+    ``q / |q| = (q/s) / |q/s|`` with ``1 ≤ |q/s| ≤ 2``.
+    """
+    n2 = qw * qw + qx * qx + qy * qy + qz * qz
+    if not 1e-290 <= n2 <= 1e290:
+        s = max(abs(qw), abs(qx), abs(qy), abs(qz))
+        if 0.0 < s < math.inf:  # zero, inf or nan: nothing to rescale
+            qw, qx, qy, qz = qw / s, qx / s, qy / s, qz / s
+            n2 = qw * qw + qx * qx + qy * qy + qz * qz
+    n = math.sqrt(n2)
+    return (qw / n, qx / n, qy / n, qz / n)
+
+
+@njit(cache=True)
 def qto_matrix(qw, qx, qy, qz, out):
     """Write the rotation matrix R(q) (body → inertial) of a unit quaternion into the 3×3 ``out``."""
     xx, yy, zz = qx * qx, qy * qy, qz * qz

@@ -43,18 +43,30 @@ def as_array(value, name: str, *, tail: tuple[int, ...] = (), finite: bool = Tru
     """Return ``value`` as a float64 array whose trailing axes are ``tail``.
 
     Raises :class:`ValidationError` naming ``name`` when the value is not
-    numeric, has the wrong trailing shape, or (with ``finite``) holds NaN/inf.
+    real numbers (text such as ``["0", "1", "0"]`` and complex numbers
+    included, which NumPy would convert), has the wrong trailing shape, or
+    (with ``finite``) holds NaN/inf.
     """
     try:
-        arr = np.asarray(value, dtype=np.float64)
+        arr = value if isinstance(value, np.ndarray) else np.asarray(value)
+        kind = "text" if arr.dtype.kind in "USO" and _holds_text(arr) else "complex" if arr.dtype.kind == "c" else ""
+        if not kind:
+            arr = arr.astype(np.float64, copy=False)
     except (TypeError, ValueError) as exc:
         raise ValidationError(f"{name}: must be an array of numbers ({exc})") from None
+    if kind:
+        raise ValidationError(f"{name}: must be an array of real numbers, not {kind}, got {value!r}")
     if tail and (arr.ndim < len(tail) or arr.shape[arr.ndim - len(tail):] != tail):
         want = "(…, " + ", ".join(map(str, tail)) + ")"
         raise ValidationError(f"{name}: must have shape {want}, got {arr.shape}")
     if finite:
         require_finite(arr, name)
     return arr
+
+
+def _holds_text(arr: np.ndarray) -> bool:
+    """Whether an array of strings, bytes or objects holds text (a ``str`` or ``bytes`` element)."""
+    return arr.dtype.kind in "US" or any(isinstance(x, (str, bytes)) for x in arr.flat)
 
 
 def readonly(arr: np.ndarray) -> np.ndarray:
@@ -121,9 +133,9 @@ def increasing_times(t, name: str = "t", *, what: str = "output times", at_least
     if times.ndim != 1 or times.size < at_least:
         count = "one" if at_least == 1 else f"at least {at_least}"
         raise ValidationError(f"{name}: must be a 1-D array of {count} {what}, got shape {times.shape}")
-    steps = times[1:] - times[:-1]
-    if (steps <= 0.0).any():
-        k = int(np.flatnonzero(steps <= 0.0)[0])
+    stalled = times[1:] <= times[:-1]  # compared, not subtracted: t = [-1e308, 1e308] is increasing
+    if stalled.any():
+        k = int(np.flatnonzero(stalled)[0])
         raise ValidationError(f"{name}: {what} must be strictly increasing ({name}[{k + 1}] = {times[k + 1]} "
                               f"<= {name}[{k}] = {times[k]})")
     return times

@@ -1,13 +1,31 @@
-"""Compiled 3-vector algebra on scalar components: the one cross product, matrix product and 3×3 solve.
+"""Vector algebra: the one cross product, matrix product and 3×3 solve (compiled), and the one scaled norm.
 
 Kernels pass vectors as three floats (``a1, a2, a3``) rather than arrays, so
 that nothing is allocated in the inner loops; these functions are inlined
-into their callers. Frames are the callers' (the functions are frame-free).
+into their callers. :func:`norm` is the NumPy norm of the Python layer.
+Frames are the callers' (the functions are frame-free).
 """
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit
+
+
+def norm(v) -> np.ndarray:
+    """Euclidean norm ``|v|`` along the last axis of ``v`` (…, k), at any magnitude of the components.
+
+    ``|v| = m |v / m|`` with ``m = max |vᵢ|``: the squares of ``v / m`` lie in
+    [0, 1], so they neither overflow (``|[1e200, 0, 0]|`` is 1e200, where
+    ``np.linalg.norm`` gives inf) nor underflow (``|[1e-200, 0, 0]|`` is
+    1e-200, not 0). The result is inf only where ``|v|`` itself exceeds the
+    float64 maximum (1.8e308); NaN where ``v`` holds NaN.
+    """
+    v = np.asarray(v, dtype=np.float64)
+    largest = np.abs(v).max(axis=-1, initial=0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        unit = v / np.where((largest > 0.0) & (largest < np.inf), largest, 1.0)[..., None]
+        return largest * np.sqrt(np.einsum("...i,...i->...", unit, unit))
 
 
 @njit(cache=True, inline="always")

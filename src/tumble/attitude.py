@@ -41,8 +41,9 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike
 
-from ._quat import orthonormality, qexp, qfrom_matrix, qlog, qmul, qnorm, qrotate, qrotate_inv, qto_matrix
+from ._quat import orthonormality, qexp, qfrom_matrix, qlog, qmul, qrotate, qrotate_inv, qto_matrix, qunit
 from ._validate import ValidationError, as_array, readonly, require_positive
+from ._vec import norm
 
 if TYPE_CHECKING:
     from scipy.spatial.transform import Rotation
@@ -50,6 +51,7 @@ if TYPE_CHECKING:
 __all__ = [
     "GIMBAL_LOCK_THRESHOLD",
     "GimbalLockWarning",
+    "NonUnitQuaternionWarning",
     "angle",
     "conjugate",
     "from_euler",
@@ -78,6 +80,11 @@ class GimbalLockWarning(UserWarning):
     """Euler angles were requested for rotations at gimbal lock; the third angle was set to 0."""
 
 
+class NonUnitQuaternionWarning(UserWarning):
+    """An initial attitude given to :func:`tumble.simulate` was further than ``UNIT_Q0_TOL`` (1e-6) from unit
+    length, and was normalised: ``q / |q|`` was used."""
+
+
 # --------------------------------------------------------------------------
 # Input checks and batch shapes (Python layer)
 # --------------------------------------------------------------------------
@@ -95,6 +102,15 @@ def _where(bad: np.ndarray) -> str:
 _HUGE_ANGLE = 1e16
 
 
+def _require_defined_angle(theta: np.ndarray, name: str, what: str) -> None:
+    """Refuse angles (rad) past :data:`_HUGE_ANGLE` in magnitude, naming ``name`` and ``what`` they are."""
+    huge = ~(np.abs(theta) <= _HUGE_ANGLE)
+    if np.any(huge):
+        raise ValidationError(f"{name}: {what} = {float(np.asarray(theta)[huge].flat[0]):.3g} rad{_where(huge)} "
+                              f"is past {_HUGE_ANGLE:g} rad, where float64 angles are 2 rad apart and define no "
+                              "rotation: reduce it modulo 2π first")
+
+
 def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
     """``q`` as a float64 (…, 4) array; with ``nonzero``, refuse q = 0 (it is no rotation)."""
     q = as_array(q, name, tail=(4,))
@@ -108,9 +124,10 @@ def _as_quat(q, name: str = "q", *, nonzero: bool = True) -> np.ndarray:
 
 
 def _scaled(q: np.ndarray) -> np.ndarray:
-    """``q`` divided by its largest |component| (non-zero): the same rotation, with components in [−1, 1] so that
-    squares neither underflow (``q = [1e-200, 1e-200, 0, 0]``) nor overflow."""
-    return q / np.abs(q).max(axis=-1, keepdims=True)
+    """``q`` (non-zero) times the power of two that brings its largest |component| into [0.5, 1): the same
+    rotation, scaled exactly (no rounding: formulas homogeneous in ``q`` give the same bits), with squares that
+    neither underflow (``q = [1e-200, 1e-200, 0, 0]``) nor overflow (``[1e308, 1e308, 1e308, 1e308]``)."""
+    return np.ldexp(q, -np.frexp(np.abs(q).max(axis=-1, keepdims=True))[1])
 
 
 def _flat(arr: np.ndarray, batch: tuple[int, ...], tail: tuple[int, ...]) -> np.ndarray:
@@ -150,16 +167,13 @@ def _multiply_loop(p, q, out):
 @njit(cache=True)
 def _normalize_loop(q, out):
     for n in range(out.shape[0]):
-        s = qnorm(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
-        for c in range(4):
-            out[n, c] = q[n, c] / s
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = qunit(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
 
 
 @njit(cache=True)
 def _rotate_loop(q, v, inverse, out):
     for n in range(out.shape[0]):
-        s = qnorm(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
-        w, x, y, z = q[n, 0] / s, q[n, 1] / s, q[n, 2] / s, q[n, 3] / s
+        w, x, y, z = qunit(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
         if inverse:
             out[n, 0], out[n, 1], out[n, 2] = qrotate_inv(w, x, y, z, v[n, 0], v[n, 1], v[n, 2])
         else:
@@ -169,8 +183,8 @@ def _rotate_loop(q, v, inverse, out):
 @njit(cache=True)
 def _to_matrix_loop(q, out):
     for n in range(out.shape[0]):
-        s = qnorm(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
-        qto_matrix(q[n, 0] / s, q[n, 1] / s, q[n, 2] / s, q[n, 3] / s, out[n])
+        w, x, y, z = qunit(q[n, 0], q[n, 1], q[n, 2], q[n, 3])
+        qto_matrix(w, x, y, z, out[n])
 
 
 @njit(cache=True)
@@ -400,14 +414,7 @@ def from_rotvec(r: ArrayLike) -> np.ndarray:
     (and ``θ²`` overflows past 1.3e154, which gave NaN).
     """
     r = as_array(r, "r", tail=(3,))
-    largest = np.abs(r).max(axis=-1, initial=0.0)
-    with np.errstate(over="ignore", invalid="ignore"):
-        theta = largest * np.linalg.norm(r / np.where(largest > 0.0, largest, 1.0)[..., None], axis=-1)
-    huge = ~(theta <= _HUGE_ANGLE)
-    if np.any(huge):
-        raise ValidationError(f"r: rotation angle |r| = {float(np.asarray(theta)[huge].flat[0]):.3g} rad{_where(huge)} "
-                              f"is past {_HUGE_ANGLE:g} rad, where float64 angles are 2 rad apart and define no "
-                              "rotation: reduce it modulo 2π first")
+    _require_defined_angle(norm(r), "r", "rotation angle |r|")
     out = np.empty((math.prod(r.shape[:-1]), 4))
     _from_rotvec_loop(_flat(r, r.shape[:-1], (3,)), out)
     return out.reshape((*r.shape[:-1], 4))
@@ -469,12 +476,14 @@ def from_euler(seq: str, angles: ArrayLike, *, degrees: bool = False) -> np.ndar
     Intrinsic ``"IJK"`` (body axes): ``q = q_I(a) ⊗ q_J(b) ⊗ q_K(c)``;
     extrinsic ``"ijk"`` (inertial axes): ``q = q_k(c) ⊗ q_j(b) ⊗ q_i(a)``,
     the meaning of ``scipy.spatial.transform.Rotation.from_euler``.
-    Angles in rad, or degrees with ``degrees=True``.
+    Angles in rad, or degrees with ``degrees=True``; an angle past
+    :data:`_HUGE_ANGLE` (1e16 rad) is refused, as in :func:`from_rotvec`.
     """
     axes, intrinsic = _parse_seq(seq)
     rad: np.ndarray = as_array(angles, "angles", tail=(3,))
     if degrees:
         rad = np.deg2rad(rad)
+    _require_defined_angle(rad, "angles", "Euler angle")
     if not intrinsic:  # extrinsic ijk (a, b, c) = intrinsic KJI (c, b, a)
         axes, rad = axes[::-1], rad[..., ::-1]
     out = np.empty((math.prod(rad.shape[:-1]), 4))
@@ -500,7 +509,7 @@ def to_euler(q: ArrayLike, seq: str, *, degrees: bool = False) -> np.ndarray:
     rotations were affected.
     """
     axes, intrinsic = _parse_seq(seq)
-    q = _as_quat(q)
+    q = _scaled(_as_quat(q))
     if not intrinsic:  # extrinsic ijk (a, b, c) = intrinsic KJI (c, b, a)
         axes = axes[::-1]
     out = np.empty((math.prod(q.shape[:-1]), 3))
@@ -530,7 +539,7 @@ def to_scipy(q: ArrayLike) -> Rotation:
     """``scipy.spatial.transform.Rotation`` of the (batch of) quaternions ``q`` (…, 4), scalar first."""
     from scipy.spatial.transform import Rotation
 
-    return Rotation.from_quat(_as_quat(q), scalar_first=True)
+    return Rotation.from_quat(_scaled(_as_quat(q)), scalar_first=True)
 
 
 def from_scipy(rot: Rotation) -> np.ndarray:

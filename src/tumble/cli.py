@@ -326,6 +326,9 @@ def sweep_command(
 
             try:
                 client = Client(scheduler, timeout=30)
+            except ValueError as exc:  # distributed's parse of the address
+                raise ValidationError(f"--scheduler: must be a scheduler address such as tcp://host:8786, "
+                                      f"got {scheduler!r} ({exc})") from None
             except OSError as exc:
                 raise ValidationError(f"--scheduler: cannot reach {scheduler} ({exc})") from None
         try:

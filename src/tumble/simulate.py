@@ -31,6 +31,7 @@ from __future__ import annotations
 import abc
 import difflib
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple, TypedDict, overload
@@ -40,6 +41,7 @@ from numpy.typing import ArrayLike
 
 from tumble import _callback, attitude, integrate
 from tumble._validate import ValidationError, as_array, output_times, require_finite
+from tumble._vec import norm
 from tumble.trajectory import Extra, Trajectory
 
 if TYPE_CHECKING:
@@ -52,6 +54,10 @@ __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
 
 #: The largest |component| of an initial state (quaternions aside: normalised): its square stays finite in float64.
 _LARGEST_STATE = 1e150
+
+#: An initial quaternion whose length is within this of 1 is normalised silently (a unit quaternion typed to 7
+#: digits, or rounded by a computation); one further off is normalised with a NonUnitQuaternionWarning.
+UNIT_Q0_TOL = 1e-6
 
 #: Solver options when not given (those the method reads).
 DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
@@ -341,8 +347,10 @@ def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverge
         omega = None
     if omega is not None:
         rate = f" (|ω| = {np.linalg.norm(omega[0, b]):.3g} rad/s at t = {t[k - 1]:g} s, the last finite state)"
-    change = "tighten rtol/atol" if integrate.METHODS[diverged.method].adaptive else "reduce dt"
-    return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: {change} or check the torque")
+    m = integrate.METHODS[diverged.method]
+    change = ("tighten rtol/atol or check the torque" if m.adaptive else "reduce dt or check the torque" if m.stepper
+              else "check the initial state and the model")  # "exact": no step, no torque
+    return integrate.SolverError(f"{who}simulation diverged at t = {t[k]:g} s{rate}: {change}")
 
 
 #: Output words per member and time beyond the states: q (4), omega (3), energy (1), momentum (3).
@@ -425,9 +433,13 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
             arr = f.default  # checked when the field was made
         arrays[f.name] = arr
     if model.batch_size is not None:
-        sizes["body"] = model.batch_size
+        sizes["model"] = model.batch_size
     if len(set(sizes.values())) > 1:
-        raise ValidationError(f"batch sizes disagree: {sizes}")
+        first, n_first = next(iter(sizes.items()))
+        other, n_other = next((name, size) for name, size in sizes.items() if size != n_first)
+        raise ValidationError(f"{other}: a batch of {n_other} does not match the {n_first} of {first}; every "
+                              f"batched value (and the model's bodies) must have the same leading length "
+                              f"(batch sizes: {', '.join(f'{k} {v}' for k, v in sizes.items())})")
     n = next(iter(sizes.values()), None)
     return _broadcast(arrays, sizes), n
 
@@ -447,10 +459,25 @@ def _checked_value(f: StateField, value: ArrayLike) -> np.ndarray:
         raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
                               f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
     if f.quaternion:
-        if not (arr * arr).any(axis=-1).all():  # |q| = 0: every square is 0
+        if not arr.any(axis=-1).all():  # |q| = 0; any other finite q normalises (attitude._normalized scales it)
             raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
+        _warn_non_unit(arr, f.name)
         arr = attitude._normalized(arr)
     return arr
+
+
+def _warn_non_unit(q: np.ndarray, name: str) -> None:
+    """One :class:`~tumble.attitude.NonUnitQuaternionWarning` when a quaternion of ``q`` (…, 4) is further than
+    :data:`UNIT_Q0_TOL` from unit length (it is then normalised: the rotation of ``q / |q|`` is meant)."""
+    lengths = norm(q.reshape(-1, 4))
+    off = np.abs(lengths - 1.0)
+    if np.all(off <= UNIT_Q0_TOL):
+        return
+    k = int(np.argmax(off))
+    where = f"[{k}]" if q.ndim == 2 else ""
+    warnings.warn(f"{name}: |{name}{where}| = {lengths[k]:.17g} is not 1 (further than "
+                  f"{UNIT_Q0_TOL:g}): normalised to {name} / |{name}|; give a unit quaternion [w, x, y, z]",
+                  attitude.NonUnitQuaternionWarning, stacklevel=5)  # the caller of simulate
 
 
 def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str, np.ndarray]:

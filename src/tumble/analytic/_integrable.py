@@ -31,7 +31,14 @@ axes ``ω = (p, q, r)``, ``γ = (γ₁, γ₂, γ₃)``, and ``c = m g ℓ / C``
   (with ``z = p + i q``: ``ξ = z² − c (γ₁ + i γ₂)`` obeys ``ξ̇ = −i r ξ``, so ``|ξ|²`` is constant);
 * Goryachev–Chaplygin (1900), ``A = B = 4C``, on the level ``L_z = 0`` only:
 
-      G = r (p² + q²) − c p γ₃                                    (rad³/s³).
+      G = |r (p² + q²) − c p γ₃|                                  (rad³/s³).
+
+  The expression inside is odd in ``e₃``: reversing the symmetry axis (``r``,
+  ``γ₃`` change sign, ``p`` does not) reverses it. The top has no preferred
+  side of that axis — a half-turn about ``e₁`` maps the body, and its
+  centre of mass, onto itself — so the sign would be that of the body axes
+  chosen, not of the motion; its magnitude is conserved all the same, and is
+  what is returned.
 
 References: S. Kowalevski, "Sur le problème de la rotation d'un corps solide
 autour d'un point fixe", *Acta Math.* 12 (1889) 177; D. N. Goryachev, *Trudy
@@ -121,7 +128,12 @@ def kovalevskaya_invariant(inertia, gravity, omega, q) -> np.ndarray:
 
 
 def goryachev_chaplygin_invariant(inertia, gravity, omega, q) -> np.ndarray:
-    """The Goryachev–Chaplygin cubic invariant ``G = r (p² + q²) − c p γ₃``, rad³/s³, shape (…).
+    """The Goryachev–Chaplygin cubic invariant ``G = |r (p² + q²) − c p γ₃|``, rad³/s³, shape (…).
+
+    The magnitude: the expression is odd in the orientation of the symmetry
+    axis ``e₃``, which the top does not fix (module docstring), so that the
+    same motion described in body axes turned by a half-turn about ``e₁``
+    gives the same ``G``.
 
     The body must be a Goryachev–Chaplygin top: principal moments about the
     pivot ``A = B = 4C`` and the centre of mass in the equatorial plane, and
@@ -139,7 +151,7 @@ def goryachev_chaplygin_invariant(inertia, gravity, omega, q) -> np.ndarray:
         raise ValidationError(f"omega: the Goryachev-Chaplygin invariant holds on the zero level of the vertical "
                               f"momentum only (|L_z| <= {CASE_RTOL:g} |I omega|), got |L_z| = {worst:.3g} |I omega|")
     (p, q_, r), (_, _, g3) = _in_frame(frame, omega, q, gravity)
-    return r * (p * p + q_ * q_) - c * p * g3
+    return np.abs(r * (p * p + q_ * q_) - c * p * g3)
 
 
 # -- helpers ----------------------------------------------------------------------

@@ -312,10 +312,11 @@ def _raise_on_failure(stats, t, max_steps):
     b = int(bad[0])
     who = f"body {b}: " if stats.shape[0] > 1 else ""
     if stats[b, 3] == _dop853.STEP_TOO_SMALL:
-        raise SolverError(f"{who}the step size fell below the float64 resolution of t; "
-                          "the motion may be singular there, or loosen rtol/atol")
+        raise SolverError(f"{who}the step size fell below the float64 resolution of t; the motion may be "
+                          "singular there, or loosen rtol/atol (or, for times far from 0, shift them nearer to it)")
     if stats[b, 3] == _dop853.TOO_MANY_PROJECTED:
-        raise SolverError(f"{who}max_steps: the run would need {stats[b, 4]:.2g} steps or more to t={t[-1]:g} "
+        need = f"{stats[b, 4]:.2g}" if stats[b, 4] < np.inf else "more than 1e308"
+        raise SolverError(f"{who}max_steps: the run would need {need} steps or more to t={t[-1]:g} "
                           f"(projected from its first {int(stats[b, 0])} at their mean step size), more than "
                           f"max_steps = {max_steps:g}; shorten the run or loosen rtol/atol")
     raise SolverError(f"{who}max_steps={int(stats[b, 0])} reached before t={t[-1]}; raise max_steps "

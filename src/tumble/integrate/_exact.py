@@ -10,14 +10,21 @@ roundings at any time (Jacobi elliptic functions; :mod:`tumble._free_flow`).
 
 from __future__ import annotations
 
+import numpy as np
 from numba import njit, prange
 
 from tumble._protocol import free_evaluate, free_setup
+from tumble._validate import ValidationError
+from tumble._vec import norm
 
 #: Output times per task of the parallel loop: one task sets a body up (about a
 #: microsecond) and evaluates up to this many times, so that a single body with
 #: many times also runs on every core.
 CHUNK = 512
+
+#: The largest turn ``|ω| (t − t₀)`` (rad) the exact motion is evaluated over: past it float64 phases are 2 rad
+#: apart, so no attitude is defined (as :func:`tumble.attitude.from_rotvec` refuses such angles).
+MAX_TURN = 1e16
 
 
 @njit(cache=True)
@@ -44,7 +51,18 @@ def exact_batch(model, y, t, out):
 
 
 def run(model, y, t, out):
-    """Fill ``out`` (len(t), N, 7) with the exact states of the bodies ``y`` (N, 7) at ``t``."""
+    """Fill ``out`` (len(t), N, 7) with the exact states of the bodies ``y`` (N, 7) at ``t``.
+
+    A run over which a body would turn more than :data:`MAX_TURN` rad is refused, naming ``t``.
+    """
+    rate = float(norm(y[:, 4:]).max())
+    with np.errstate(over="ignore"):
+        turn = rate * (t[-1] - t[0])
+    if not turn <= MAX_TURN:
+        turned = f"{turn:.3g} rad" if turn < np.inf else "more than 1.8e308 rad"
+        raise ValidationError(f"t: the exact motion from t = {t[0]:g} to {t[-1]:g} s at |ω| = {rate:.3g} rad/s would "
+                              f"turn {turned}, past {MAX_TURN:g} rad, where float64 phases are 2 rad apart and define "
+                              "no attitude; shorten the span")
     tasks = y.shape[0] * -(-t.shape[0] // CHUNK)
     if tasks == 1:  # a short run of one body: no parallel region (its start-up dominates)
         exact_task(model, y, t, out, 0)

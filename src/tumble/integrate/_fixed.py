@@ -84,8 +84,8 @@ def landing_steps(t_out, dt: float, max_steps: int) -> tuple[np.ndarray, np.ndar
     more than ``max_steps``, before anything is integrated.
     """
     t_out = np.asarray(t_out, dtype=np.float64)
-    spans = t_out[1:] - t_out[:-1]
-    with np.errstate(over="ignore"):
+    with np.errstate(over="ignore"):  # a span past 1.8e308 (t from -1e308 to 1e308): inf steps, refused below
+        spans = t_out[1:] - t_out[:-1]
         counts = np.maximum(1.0, np.ceil(spans / dt - 1e-9))
     needed = math.fsum(counts)
     if not needed <= max_steps:

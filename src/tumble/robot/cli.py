@@ -12,6 +12,7 @@ line on stderr.
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 from typing import Annotated
@@ -37,11 +38,11 @@ def robot() -> None:
 
 
 def _vector(text: str | None, name: str, n: int) -> np.ndarray:
-    """Numbers separated by commas or spaces; ``None`` is n zeros."""
+    """Numbers separated by commas or spaces (an empty entry, as in ``"1,,2"``, is refused); ``None`` is n zeros."""
     if text is None:
         return np.zeros(n)
     try:
-        values = np.array([float(x) for x in text.replace(",", " ").split()])
+        values = np.array([float(x) for x in re.split(r"\s*,\s*|\s+", text.strip())])
     except ValueError:
         raise ValidationError(f"--{name}: must be numbers separated by commas, got {text!r}") from None
     if values.shape != (n,) or not np.isfinite(values).all():

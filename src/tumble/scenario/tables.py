@@ -278,25 +278,45 @@ class Time(_Table):
         if step is not None and {"start", "stop"} <= info.data.keys():
             n = _step_count(info.data["start"], info.data["stop"], step) + 1
             if n > MAX_SAMPLES:
-                raise ValueError(f"makes {n} output times, more than the limit {MAX_SAMPLES}; use a larger step")
+                # exact while float64 counts every whole number; past float64's range, said so
+                count = f"{n:.0f}" if n < 2**53 else f"{n:.3g}" if n < np.inf else "more than 1e308"
+                raise ValueError(f"makes {count} output times, more than the limit {MAX_SAMPLES}; use a larger step")
         return step
 
     def times(self) -> np.ndarray:
         """The output times: ``linspace(start, stop, samples)``, or ``start + k step`` up to ``stop``."""
         if self.samples is not None:
-            return np.linspace(self.start, self.stop, self.samples)
+            return _spaced(self.start, self.stop, self.samples)
         step = self.step
         assert step is not None  # the validator gives exactly one of samples and step
-        n = _step_count(self.start, self.stop, step)
+        n = int(_step_count(self.start, self.stop, step))  # at most MAX_SAMPLES (the validator)
         end = self.start + n * step
+        if not np.isfinite(end):  # n step overflows (start = -1e308): the same sum, from its halves
+            end = 2.0 * (0.5 * self.start + (0.5 * step) * n)
         if abs(end - self.stop) <= _STEP_ROUNDING * step:
             end = self.stop  # land exactly on stop despite rounding
-        return np.linspace(self.start, end, n + 1)
+        return _spaced(self.start, end, n + 1)
 
 
-def _step_count(start: float, stop: float, step: float) -> int:
-    """Number of whole steps from ``start`` that stay within ``stop`` (to rounding)."""
-    return int(np.floor((stop - start) / step + _STEP_ROUNDING))
+def _step_count(start: float, stop: float, step: float) -> float:
+    """Number of whole steps from ``start`` that stay within ``stop`` (to rounding), as a float: it may be
+    past any int (``step = 1e-300``; the validator refuses more than :data:`MAX_SAMPLES`)."""
+    span = stop - start
+    steps = span / step if np.isfinite(span) else stop / step - start / step  # stop - start past 1.8e308
+    return float(np.floor(steps + _STEP_ROUNDING))
+
+
+def _spaced(start: float, stop: float, n: int) -> np.ndarray:
+    """``n`` evenly spaced times from ``start`` to ``stop`` (s), ``np.linspace``'s. Where ``stop − start``
+    overflows float64 (``start = -1e308, stop = 1e308``), ``start + f (stop − start)`` is summed from the
+    halves of the difference, ``(start + f h) + f h`` with ``h = stop/2 − start/2``, which stay finite."""
+    if np.isfinite(stop - start):
+        return np.linspace(start, stop, n)
+    fraction = np.linspace(0.0, 1.0, n)
+    half = 0.5 * stop - 0.5 * start
+    times = (start + half * fraction) + half * fraction
+    times[-1] = stop
+    return times
 
 
 # --------------------------------------------------------------------------

@@ -61,7 +61,7 @@ def _trajectory(traj) -> Trajectory:
         return load(traj)
     except ValidationError as exc:
         cause = exc.__cause__  # load names the file; the error of the field it read is the cause
-        if isinstance(cause, ValidationError) and cause.field == "t" and "at least one time" in cause.rule:
+        if isinstance(cause, ValidationError) and cause.field == "t" and "got shape (0,)" in cause.rule:
             raise ValidationError(f"traj: {os.fspath(traj)!r} is an empty trajectory (no samples): nothing to show") \
                 from None
         raise ValidationError(f"traj: {os.fspath(traj)!r} is not a tumble trajectory ({exc})") from None
