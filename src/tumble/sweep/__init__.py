@@ -52,7 +52,7 @@ from tumble.sweep.outcomes import (
 )
 from tumble.sweep.plan import _is_builder, make_plan
 from tumble.sweep.runner import local_cluster, run_chunks
-from tumble.sweep.store import SweepStore
+from tumble.sweep.store import StoreMismatchError, SweepStore, writing
 
 if TYPE_CHECKING:
     import xarray
@@ -64,7 +64,7 @@ if TYPE_CHECKING:
     from tumble.simulate import Model
     from tumble.torques import TorqueLike
 
-__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
+__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "StoreMismatchError", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
            "Component", "Max", "Final", "SettlingTime", "CrossingTime"]
 
@@ -171,10 +171,11 @@ def sweep(
     plan = make_plan(model, dispersions or {}, samples=samples, seed=seed, chunk=chunk, t=times, method=m.name,
                      options=options, torque=torque, outcomes=dict(outcomes or {}), series=dict(statistics or {}),
                      fixed=initial_state, trajectories=trajectories)
-    result = SweepStore(store, plan)
-    computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
-    if computed or not result.complete or not result.has_percentiles(percentiles):
-        result.finalize(percentiles)
+    with writing(store):  # one writer at a time; the temporaries of killed runs removed
+        result = SweepStore(store, plan)
+        computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
+        if computed or not result.complete or not result.has_percentiles(percentiles):
+            result.finalize(percentiles)
     ds = result.dataset()
     ds.attrs["chunks_computed"] = computed
     return ds

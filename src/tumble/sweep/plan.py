@@ -196,8 +196,26 @@ class Plan:
         }
 
     def token(self) -> str:
-        """A short digest of :meth:`settings` (the Dask keys of this sweep's tasks)."""
+        """A short digest of :meth:`settings` (it names this sweep's Dask tasks)."""
         return hashlib.sha256(json.dumps(self.settings(), sort_keys=True).encode()).hexdigest()[:16]
+
+    def digest(self, *, strict: bool = True) -> str:
+        """A digest of everything the samples' results depend on, the same in every process: the whole plan
+        through :func:`dask.base.tokenize` (arrays by their bytes, dataclasses by their fields, other objects
+        and functions by their pickle: a model's data, a tabulated torque's values, a scenario's every table,
+        a lambda's code). :meth:`settings` shows what a person reads; this catches what it leaves out.
+
+        ``strict``: refuse a plan that does not pickle the same way twice (what a store records must be
+        found again when the sweep resumes); otherwise such a plan gets a digest of its own, never repeated."""
+        from dask.base import tokenize
+        from dask.tokenize import TokenizationError
+
+        try:
+            return tokenize(self, ensure_deterministic=strict)
+        except TokenizationError as exc:
+            raise ValidationError(f"store: this sweep cannot be recorded for resuming (its model, torque or "
+                                  f"functions do not pickle the same way twice: {exc}); run it without a store"
+                                  ) from None
 
 
 def _is_builder(model: object) -> TypeGuard[Callable[..., Any]]:

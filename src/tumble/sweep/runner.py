@@ -19,6 +19,7 @@ cancelled and the chunks already written stay in the store.
 from __future__ import annotations
 
 import os
+import uuid
 from collections.abc import Callable
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
@@ -120,12 +121,12 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         client = Client(cluster)
     elif workers is not None:
         raise ValidationError("workers: give it only without client= (a client's cluster has its own workers)")
-    token = plan.token()
+    # keys of this call alone: two sweeps on one scheduler never share a task, whatever their settings
+    run = f"tumble-sweep-{plan.token()}-{uuid.uuid4().hex}"
     futures = {}
     try:
         for k in missing:
-            futures[client.submit(_run_chunk, plan, k, key=f"tumble-sweep-{token}-{k}", retries=retries,
-                                  pure=False)] = k
+            futures[client.submit(_run_chunk, plan, k, key=f"{run}-{k}", retries=retries, pure=False)] = k
         done = total - len(missing)
         for future in as_completed(futures):
             store.write(futures[future], future.result())
