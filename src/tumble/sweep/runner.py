@@ -128,7 +128,7 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         for k in missing:
             futures[client.submit(_run_chunk, plan, k, key=f"{run}-{k}", retries=retries, pure=False)] = k
         done = total - len(missing)
-        for future in as_completed(futures):
+        for future in as_completed(futures, loop=client.loop):  # this client, default or not
             store.write(futures[future], future.result())
             future.release()
             done += 1

@@ -1,0 +1,199 @@
+"""Reliability of sweeps (issue 34): no silent wrong result from a sweep.
+
+Each test runs the real thing: sweeps in this process (``workers=0``) and on a
+``dask scheduler`` with a ``dask worker`` process started here on 127.0.0.1,
+stores on disk interrupted, damaged and resumed, processes killed with SIGKILL.
+Every result is compared bit for bit with the same sweep run whole in this
+process. docs/reliability.md lists the guarantee each test checks.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import cloudpickle
+import numpy as np
+import pytest
+
+import tumble
+from tumble import _callback
+from tumble.sweep import Component, CrossingTime, Final, Normal, NutationAngle, StoreMismatchError
+from tumble.sweep.store import writing
+
+distributed = pytest.importorskip("distributed")
+
+BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+T = np.linspace(0.0, 2.0, 11)
+OUTCOMES = {"nutation": Final(NutationAngle([0.0, 0.0, 1.0])), "omega_z": Final(Component("omega", 2))}
+RUN = dict(t=T, method="rk4", dt=0.01, outcomes=OUTCOMES, statistics={"omega_x": Component("omega", 0)})
+DISPERSIONS = {"omega0": Normal([0.0, 0.0, 1.0], [0.05, 0.05, 0.1])}
+N, CHUNK = 23, 5  # 5 chunks, the last one of 3 samples
+SRC = str(Path(tumble.__file__).parents[1])
+ENV = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", ""), "NUMBA_NUM_THREADS": "1"}
+TIMEOUT = 60  # s: the longest a step of these tests may take before it is counted as hung
+
+
+def tabulated(scale: float) -> tumble.torques.Tabulated:
+    """A body-axes torque ramp (N·m) over the run; ``scale`` changes its values only, not its repr."""
+    return tumble.torques.Tabulated([0.0, 2.0], scale * np.array([[0.0, 0.01, 0.1], [0.0, 0.03, 0.3]]))
+
+
+def assert_same(ds, reference):
+    assert ds.attrs["tumble_sweep_complete"]
+    for name in reference.data_vars:
+        np.testing.assert_array_equal(ds[name].values, reference[name].values, err_msg=name)
+
+
+def stop_after(n):
+    """A progress callback that interrupts the sweep (as Ctrl-C would) once ``n`` chunks are written."""
+
+    def progress(done, total):
+        if done >= n:
+            raise KeyboardInterrupt
+
+    return progress
+
+
+def stop(*processes):
+    """End processes this module started: SIGTERM to all, then SIGKILL to any not exited within 5 s."""
+    for process in processes:
+        if process.poll() is None:
+            process.terminate()
+    for process in processes:
+        try:
+            process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=20)
+
+
+@pytest.fixture(scope="module")
+def scheduler_file(tmp_path_factory):
+    """``dask scheduler`` and one ``dask worker`` process of 2 threads on 127.0.0.1, started and stopped here."""
+    path = tmp_path_factory.mktemp("dask") / "scheduler.json"
+    cli = [sys.executable, "-m"]
+    commands = [["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(path)],
+                ["distributed.cli.dask_worker", "--scheduler-file", str(path), "--host", "127.0.0.1", "--nthreads",
+                 "2", "--nworkers", "1", "--dashboard-address", "127.0.0.1:0"]]
+    processes = []
+    try:
+        for command in commands:
+            processes.append(subprocess.Popen(cli + command, env=ENV, stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL))
+        deadline = time.monotonic() + TIMEOUT
+        while not path.exists():
+            assert time.monotonic() < deadline, "the scheduler did not start"
+            time.sleep(0.1)
+        with distributed.Client(scheduler_file=str(path), timeout=TIMEOUT) as client:
+            client.wait_for_workers(1, timeout=TIMEOUT)
+        yield path
+    finally:  # the worker first: a worker whose scheduler is gone retries it before it exits
+        stop(*processes[1:])
+        stop(*processes[:1])
+
+
+# -- 1. two sweeps on one scheduler never share a task ------------------------------------
+
+# 4 chunks of 8 bodies, each 40 000 rk4 steps (about 0.1 s a chunk): the two sweeps' chunks are in flight together
+SLOW = dict(dispersions=DISPERSIONS, samples=32, seed=2, chunk=8, t=np.linspace(0.0, 10.0, 11), method="rk4",
+            dt=2.5e-4, outcomes=OUTCOMES)
+
+
+def test_two_sweeps_on_one_scheduler_at_once_each_keep_their_own_results(scheduler_file):
+    # the two differ only in a tabulated torque's values, which their recorded settings do not show: their
+    # tasks once had the same keys, and the second sweep's store silently held the first one's results
+    torques = (tabulated(1.0), tabulated(2.0))
+    alone = [tumble.sweep(BODY, torque=torque, workers=0, **SLOW) for torque in torques]
+    assert alone[0].attrs["tumble_sweep"] == alone[1].attrs["tumble_sweep"]
+    assert not np.array_equal(alone[0].omega_z.values, alone[1].omega_z.values)
+    together = threading.Barrier(2, timeout=TIMEOUT)
+    results: list = [None, None]
+
+    def run(j):
+        def submit_together(done, total):
+            if done == 0:
+                together.wait()  # both sweeps submit their chunks at the same time
+
+        # not the default client: two of them in threads would leave the last one's Dask setting behind
+        with distributed.Client(scheduler_file=str(scheduler_file), timeout=TIMEOUT, set_as_default=False) as client:
+            results[j] = tumble.sweep(BODY, torque=torques[j], client=client, progress=submit_together, **SLOW)
+
+    threads = [threading.Thread(target=run, args=(j,)) for j in range(2)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join(4 * TIMEOUT)
+    for ds, reference in zip(results, alone, strict=True):
+        assert_same(ds, reference)
+
+
+# -- 2. a store records the whole content of its sweep --------------------------------------
+
+
+def test_a_sweep_resumed_after_its_torque_table_changed_is_refused_and_unchanged_equals_a_whole_run(tmp_path):
+    store = tmp_path / "mc.zarr"
+    args = dict(samples=N, seed=1, chunk=CHUNK, **RUN)
+    whole = tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.0), workers=0, **args)
+    with pytest.raises(KeyboardInterrupt):
+        tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.0), workers=0, store=store, progress=stop_after(2), **args)
+    done = tumble.sweep.open_sweep(store).done.values.tolist()
+    assert done == [True, True, False, False, False]
+    with pytest.raises(StoreMismatchError, match=r"^store: .*mc\.zarr was written by another sweep: the settings "
+                                                 r"agree but not the content .* delete the store"):
+        tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.5), workers=0, store=store, **args)
+    assert tumble.sweep.open_sweep(store).done.values.tolist() == done  # left alone
+    resumed = tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.0), workers=0, store=store, **args)
+    assert resumed.attrs["chunks_computed"] == 3
+    assert_same(resumed, whole)
+
+
+SCENARIO = textwrap.dedent("""
+    [body]
+    inertia = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.5]]
+    [initial]
+    omega = [0.0, 0.0, 1.0]
+    [time]
+    stop = 1.0
+    step = 0.5
+    [solver]
+    method = "rk4"
+    dt = 0.01
+    [[torque]]
+    kind = "tabulated"
+    times = [0.0, 1.0]
+    values = [[0.0, 0.0, {value}], [0.0, 0.0, 0.2]]
+    [sweep]
+    samples = 4
+    [sweep.dispersions]
+    "body.inertia" = {{ inertia = {{ moments = [1.0, 2.0, 2.5], std = [0.02, 0.02, 0.03], angle = 0.01 }} }}
+    [sweep.outcomes]
+    omega_z = {{ series = "component", name = "omega", index = 2, reduce = "final" }}
+""")
+
+
+def test_a_scenario_whose_tables_changed_beyond_its_recorded_settings_has_another_digest(tmp_path):
+    # a dispersed non-state key rebuilds the model per sample from the file: the recorded settings name the
+    # file, the keys and the torque's kind only; the digest holds every table of the file
+    from tumble.scenario.sweep import sweep_arguments
+    from tumble.sweep.plan import make_plan
+
+    path = tmp_path / "spinner.toml"
+    plans = []
+    for value in (0.1, 0.15):
+        path.write_text(SCENARIO.format(value=value))
+        a = sweep_arguments(tumble.scenario.load(path))
+        plans.append(make_plan(a.pop("model"), a.pop("dispersions"), samples=a.pop("samples"), seed=a.pop("seed"),
+                               chunk=a.pop("chunk"), t=a.pop("t"), method=a.pop("method"), options={"dt": 0.01},
+                               torque=a.pop("torque"), outcomes=a.pop("outcomes"), series=a.pop("statistics"),
+                               fixed={"omega0": a["omega0"]}))
+    assert plans[0].settings() == plans[1].settings()
+    assert plans[0].digest() != plans[1].digest()
