@@ -197,3 +197,112 @@ def test_a_scenario_whose_tables_changed_beyond_its_recorded_settings_has_anothe
                                fixed={"omega0": a["omega0"]}))
     assert plans[0].settings() == plans[1].settings()
     assert plans[0].digest() != plans[1].digest()
+
+
+# -- 3. a Python function in a model runs on a Dask worker --------------------------------
+
+
+def test_a_python_callback_pickled_to_another_process_registers_there_under_its_own_slot():
+    torque = tabulated(1.0) + tumble.torques.PythonTorque(lambda t, q, omega: np.array([0.0, 0.0, 0.1 * t]))
+    copy = pickle.loads(cloudpickle.dumps(torque))
+    original, arrived = torque.terms()[1].callback, copy.terms()[1].callback
+    assert arrived.slot != original.slot  # registered again, as a worker process would
+    assert _callback._ENTRIES[arrived.slot].function is arrived.function
+    # at 0.5 s: a quarter of the ramp from [0, 0.01, 0.1] to [0, 0.03, 0.3], and 0.05 N·m from the function
+    np.testing.assert_allclose(copy(0.5, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), [0.0, 0.015, 0.2], rtol=1e-15)
+
+
+def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in_this_one(scheduler_file):
+    # the function's slot was a number of the client's registry: the worker raised KeyError, or called another
+    # function registered there under the same number
+    def spin_up(t, q, omega):
+        return np.array([0.0, 0.0, 0.05 * t])
+
+    def decoys():  # in the worker: its first callback slots taken by other functions (1 N·m about x)
+        import tumble._callback as registry
+
+        registry.decoys = [registry.Callback(lambda t, q, omega: [1.0, 0.0, 0.0], field="torque",
+                                             signature="(t, q, omega)", returns="3 numbers") for _ in range(64)]
+        return len(registry._ENTRIES)
+
+    torque = tabulated(1.0) + spin_up
+    args = dict(dispersions=DISPERSIONS, samples=8, seed=4, chunk=2, torque=torque, **RUN)
+    reference = tumble.sweep(BODY, workers=0, **args)
+    with distributed.Client(scheduler_file=str(scheduler_file), timeout=TIMEOUT) as client:
+        assert all(n >= 64 for n in client.run(decoys).values())
+        ds = tumble.sweep(BODY, client=client, **args)
+    assert_same(ds, reference)
+
+
+# -- 4. a lost chunk file is computed again ---------------------------------------------
+
+
+def test_a_complete_store_that_lost_a_chunk_file_computes_that_chunk_again(tmp_path):
+    store = tmp_path / "mc.zarr"
+    outcomes = {**OUTCOMES, "never": CrossingTime(Component("omega", 2), above=100.0)}  # NaN in every sample
+    args = dict(samples=N, seed=1, chunk=CHUNK, **{**RUN, "outcomes": outcomes}, workers=0)
+    whole = tumble.sweep(BODY, DISPERSIONS, store=store, **args)
+    assert np.isnan(whole.never.values).all()
+    again = tumble.sweep(BODY, DISPERSIONS, store=store, **args)
+    assert again.attrs["chunks_computed"] == 0  # chunks of NaN (the fill value) are files too
+    os.remove(store / "omega_z" / "c" / "3")  # chunk 3 of an outcome, samples 15 to 19
+    damaged = tumble.sweep.open_sweep(store)
+    assert np.isnan(damaged.omega_z.values[15:20]).all() and damaged.done.values.all()  # what resuming once read
+    resumed = tumble.sweep(BODY, DISPERSIONS, store=store, **args)
+    assert resumed.attrs["chunks_computed"] == 1
+    assert_same(resumed, whole.load())
+
+
+# -- 5. percentiles changed on a complete store ---------------------------------------------
+
+
+def test_other_percentiles_on_a_complete_store_replace_its_statistics(tmp_path):
+    store = tmp_path / "mc.zarr"
+    args = dict(samples=N, seed=1, chunk=CHUNK, **RUN, workers=0)
+    first = tumble.sweep(BODY, DISPERSIONS, store=store, **args)
+    again = tumble.sweep(BODY, DISPERSIONS, store=store, percentiles=[10, 90], **args)
+    assert again.attrs["chunks_computed"] == 0 and again.percentile.values.tolist() == [10.0, 90.0]
+    np.testing.assert_array_equal(again.omega_z_percentiles.values,
+                                  np.percentile(first.omega_z.values, [10, 90]))
+    np.testing.assert_array_equal(again.omega_x_percentiles.values,
+                                  np.percentile(first.omega_x.values, [10, 90], axis=0))
+
+
+# -- 7. temporaries of killed runs ------------------------------------------------------------
+
+KILLED = textwrap.dedent("""
+    import numpy as np, tumble
+    # 2000 bodies x 4001 output times: chunks of 131 bodies, one written at a time
+    tumble.simulate(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), np.tile([0.1, 0.0, 1.0], (2000, 1)),
+                    t=np.linspace(0.0, 40.0, 4001), method="rk4", dt=0.01, store={store!r})
+""")
+
+
+def test_a_store_killed_mid_run_leaves_a_temporary_that_the_next_run_removes(tmp_path):
+    store = tmp_path / "run.zarr"
+    process = subprocess.Popen([sys.executable, "-c", KILLED.format(store=str(store))], env=ENV,
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + TIMEOUT
+        while not list(tmp_path.glob(".run.zarr.*.tmp/q/c/0/1/0")):  # a chunk after the first written
+            assert process.poll() is None, process.stderr.read().decode()
+            assert time.monotonic() < deadline, "the run wrote no chunk"
+            time.sleep(0.02)
+        process.send_signal(signal.SIGKILL)
+        process.wait(timeout=TIMEOUT)
+    finally:
+        stop(process)
+        process.stderr.close()
+    assert not store.exists() and len(list(tmp_path.glob(".run.zarr.*.tmp"))) == 1
+    tumble.simulate(BODY, np.tile([0.1, 0.0, 1.0], (3, 1)), t=T, method="rk4", dt=0.01, store=store)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.zarr"]
+
+
+def test_a_live_writers_temporary_is_left_alone_and_a_second_writer_refused(tmp_path):
+    store = tmp_path / "mc.zarr"
+    with writing(store):  # a live writer: holds the lock, its temporary in use
+        live = tmp_path / ".mc.zarr.live.tmp"
+        live.mkdir()
+        with pytest.raises(FileExistsError, match=r"mc\.zarr: another process is writing it now"):
+            tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=CHUNK, store=store, **RUN, workers=0)
+        assert live.is_dir() and not store.exists()
