@@ -306,3 +306,65 @@ def test_a_live_writers_temporary_is_left_alone_and_a_second_writer_refused(tmp_
         with pytest.raises(FileExistsError, match=r"mc\.zarr: another process is writing it now"):
             tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=CHUNK, store=store, **RUN, workers=0)
         assert live.is_dir() and not store.exists()
+
+
+# -- 5. a [sweep] table the sweep would fail on is refused before any chunk runs ------------------
+
+TABLE = textwrap.dedent("""
+    [body]
+    inertia = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.5]]
+    [initial]
+    omega = [0.0, 0.0, 1.0]
+    [time]
+    stop = 1.0
+    step = 0.5
+    [solver]
+    method = "rk4"
+    dt = 0.01
+    [sweep]
+    samples = 4
+    chunk = 2
+    [sweep.dispersions]
+    "initial.omega" = { normal = { mean = [0.0, 0.0, 1.0], std = [0.02, 0.02, 0.01] } }
+""")
+
+
+@pytest.mark.parametrize("table, message", [
+    ('[sweep.outcomes]\ndone = { series = "nutation_angle", reduce = "max" }',
+     "sweep.outcomes.done: 'done' is a variable of the store itself"),
+    ('[sweep.outcomes]\nsample = { series = "nutation_angle", reduce = "max" }',
+     "sweep.outcomes.sample: 'sample' is a variable of the store itself"),
+    ('[sweep.outcomes]\na = { series = "nutation_angle", reduce = "max" }\n'
+     'a_percentiles = { series = "nutation_angle", reduce = "final" }',
+     "sweep.outcomes.a_percentiles: names ending in _percentiles, _count, _mean, _std, _min, _max or holding "
+     "'_dim' are the store's statistics"),
+    ('[sweep.statistics]\nx_mean = { series = "nutation_angle" }', "sweep.statistics.x_mean: names ending in"),
+    ('[sweep.outcomes]\na = { series = "component", name = "wheel_speed", reduce = "max" }',
+     "sweep.outcomes.a: component: name: the trajectory has no sampled field 'wheel_speed' (it has energy, "
+     "momentum_body, momentum_inertial, omega, q)"),
+    ('[sweep.outcomes]\na = { series = "component", name = "omega", index = 3, reduce = "final" }',
+     "sweep.outcomes.a: component: index: omega has components of shape (3,): give one index per axis, each in "
+     "range, got [3]"),
+    ('[sweep.statistics]\na = { series = "component", name = "omega" }',
+     "sweep.statistics.a: component: index: omega has components of shape (3,)"),
+    ('[sweep.dispersions."body.inertia[0]"]\ngrid = [1.0, 1.1]',
+     "sweep.dispersions.body.inertia[0]: a dispersion replaces a whole value, named by its dotted key"),
+])
+def test_a_sweep_table_that_would_fail_after_its_chunks_is_refused_naming_the_key(tmp_path, table, message):
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    scenario = tmp_path / "bad.toml"
+    scenario.write_text(TABLE + table + "\n")
+    result = CliRunner().invoke(app, ["sweep", str(scenario), "-o", str(tmp_path / "out.zarr"), "--workers", "0"])
+    assert result.exit_code == 2, result.output
+    assert f"error: {scenario}: {message}" in result.output.replace("\n", " ")
+    assert sorted(os.listdir(tmp_path)) == ["bad.toml"]
+
+
+def test_outcome_names_of_the_stores_own_variables_are_refused_by_the_function_too():
+    for name in ("done", "time", "nutation_count", "w_dim0"):
+        with pytest.raises(tumble.ValidationError, match=rf"^outcomes\['{name}'\]: .*; give another name$"):
+            tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, t=T, method="rk4", dt=0.01, workers=0,
+                         outcomes={name: Final(NutationAngle())})

@@ -352,13 +352,36 @@ def _check_inertia(d: Dispersion) -> None:
                               f"Grid of (3, 3) tensors (kg m^2), got {type(d).__name__} of shape {d.shape}")
 
 
+#: Names of the store's own variables and dimensions, and the suffixes of the variables it derives from an
+#: outcome or a series (:mod:`tumble.sweep.store`): no outcome or series may take them.
+STORE_NAMES = ("sample", "time", "percentile", "chunk", "done")
+DERIVED_SUFFIXES = ("_percentiles", "_count", "_mean", "_std", "_min", "_max")
+
+
+def store_name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name an outcome or a series (it is, or may become, another variable of the store),
+    or None."""
+    if not str(name).isidentifier():
+        return "must be an identifier"
+    if name in STORE_NAMES:
+        return f"{name!r} is a variable of the store itself ({', '.join(STORE_NAMES)})"
+    suffix = next((s for s in DERIVED_SUFFIXES if name.endswith(s)), None)
+    if suffix is not None or "_dim" in name:
+        return (f"names ending in {', '.join(DERIVED_SUFFIXES)} or holding '_dim' are the store's statistics "
+                f"and dimensions of other outcomes")
+    return None
+
+
 def _check_reductions(outcomes: dict, series: dict, dispersions: dict, trajectories: bool) -> None:
-    """Outcome and series names: identifiers, none the name of a dispersed input, of each other or of a
-    kept trajectory field; each function describable in the store."""
+    """Outcome and series names: identifiers, none a name of the store's own (:func:`store_name_problem`), of
+    a dispersed input, of each other or of a kept trajectory field; each function describable in the store."""
     taken = set(dispersions) | ({"q", "omega", "energy", "momentum_body"} if trajectories else set())
     for group, kind in ((outcomes, "outcomes"), (series, "statistics")):
         for name, f in group.items():
-            if not str(name).isidentifier() or name in taken or (kind == "statistics" and name in outcomes):
-                raise ValidationError(f"{kind}[{name!r}]: names must be identifiers, different from the "
-                                      f"dispersed inputs and from each other")
+            problem = store_name_problem(name)
+            if problem is not None:
+                raise ValidationError(f"{kind}[{name!r}]: {problem}; give another name")
+            if name in taken or (kind == "statistics" and name in outcomes):
+                raise ValidationError(f"{kind}[{name!r}]: names must be different from the dispersed inputs "
+                                      f"and from each other")
             describe(f)
