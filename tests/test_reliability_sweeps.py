@@ -368,3 +368,47 @@ def test_outcome_names_of_the_stores_own_variables_are_refused_by_the_function_t
         with pytest.raises(tumble.ValidationError, match=rf"^outcomes\['{name}'\]: .*; give another name$"):
             tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, t=T, method="rk4", dt=0.01, workers=0,
                          outcomes={name: Final(NutationAngle())})
+
+
+# -- 6. Ctrl-C during tumble sweep ----------------------------------------------------------------
+
+SLOW_SPINNER = TABLE.replace("stop = 1.0", "stop = 100.0").replace("dt = 0.01", "dt = 0.0005").replace(
+    "samples = 4\nchunk = 2", "samples = 64\nchunk = 4") + ('[sweep.outcomes]\n'
+                                                         'nutation = { series = "nutation_angle", reduce = "max" }\n')
+
+
+@pytest.mark.slow
+def test_ctrl_c_during_tumble_sweep_is_one_line_and_exit_130_and_the_store_resumes(tmp_path):
+    # a terminal's Ctrl-C reaches the whole process group: the command and its local cluster's workers
+    scenario, store = tmp_path / "spinner.toml", tmp_path / "out.zarr"
+    scenario.write_text(SLOW_SPINNER)
+    process = subprocess.Popen([sys.executable, "-m", "tumble", "sweep", str(scenario), "-o", str(store), "-q",
+                                "--workers", "2"], env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 4 * TIMEOUT
+        while _done(store) < 1:
+            assert process.poll() is None, process.stderr.read()
+            assert time.monotonic() < deadline, "the sweep wrote no chunk"
+            time.sleep(0.02)
+        os.killpg(process.pid, signal.SIGINT)
+        _, stderr = process.communicate(timeout=TIMEOUT)
+    finally:
+        stop(process)
+    assert process.returncode == 130
+    assert stderr.splitlines() == [f"error: interrupted; the chunks written are kept in {store}: the same command "
+                                   "resumes the sweep"]
+    written = _done(store)
+    assert 1 <= written < 16
+    resumed = tumble.sweep.sweep_scenario(scenario, store=store, workers=0)
+    assert resumed.attrs["chunks_computed"] == 16 - written
+    assert_same(resumed, tumble.sweep.sweep_scenario(scenario, workers=0))
+
+
+def _done(store):
+    """Chunks marked done in the store (0 while it does not exist)."""
+    if not store.exists():
+        return 0
+    import zarr
+
+    return int(np.sum(zarr.open_group(store, mode="r")["done"][:]))

@@ -19,6 +19,8 @@ cancelled and the chunks already written stay in the store.
 from __future__ import annotations
 
 import os
+import signal
+import threading
 import uuid
 from collections.abc import Callable
 from contextlib import contextmanager
@@ -50,9 +52,26 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     from distributed import LocalCluster
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
-    with _glibc_malloc_defaults():
+    with _glibc_malloc_defaults(), _interrupts_ignored():
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
                             dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
+
+
+@contextmanager
+def _interrupts_ignored():
+    """Worker processes spawned inside ignore SIGINT: Ctrl-C in a terminal reaches every process of its group,
+    and is the client's to handle (it cancels the chunks in flight and closes the cluster); a worker that took
+    it printed Dask's tracebacks, 60-90 lines. An ignored signal stays ignored across ``exec`` and Python
+    leaves it so. This process's handler comes back after (from the main thread only: elsewhere nothing is
+    changed)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager
