@@ -412,3 +412,21 @@ def _done(store):
     import zarr
 
     return int(np.sum(zarr.open_group(store, mode="r")["done"][:]))
+
+
+# -- 9. the default chunk shares a small sweep between the workers ---------------------------------
+
+
+def test_a_small_sweeps_default_chunk_gives_every_worker_a_chunk_and_a_resume_keeps_it(scheduler_file, tmp_path):
+    store = tmp_path / "mc.zarr"
+    args = dict(dispersions=DISPERSIONS, samples=N, seed=1, **RUN)
+    whole = tumble.sweep(BODY, workers=0, **args)
+    assert whole.attrs["tumble_sweep"]["chunk"] == N  # one worker: one chunk
+    with distributed.Client(scheduler_file=str(scheduler_file), timeout=TIMEOUT) as client:
+        assert sum(client.nthreads().values()) == 2
+        ds = tumble.sweep(BODY, client=client, store=store, **args)
+    assert ds.attrs["tumble_sweep"]["chunk"] == 12 and ds.done.size == 2  # ceil(23 / 2): a chunk per thread
+    per_sample = [name for name, v in whole.data_vars.items() if v.dims[:1] == ("sample",)]
+    assert_same(ds, whole[per_sample])  # the same samples, whatever the chunks (their moments merge otherwise)
+    resumed = tumble.sweep(BODY, workers=0, store=store, **args)  # the store's chunk, not one of 23 samples
+    assert resumed.attrs["chunks_computed"] == 0 and resumed.attrs["tumble_sweep"]["chunk"] == 12

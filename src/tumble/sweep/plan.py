@@ -263,12 +263,13 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
               chunk: int | None, t: np.ndarray, method: str, options: dict[str, Any], torque: TorqueLike | ArrayLike,
               outcomes: dict[str, Callable[[Trajectory], np.ndarray]],
               series: dict[str, Callable[[Trajectory], np.ndarray]], fixed: Mapping[str, ArrayLike],
-              trajectories: bool = False) -> Plan:
-    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
+              trajectories: bool = False, parallel: int = 1) -> Plan:
+    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`); ``parallel``: the
+    chunks the cluster runs at once (for the default chunk)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
     drawn = {str(name): as_dispersion(d, name) for name, d in dispersions.items()}
-    samples, chunk = _sizes(drawn, samples, chunk, len(t))
+    samples, chunk = _sizes(drawn, samples, chunk, len(t), parallel)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
     builder = _is_builder(model)
@@ -296,9 +297,10 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
                 outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
 
 
-def _sizes(dispersions: dict, samples, chunk, n_times: int) -> tuple[int, int]:
+def _sizes(dispersions: dict, samples, chunk, n_times: int, parallel: int) -> tuple[int, int]:
     """The number of samples (default: one per grid point when every dispersion is a grid) and the chunk
-    (default: :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
+    (default: the samples shared evenly between ``parallel`` workers, and at most
+    :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
     if samples is None:
         if not any(isinstance(d, Grid) for d in dispersions.values()) or any(d.n_raw for d in dispersions.values()):
             raise ValidationError("samples: needed unless every dispersion is a grid (then one sample per point)")
@@ -309,7 +311,7 @@ def _sizes(dispersions: dict, samples, chunk, n_times: int) -> tuple[int, int]:
     if chunk is None:
         from tumble.ensemble import SAMPLES_PER_CHUNK
 
-        chunk = max(1, min(samples, SAMPLES_PER_CHUNK // n_times))
+        chunk = max(1, min(math.ceil(samples / parallel), SAMPLES_PER_CHUNK // n_times))
     if int(chunk) < 1:
         raise ValidationError(f"chunk: must be >= 1 sample, got {chunk}")
     return samples, int(chunk)

@@ -79,7 +79,7 @@ from tumble._validate import ValidationError
 from tumble.ensemble import STATISTICS, _merge, moments
 from tumble.sweep.plan import ChunkResult, Plan
 
-__all__ = ["SweepStore", "StoreMismatchError", "writing", "SETTINGS_ATTR", "DIGEST_ATTR", "COMPLETE_ATTR"]
+__all__ = ["SweepStore", "StoreMismatchError", "stored_chunk", "writing", "SETTINGS_ATTR", "DIGEST_ATTR", "COMPLETE_ATTR"]
 
 #: Group attributes: the sweep's settings, the digest of its content, and whether its statistics are written.
 SETTINGS_ATTR = "tumble_sweep"
@@ -110,6 +110,18 @@ def writing(path: str | os.PathLike[str] | None) -> Iterator[None]:
         for stale in glob.glob(os.path.join(glob.escape(directory), f".{glob.escape(name)}.*.tmp")):
             shutil.rmtree(stale, ignore_errors=True)
         yield
+
+
+def stored_chunk(path: str | os.PathLike[str]) -> int | None:
+    """The chunk of the sweep stored at ``path``, or None where there is no readable sweep store."""
+    import zarr
+
+    try:
+        settings = dict(zarr.open_group(os.fspath(path), mode="r", zarr_format=3).attrs).get(SETTINGS_ATTR)
+    except Exception:  # noqa: BLE001 - not a store: the sweep refuses it in SweepStore, naming why
+        return None
+    chunk = settings.get("chunk") if isinstance(settings, dict) else None
+    return chunk if isinstance(chunk, int) and not isinstance(chunk, bool) else None
 
 
 def temporary(path: str) -> str:
