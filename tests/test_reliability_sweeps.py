@@ -430,3 +430,32 @@ def test_a_small_sweeps_default_chunk_gives_every_worker_a_chunk_and_a_resume_ke
     assert_same(ds, whole[per_sample])  # the same samples, whatever the chunks (their moments merge otherwise)
     resumed = tumble.sweep(BODY, workers=0, store=store, **args)  # the store's chunk, not one of 23 samples
     assert resumed.attrs["chunks_computed"] == 0 and resumed.attrs["tumble_sweep"]["chunk"] == 12
+
+
+# -- 8. a sweep too big for this process is refused before it holds anything --------------------------
+
+
+@pytest.mark.parametrize("store", [None, "mc.zarr"])
+def test_a_sweep_whose_index_and_outcomes_outgrow_memory_is_refused_at_once(tmp_path, store):
+    # 1e13 samples: the sample index alone is 80 TB
+    with pytest.raises(tumble.ValidationError, match=r"^samples: 10000000000000 samples \(the store's sample index "
+                                                     r"and the outcomes' percentiles.*\) need \d+\.\d [TP]iB .*more than "
+                                                     r"half this machine's memory"):
+        tumble.sweep(BODY, DISPERSIONS, samples=10**13, seed=1, store=None if store is None else tmp_path / store,
+                     **RUN, workers=0)
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_sweep_of_more_chunks_than_its_window_holds_a_window_of_tasks_at_a_time(scheduler_file):
+    # 40 chunks of one sample, a window of 32 (tumble.sweep.runner.IN_FLIGHT): each completed chunk submits one
+    args = dict(dispersions=DISPERSIONS, samples=40, seed=1, chunk=1, **RUN)
+    reference = tumble.sweep(BODY, workers=0, **args)
+    held = []
+    with distributed.Client(scheduler_file=str(scheduler_file), timeout=TIMEOUT) as client:
+        def count(done, total):
+            held.append(client.run_on_scheduler(lambda dask_scheduler: sum(
+                key.startswith("tumble-sweep-") for key in map(str, dask_scheduler.tasks))))
+
+        ds = tumble.sweep(BODY, client=client, progress=count, **args)
+    assert_same(ds, reference)
+    assert max(held) <= 32 and held[0] == 0 and len(held) == 41

@@ -28,7 +28,7 @@ import types
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
-from tumble._validate import ValidationError, output_times
+from tumble._validate import ValidationError, output_times, require_memory
 from tumble.simulate import _solver_options, as_model
 from tumble.sweep.dispersions import (
     Dispersion,
@@ -176,6 +176,9 @@ def sweep(
     plan = make_plan(model, dispersions or {}, samples=samples, seed=seed, chunk=chunk, t=times, method=m.name,
                      options=options, torque=torque, outcomes=dict(outcomes or {}), series=dict(statistics or {}),
                      fixed=initial_state, trajectories=trajectories, parallel=_parallel(client, workers))
+    require_memory(plan.client_bytes(in_memory=store is None), "samples",
+                   f"{plan.samples} samples (the store's sample index and the outcomes' percentiles"
+                   f"{'; in memory, every value kept' if store is None else ''})")
     with writing(store):  # one writer at a time; the temporaries of killed runs removed
         result = SweepStore(store, plan)
         computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)

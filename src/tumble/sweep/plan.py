@@ -172,6 +172,17 @@ class Plan:
                                              _members(state, m).items()}) for j, model in enumerate(models)]
         return _stack(members)
 
+    def client_bytes(self, *, in_memory: bool) -> float:
+        """A lower bound of the bytes the client process holds at once for the whole sweep (float64 words):
+        the store's sample index, and each outcome read whole for its percentiles (its values and NumPy's
+        partitioned copy); in memory, also every value kept per sample (the dispersed inputs, the outcomes,
+        the series per output time and, with ``trajectories``, at least 11 words per output time)."""
+        words = 1 + 2 * len(self.outcomes)
+        if in_memory:
+            words += (sum(math.prod(d.shape) for d in self.dispersions.values()) + len(self.outcomes)
+                      + len(self.t) * (len(self.series) + (11 if self.trajectories else 0)))
+        return 8.0 * float(self.samples) * words
+
     # -- what the store records -------------------------------------------------------
 
     def settings(self) -> dict:

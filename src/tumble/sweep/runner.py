@@ -10,6 +10,10 @@ machines, dask-jobqueue, Kubernetes): only the chunks' small results travel
 back to the client, which writes them to the store, so the workers need no
 shared file system.
 
+The chunks are submitted as a window that moves as they complete (four per
+worker thread, at least :data:`IN_FLIGHT`), so that a sweep of millions of
+chunks holds a few of them at a time on the client and the scheduler.
+
 A task that fails with an exception is retried ``retries`` times; a task whose
 worker dies (killed, out of memory) is given to another worker by the
 scheduler, as Dask does for every task. On Ctrl-C the tasks not finished are
@@ -18,6 +22,7 @@ cancelled and the chunks already written stay in the store.
 
 from __future__ import annotations
 
+import itertools
 import os
 import signal
 import threading
@@ -36,6 +41,9 @@ if TYPE_CHECKING:
 __all__ = ["local_cluster", "run_chunks"]
 
 _TRIM = "MALLOC_TRIM_THRESHOLD_"  # glibc's malloc setting that Dask gives its workers
+#: The fewest chunks submitted at once (else four per worker thread): more are submitted as these complete,
+#: so that the client and the scheduler hold a window of the sweep's tasks, not millions of them.
+IN_FLIGHT = 32
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
@@ -142,14 +150,24 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         raise ValidationError("workers: give it only without client= (a client's cluster has its own workers)")
     # keys of this call alone: two sweeps on one scheduler never share a task, whatever their settings
     run = f"tumble-sweep-{plan.token()}-{uuid.uuid4().hex}"
-    futures = {}
+    futures: dict = {}  # the chunks in flight: future → chunk
+
+    def submit(k: int):
+        future = client.submit(_run_chunk, plan, k, key=f"{run}-{k}", retries=retries, pure=False)
+        futures[future] = k
+        return future
+
+    todo = iter(missing)
+    window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))
     try:
-        for k in missing:
-            futures[client.submit(_run_chunk, plan, k, key=f"{run}-{k}", retries=retries, pure=False)] = k
+        queue = as_completed([submit(k) for k in itertools.islice(todo, window)], loop=client.loop)
         done = total - len(missing)
-        for future in as_completed(futures, loop=client.loop):  # this client, default or not
-            store.write(futures[future], future.result())
+        for future in queue:  # on this client, default or not
+            store.write(futures.pop(future), future.result())
             future.release()
+            following = next(todo, None)
+            if following is not None:
+                queue.add(submit(following))
             done += 1
             if progress is not None:
                 progress(done, total)
