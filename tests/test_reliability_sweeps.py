@@ -212,6 +212,20 @@ def test_a_python_callback_pickled_to_another_process_registers_there_under_its_
     np.testing.assert_allclose(copy(0.5, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), [0.0, 0.015, 0.2], rtol=1e-15)
 
 
+def test_a_spacecraft_pickled_after_compiling_its_python_law_compiles_it_again_with_its_own_slot():
+    # the compiled programs (a cached property) held the client's slot number: they are left out of the pickle
+    from tumble.spacecraft import Spacecraft, pyramid_wheels
+
+    craft = Spacecraft(inertia=np.diag([10.0, 12.0, 8.0]), wheels=pyramid_wheels(0.02),
+                       controller=lambda t, q, omega, wheel_speeds: -omega)
+    compiled = craft._programs  # what a run in this process computes and caches
+    copy = pickle.loads(cloudpickle.dumps(craft))
+    law, arrived = craft.controller[0], copy.controller[0]
+    assert "_programs" not in vars(copy) and arrived.callback.slot != law.callback.slot
+    slots = [int(p.params[0]) for p in copy._programs if p.kind == "python_law"]
+    assert slots == [arrived.callback.slot] and [p.kind for p in compiled] == [p.kind for p in copy._programs]
+
+
 def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in_this_one(scheduler_file):
     # the function's slot was a number of the client's registry: the worker raised KeyError, or called another
     # function registered there under the same number
