@@ -156,6 +156,18 @@ def test_a_sweep_resumed_after_its_torque_table_changed_is_refused_and_unchanged
     assert_same(resumed, whole)
 
 
+def test_a_store_without_a_content_digest_is_refused_as_unverifiable(tmp_path):
+    import zarr
+
+    store = tmp_path / "mc.zarr"
+    args = dict(samples=N, seed=1, chunk=CHUNK, store=store, workers=0, **RUN)
+    tumble.sweep(BODY, DISPERSIONS, **args)
+    del zarr.open_group(store, mode="r+").attrs["tumble_sweep_digest"]  # as an earlier tumble wrote it
+    with pytest.raises(StoreMismatchError, match=r"^store: .*mc\.zarr was written by an earlier tumble, which did "
+                                                 r"not record the sweep's content"):
+        tumble.sweep(BODY, DISPERSIONS, **args)
+
+
 SCENARIO = textwrap.dedent("""
     [body]
     inertia = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.5]]

@@ -188,7 +188,11 @@ class SweepStore:
                 raise StoreMismatchError(f"store: {self.path} was written with other settings: {key} = "
                                          f"{stored.get(key)!r} there, {here[key]!r} here; give a new path, the "
                                          "same settings, or delete the store to start again")
-        if attrs.get(DIGEST_ATTR) != self._digest():
+        if DIGEST_ATTR not in attrs:
+            raise StoreMismatchError(f"store: {self.path} was written by an earlier tumble, which did not record "
+                                     "the sweep's content: it cannot be checked to be this sweep's; give a new "
+                                     "path, or delete the store to start again")
+        if attrs[DIGEST_ATTR] != self._digest():
             raise StoreMismatchError(f"store: {self.path} was written by another sweep: the settings agree but not "
                                      "the content (the model's or a torque's data, a scenario's tables, a "
                                      "function's code); give a new path, or delete the store to start again")
