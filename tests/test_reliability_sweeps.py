@@ -464,9 +464,9 @@ def test_a_small_sweeps_default_chunk_gives_every_worker_a_chunk_and_a_resume_ke
 @pytest.mark.parametrize("store", [None, "mc.zarr"])
 def test_a_sweep_whose_index_and_outcomes_outgrow_memory_is_refused_at_once(tmp_path, store):
     # 1e13 samples: the sample index alone is 80 TB
-    with pytest.raises(tumble.ValidationError, match=r"^samples: 10000000000000 samples \(the store's sample index "
-                                                     r"and the outcomes' percentiles.*\) need \d+\.\d [TP]iB .*more than "
-                                                     r"half this machine's memory"):
+    with pytest.raises(tumble.ValidationError, match=r"^samples: 10000000000000 samples \(the store's sample "
+                                                     r"index and the outcomes' percentiles.*\) need \d+\.\d [TP]iB "
+                                                     r".*more than half this machine's memory"):
         tumble.sweep(BODY, DISPERSIONS, samples=10**13, seed=1, store=None if store is None else tmp_path / store,
                      **RUN, workers=0)
     assert os.listdir(tmp_path) == []

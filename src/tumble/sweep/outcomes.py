@@ -109,7 +109,8 @@ class Component:
             raise ValidationError(f"name: the trajectory has no sampled field {self.name!r} (it has "
                                   f"{', '.join(fields)})")
         components = data.shape[2:]
-        if len(self.index) != len(components) or any(not -n <= i < n for i, n in zip(self.index, components, strict=True)):
+        if len(self.index) != len(components) or any(not -n <= i < n for i, n in
+                                                       zip(self.index, components, strict=True)):
             raise ValidationError(f"index: {self.name} has components of shape {components}: give one index "
                                   f"per axis, each in range, got {list(self.index)}")
         return data[(slice(None), slice(None), *self.index)]

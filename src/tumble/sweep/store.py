@@ -79,7 +79,8 @@ from tumble._validate import ValidationError
 from tumble.ensemble import STATISTICS, _merge, moments
 from tumble.sweep.plan import ChunkResult, Plan
 
-__all__ = ["SweepStore", "StoreMismatchError", "stored_chunk", "writing", "SETTINGS_ATTR", "DIGEST_ATTR", "COMPLETE_ATTR"]
+__all__ = ["SweepStore", "StoreMismatchError", "stored_chunk", "temporary", "writing", "SETTINGS_ATTR", "DIGEST_ATTR",
+           "COMPLETE_ATTR"]
 
 #: Group attributes: the sweep's settings, the digest of its content, and whether its statistics are written.
 SETTINGS_ATTR = "tumble_sweep"
@@ -128,6 +129,8 @@ def temporary(path: str) -> str:
     """A new empty directory beside the store ``path`` (``.NAME.XXXX.tmp``), to be renamed onto it when whole."""
     directory, name = os.path.split(os.path.abspath(path))
     return tempfile.mkdtemp(dir=directory, prefix=f".{name}.", suffix=".tmp")
+
+
 #: Values of a series read at once when taking its percentiles (float64 words): 256 MB.
 _BLOCK_WORDS = 2**25
 
