@@ -247,8 +247,9 @@ def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in
     def decoys():  # in the worker: its first callback slots taken by other functions (1 N·m about x)
         import tumble._callback as registry
 
-        registry.decoys = [registry.Callback(lambda t, q, omega: [1.0, 0.0, 0.0], field="torque",
-                                             signature="(t, q, omega)", returns="3 numbers") for _ in range(64)]
+        for _ in range(64):  # owned by the registry's module: they live as long as the worker
+            registry.register(registry, lambda t, q, omega: [1.0, 0.0, 0.0], field="torque",
+                              signature="(t, q, omega)", returns="3 numbers")
         return len(registry._ENTRIES)
 
     torque = tabulated(1.0) + spin_up
