@@ -168,45 +168,32 @@ def test_a_store_without_a_content_digest_is_refused_as_unverifiable(tmp_path):
         tumble.sweep(BODY, DISPERSIONS, **args)
 
 
-SCENARIO = textwrap.dedent("""
-    [body]
-    inertia = [[1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.5]]
-    [initial]
-    omega = [0.0, 0.0, 1.0]
-    [time]
-    stop = 1.0
-    step = 0.5
-    [solver]
-    method = "rk4"
-    dt = 0.01
-    [[torque]]
-    kind = "tabulated"
-    times = [0.0, 1.0]
-    values = [[0.0, 0.0, {value}], [0.0, 0.0, 0.2]]
+EXPLORER = (tumble.examples.directory() / "spacecraft" / "explorer1.toml").read_text() + textwrap.dedent("""
     [sweep]
     samples = 4
     [sweep.dispersions]
-    "body.inertia" = {{ inertia = {{ moments = [1.0, 2.0, 2.5], std = [0.02, 0.02, 0.03], angle = 0.01 }} }}
+    "damper.damping" = { uniform = { low = 1e-4, high = 3e-4 } }
     [sweep.outcomes]
-    omega_z = {{ series = "component", name = "omega", index = 2, reduce = "final" }}
+    omega_z = { series = "component", name = "omega", index = 2, reduce = "final" }
 """)
 
 
-def test_a_scenario_whose_tables_changed_beyond_its_recorded_settings_has_another_digest(tmp_path):
-    # a dispersed non-state key rebuilds the model per sample from the file: the recorded settings name the
-    # file, the keys and the torque's kind only; the digest holds every table of the file
+def test_a_scenario_whose_undispersed_table_changed_has_another_digest(tmp_path):
+    # a dispersed non-state key (the damper's damping) rebuilds the model per sample from the file: the
+    # recorded settings name the file and the keys only, the digest holds every table of it (here the
+    # damper's sphere inertia, which nothing else records)
     from tumble.scenario.sweep import sweep_arguments
     from tumble.sweep.plan import make_plan
 
-    path = tmp_path / "spinner.toml"
+    path = tmp_path / "explorer1.toml"
     plans = []
-    for value in (0.1, 0.15):
-        path.write_text(SCENARIO.format(value=value))
+    for text in (EXPLORER, EXPLORER.replace("inertia = 3e-4", "inertia = 4e-4")):
+        path.write_text(text)
         a = sweep_arguments(tumble.scenario.load(path))
         plans.append(make_plan(a.pop("model"), a.pop("dispersions"), samples=a.pop("samples"), seed=a.pop("seed"),
-                               chunk=a.pop("chunk"), t=a.pop("t"), method=a.pop("method"), options={"dt": 0.01},
-                               torque=a.pop("torque"), outcomes=a.pop("outcomes"), series=a.pop("statistics"),
-                               fixed={"omega0": a["omega0"]}))
+                               chunk=a.pop("chunk"), t=a.pop("t"), method=a.pop("method"),
+                               options={"rtol": 1e-12, "atol": 1e-12}, torque=a.pop("torque"),
+                               outcomes=a.pop("outcomes"), series=a.pop("statistics"), fixed={"omega0": a["omega0"]}))
     assert plans[0].settings() == plans[1].settings()
     assert plans[0].digest() != plans[1].digest()
 
