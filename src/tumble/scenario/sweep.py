@@ -178,9 +178,9 @@ def _component_problems(run: Run, table: SweepTable) -> list[tuple[str, str]]:
     """``(key, problem)`` for each ``component`` series whose field the scenario's trajectory lacks or whose
     index is out of range, found on a run of the nominal model over the first two output times (before any
     chunk runs: a sweep refused after it ran every chunk is an hour lost)."""
-    import numpy as np
+    import dataclasses
 
-    from tumble.simulate import simulate
+    import numpy as np
 
     components = [(f"sweep.{kind}.{name}", entry.series_function())
                   for kind, group in (("outcomes", table.outcomes), ("statistics", table.statistics))
@@ -188,7 +188,7 @@ def _component_problems(run: Run, table: SweepTable) -> list[tuple[str, str]]:
     if not components:
         return []
     one = {name: np.reshape(value, (1, -1)) for name, value in run.initial.items()}  # a batch of one, as a chunk
-    probe = simulate(run.model, t=run.t[:2], method=run.method, torque=run.torque, **run.options, **one)
+    probe = dataclasses.replace(run, t=run.t[:2], initial=one).simulate()
     problems = []
     for where, component in components:
         try:

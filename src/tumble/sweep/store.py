@@ -210,6 +210,7 @@ class SweepStore:
 
     def _chunk_on_disk(self, group, k: int) -> bool:
         """Whether chunk ``k`` of every per-sample array has its (non-empty) file in the store."""
+        assert self.path is not None  # a store on disk: one in memory is never resumed
         for name, array in group.arrays():
             dims = array.metadata.dimension_names or ()
             if name == "sample" or not dims or dims[0] != "sample":  # the coordinate: one chunk, written whole
