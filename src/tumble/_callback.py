@@ -76,6 +76,25 @@ def register(owner, function: Callable, *, field: str, signature: str, returns: 
     return slot
 
 
+def invoke(slot: int, t: float, args: tuple, out: np.ndarray) -> None:
+    """``out[:] = f(t, *args)`` for the function in ``slot`` (each argument passed as a fresh copy).
+
+    Raises :class:`~tumble.ValidationError` naming the function when its
+    result does not have the shape of ``out`` or is not finite.
+    """
+    entry = _ENTRIES[int(slot)]
+    result = entry.function(float(t), *(np.array(a) for a in args))
+    try:
+        value = None if result is None else np.asarray(result, dtype=np.float64)  # asarray(None) would be nan
+    except (TypeError, ValueError):
+        value = None  # not numbers at all (a string, a ragged list): said as returned, below
+    if value is None or value.shape != out.shape or not np.all(np.isfinite(value)):
+        name = getattr(entry.function, "__name__", repr(entry.function))
+        raise ValidationError(f"{entry.field}: the function {name}{entry.signature} must return {entry.returns}; "
+                              f"at t={t} it returned {result!r}")
+    out[:] = value
+
+
 class Callback:
     """A Python function registered for compiled code: ``slot`` is its slot in this process's registry, for as
     long as this object lives.
@@ -99,22 +118,3 @@ class Callback:
 def _registered(function: Callable, field: str, signature: str, returns: str) -> Callback:
     """A :class:`Callback` unpickled: the function registered in this process."""
     return Callback(function, field=field, signature=signature, returns=returns)
-
-
-def invoke(slot: int, t: float, args: tuple, out: np.ndarray) -> None:
-    """``out[:] = f(t, *args)`` for the function in ``slot`` (each argument passed as a fresh copy).
-
-    Raises :class:`~tumble.ValidationError` naming the function when its
-    result does not have the shape of ``out`` or is not finite.
-    """
-    entry = _ENTRIES[int(slot)]
-    result = entry.function(float(t), *(np.array(a) for a in args))
-    try:
-        value = None if result is None else np.asarray(result, dtype=np.float64)  # asarray(None) would be nan
-    except (TypeError, ValueError):
-        value = None  # not numbers at all (a string, a ragged list): said as returned, below
-    if value is None or value.shape != out.shape or not np.all(np.isfinite(value)):
-        name = getattr(entry.function, "__name__", repr(entry.function))
-        raise ValidationError(f"{entry.field}: the function {name}{entry.signature} must return {entry.returns}; "
-                              f"at t={t} it returned {result!r}")
-    out[:] = value
