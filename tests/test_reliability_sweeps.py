@@ -108,6 +108,7 @@ SLOW = dict(dispersions=DISPERSIONS, samples=32, seed=2, chunk=8, t=np.linspace(
             dt=2.5e-4, outcomes=OUTCOMES)
 
 
+@pytest.mark.slow
 def test_two_sweeps_on_one_scheduler_at_once_each_keep_their_own_results(scheduler_file):
     # the two differ only in a tabulated torque's values, which their recorded settings do not show: their
     # tasks once had the same keys, and the second sweep's store silently held the first one's results
@@ -292,6 +293,7 @@ KILLED = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 def test_a_store_killed_mid_run_leaves_a_temporary_that_the_next_run_removes(tmp_path):
     store = tmp_path / "run.zarr"
     process = subprocess.Popen([sys.executable, "-c", KILLED.format(store=str(store))], env=ENV,
