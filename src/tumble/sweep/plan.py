@@ -216,14 +216,21 @@ class Plan:
         and functions by their pickle: a model's data, a tabulated torque's values, a scenario's every table,
         a lambda's code). :meth:`settings` shows what a person reads; this catches what it leaves out.
 
+        A plan that Dask cannot tokenize (an object whose pickle does not load back in this process) is
+        digested from its pickle's bytes (SHA-256 of :func:`cloudpickle.dumps`), when two of them agree.
+
         ``strict``: refuse a plan that does not pickle the same way twice (what a store records must be
         found again when the sweep resumes); otherwise such a plan gets a digest of its own, never repeated."""
+        import cloudpickle
         from dask.base import tokenize
         from dask.tokenize import TokenizationError
 
         try:
             return tokenize(self, ensure_deterministic=strict)
         except TokenizationError as exc:
+            pickled = [cloudpickle.dumps(self) for _ in range(2)]
+            if pickled[0] == pickled[1]:
+                return hashlib.sha256(pickled[0]).hexdigest()
             raise ValidationError(f"store: this sweep cannot be recorded for resuming (its model, torque or "
                                   f"functions do not pickle the same way twice: {exc}); run it without a store"
                                   ) from None
