@@ -352,8 +352,8 @@ TABLE = textwrap.dedent("""
      "sweep.outcomes.sample: 'sample' is a variable of the store itself"),
     ('[sweep.outcomes]\na = { series = "nutation_angle", reduce = "max" }\n'
      'a_percentiles = { series = "nutation_angle", reduce = "final" }',
-     "sweep.outcomes.a_percentiles: names ending in _percentiles, _count, _mean, _std, _min, _max or holding "
-     "'_dim' are the store's statistics"),
+     "sweep.outcomes.a_percentiles: names ending in _percentiles, _count, _mean, _std, _min, _max or _dimN are "
+     "the store's statistics"),
     ('[sweep.statistics]\nx_mean = { series = "nutation_angle" }', "sweep.statistics.x_mean: names ending in"),
     ('[sweep.outcomes]\na = { series = "component", name = "wheel_speed", reduce = "max" }',
      "sweep.outcomes.a: component: name: the trajectory has no sampled field 'wheel_speed' (it has energy, "

@@ -29,6 +29,7 @@ import hashlib
 import inspect
 import json
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, TypeGuard
@@ -385,10 +386,9 @@ def store_name_problem(name: str) -> str | None:
         return "must be an identifier"
     if name in STORE_NAMES:
         return f"{name!r} is a variable of the store itself ({', '.join(STORE_NAMES)})"
-    suffix = next((s for s in DERIVED_SUFFIXES if name.endswith(s)), None)
-    if suffix is not None or "_dim" in name:
-        return (f"names ending in {', '.join(DERIVED_SUFFIXES)} or holding '_dim' are the store's statistics "
-                f"and dimensions of other outcomes")
+    if name.endswith(DERIVED_SUFFIXES) or re.search(r"_dim\d+$", name):
+        return (f"names ending in {', '.join(DERIVED_SUFFIXES)} or _dimN are the store's statistics and "
+                f"dimensions of other outcomes")
     return None
 
 
