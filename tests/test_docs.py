@@ -10,6 +10,10 @@ Rules (docs/README.md, "Examples that run"):
 * A ``toml`` block whose first line is ``# NAME.toml`` is a file the page's commands read: it is written
   there before the next block runs. (``# examples/NAME.toml`` shows an installed example file, which
   ``tumble examples copy examples`` puts there; tests/test_scenario*.py check that the two agree.)
+* A Python block that starts a local Dask cluster (``tumble.sweep(...)``, ``sweep_scenario(...)`` or
+  ``local_cluster(...)`` without ``workers=0``) must guard its entry point with ``if __name__ ==
+  "__main__":``, and runs as a script in a new Python process (``python block.py``): the cluster's
+  worker processes import the script, which ``exec`` inside pytest would not show.
 * ``<!-- docs-test: skip: REASON -->`` just before a block leaves it out (a GPU, a cluster address, a
   listing of signatures); such blocks are few and counted here. ``<!-- docs-test: exit N -->`` before a
   shell block says its commands exit with N, and every ``error:`` line it shows is checked.
@@ -27,8 +31,12 @@ from __future__ import annotations
 import builtins
 import io
 import math
+import os
+import pickle
 import re
 import shlex
+import subprocess
+import sys
 import warnings
 from contextlib import redirect_stdout
 from pathlib import Path
@@ -48,6 +56,9 @@ FENCE = re.compile(r"(?P<mark><!-- docs-test: (?P<rule>[^>]*?) -->\n)?```(?P<lan
 COMMAND = re.compile(r"^(?:\$ )?(?:python3? -m )?tumble(?: |$)(?P<args>.*)$")
 NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:e[-+]?\d+)?j?", re.I)
 ROUNDING = 1e-12   # claimed figures smaller than this are rounding errors: checked as bounds (10x)
+# A call that starts a local Dask cluster unless given workers=0; the guard the script then needs.
+CLUSTER = re.compile(r"\b(?:tumble\.sweep|sweep_scenario|local_cluster|LocalCluster)\(")
+GUARD = re.compile(r'^if __name__ == "__main__":', re.M)
 
 
 def blocks(page: Path) -> list[dict]:
@@ -170,6 +181,44 @@ def run_python(code: str, where: str, page: Path) -> dict:
     return namespace
 
 
+def starts_a_cluster(code: str) -> bool:
+    return bool(CLUSTER.search(code)) and "workers=0" not in code
+
+
+# What a script block's prelude records: each checked print's values, pickled to PRINTED at exit.
+SCRIPT_PRELUDE = """\
+import atexit as __atexit, builtins as __builtins, pickle as __pickle
+__printed = {}
+def __print__(line, *values, **kwargs):
+    __printed[line] = values
+    __builtins.print(*values, **kwargs)
+def __save():
+    with open(%r, "wb") as f:
+        __pickle.dump(__printed, f)
+__atexit.register(__save)
+"""
+
+
+def run_script(code: str, where: str, page: Path, directory: Path) -> None:
+    """Run one block as ``python block.py`` in ``directory`` (a new process, ``__main__`` its own), and check the
+    figures its comments claim."""
+    assert GUARD.search(code), f"{page.name}:{where}: a block that starts a local cluster needs `if __name__ == " \
+                               '"__main__":` (its worker processes import the script)'
+    wanted: dict = {}
+    script, printed = directory / f"{page.stem}_{where.split()[-1]}.py", directory / "printed.pickle"
+    script.write_text(SCRIPT_PRELUDE % str(printed) + instrument(code, wanted), encoding="utf-8")
+    source = str(Path(__file__).resolve().parents[1] / "src")
+    env = {**os.environ, "PYTHONPATH": source + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    result = subprocess.run([sys.executable, str(script)], cwd=directory, env=env, capture_output=True, text=True,
+                            timeout=600)
+    assert result.returncode == 0, f"{page.name}:{where} exited {result.returncode}:\n{result.stderr[-3000:]}"
+    values = pickle.loads(printed.read_bytes())
+    printed.unlink()
+    script.unlink()
+    for line, claim in wanted.items():
+        check(claim, values[line], f"{page.name}:{where} line {line + 1}")
+
+
 def run_shell(body: str, lang: str, rule: str | None, where: str) -> None:
     from tumble.cli import app
 
@@ -232,7 +281,9 @@ def test_every_example_of_the_page_runs(page, tmp_path, monkeypatch):
         rule = block["rule"]
         if rule and rule.startswith("skip"):
             continue
-        if block["lang"] == "python":
+        if block["lang"] == "python" and starts_a_cluster(block["body"]):
+            run_script(block["body"], where, page, tmp_path)
+        elif block["lang"] == "python":
             namespace = run_python(block["body"], where, page)
             if (page.name, block["heading"]) in FOLLOW_UP:
                 FOLLOW_UP[page.name, block["heading"]](namespace, tmp_path)
@@ -267,3 +318,18 @@ def test_claims_are_read_from_comments():
     with pytest.raises(AssertionError):
         check(("equal", ["1.76"]), [1.7651], "here")
     assert math.isclose(sum(numbers([np.array([1.0, 2.0]), (3, 4), "x 5.5 y"])), 15.5)
+
+
+def test_a_block_that_starts_a_cluster_is_run_as_a_script_and_needs_the_guard(tmp_path):
+    # exec inside pytest could not show the missing guard: spawned workers import the script, not pytest
+    unguarded = "import tumble\nds = tumble.sweep(body, dispersions, samples=10, t=t)\n"
+    assert starts_a_cluster(unguarded) and not starts_a_cluster(unguarded.replace("t=t", "t=t, workers=0"))
+    assert starts_a_cluster("cluster = tumble.sweep.local_cluster(2)\n")
+    assert not starts_a_cluster("tumble.sweep.Normal(0, 1)")
+    with pytest.raises(AssertionError, match='needs `if __name__ == "__main__":`'):
+        run_script(unguarded, "block at line 1", ROOT / "README.md", tmp_path)
+    run_script('import math\nif __name__ == "__main__":\n    print(math.pi)  # 3.14159\n', "block at line 1",
+               ROOT / "README.md", tmp_path)
+    with pytest.raises(AssertionError, match=r"line 3: printed 3\.14159265\d*, the docs say 3\.1415\n"):
+        run_script('import math\nif __name__ == "__main__":\n    print(math.pi)  # 3.1415\n', "block at line 1",
+                   ROOT / "README.md", tmp_path)

@@ -8,10 +8,15 @@ microseconds, and a batch that makes such calls runs on one core (the kernel's
 ``calls_python``).
 
 A registration lasts as long as its *owner*, the object that registered the
-function (a :class:`tumble.torques.PythonTorque`, a control law, ...): the
-entry goes when the owner is garbage-collected. An owner made while a model
-compiles (a plain function wrapped as a torque model) lives as long as the
-run, which holds it through :func:`keep_alive`.
+function (a :class:`Callback`, held by a :class:`tumble.torques.PythonTorque`,
+a control law, ...): the entry goes when the owner is garbage-collected. An
+owner made while a model compiles (a plain function wrapped as a torque model)
+lives as long as the run, which holds it through :func:`keep_alive`.
+
+Slots are numbers local to a process. A model sent to another process (a
+sweep's chunk on a Dask worker) carries its functions as :class:`Callback`
+values, which pickle as the function alone and register it again where they
+are unpickled, under that process's own slot: a slot number never travels.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ import numpy as np
 
 from tumble._validate import ValidationError
 
-__all__ = ["invoke", "keep_alive", "register"]
+__all__ = ["Callback", "invoke", "keep_alive", "register"]
 
 
 class _Entry(NamedTuple):
@@ -107,3 +112,28 @@ def invoke(slot: int, t: float, args: tuple, out: np.ndarray) -> None:
         raise ValidationError(f"{entry.field}: the function {name}{entry.signature} must return {entry.returns}; "
                               f"at t={t} it returned {result!r}")
     out[:] = value
+
+
+class Callback:
+    """A Python function registered for compiled code: ``slot`` is its slot in this process's registry, for as
+    long as this object lives.
+
+    Pickled (a model sent to a Dask worker), it carries the function and the wording of its errors, not the
+    slot; unpickled, it registers the function in the receiving process and takes the slot given there."""
+
+    __slots__ = ("function", "field", "signature", "returns", "slot", "__weakref__")
+
+    def __init__(self, function: Callable, *, field: str, signature: str, returns: str) -> None:
+        self.function, self.field, self.signature, self.returns = function, field, signature, returns
+        self.slot = register(self, function, field=field, signature=signature, returns=returns)
+
+    def __reduce__(self):
+        return _registered, (self.function, self.field, self.signature, self.returns)
+
+    def __repr__(self):
+        return f"Callback({getattr(self.function, '__name__', self.function)!r}, field={self.field!r})"
+
+
+def _registered(function: Callable, field: str, signature: str, returns: str) -> Callback:
+    """A :class:`Callback` unpickled: the function registered in this process."""
+    return Callback(function, field=field, signature=signature, returns=returns)

@@ -13,6 +13,7 @@ import contextlib
 import os
 import re
 import secrets
+import shutil
 import signal
 import stat
 import threading
@@ -199,13 +200,31 @@ def _new_temporary(path: str) -> str:
         return tmp_path
 
 
+def new_temporary_directory(path: str | os.PathLike) -> str:
+    """Create and return a new empty directory beside ``path``, named as its temporaries are
+    (``.NAME.XXXXXXXX.tmp``): a store written whole there, then renamed onto ``path``."""
+    directory, name = os.path.split(os.path.abspath(path))
+    while True:
+        tmp_path = os.path.join(directory, f".{name}.{secrets.token_hex(4)}.tmp")
+        try:
+            os.mkdir(tmp_path, 0o700)
+        except FileExistsError:
+            continue
+        return tmp_path
+
+
 def _remove_stale(directory: str, name: str) -> None:
-    """Remove the temporaries of ``directory/name`` that killed writers left (the caller holds its lock)."""
+    """Remove the temporaries (files, or directories of a store) of ``directory/name`` that killed writers left
+    (the caller holds its lock)."""
     pattern = _temporary_pattern(name)
     for entry in os.listdir(directory):
         if pattern.fullmatch(entry):
-            with contextlib.suppress(FileNotFoundError):
-                os.remove(os.path.join(directory, entry))
+            stale = os.path.join(directory, entry)
+            if os.path.isdir(stale) and not os.path.islink(stale):
+                shutil.rmtree(stale, ignore_errors=True)
+            else:
+                with contextlib.suppress(FileNotFoundError):
+                    os.remove(stale)
 
 
 def _sync(path: str) -> None:

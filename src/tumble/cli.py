@@ -335,6 +335,10 @@ def sweep_command(
             with _progress_bar("sweeping", enabled=not quiet, unit="chunks") as progress:
                 ds = sweep_scenario(spec, samples=samples, store=output, client=client, workers=workers,
                                     progress=progress)
+        except KeyboardInterrupt:  # Ctrl-C: one line, exit 130 (the chunks written stay in the store)
+            typer.echo(f"error: interrupted; the chunks written are kept in {output}: the same command resumes "
+                       "the sweep", err=True)
+            raise typer.Exit(130) from None
         finally:
             if client is not None:
                 client.close()

@@ -265,12 +265,13 @@ class PythonTorque(TorqueModel):
         if not callable(function):
             raise ValidationError(f"torque: must be a torque model or a callable f(t, q, omega), got {function!r}")
         self.function = function
-        self.slot = _callback.register(self, function, field="torque", signature="(t, q, omega)",
-                                       returns="3 finite numbers (body torque, N·m)")
+        # registered per process: a copy sent to a Dask worker registers it there (tumble._callback.Callback)
+        self.callback = _callback.Callback(function, field="torque", signature="(t, q, omega)",
+                                           returns="3 finite numbers (body torque, N·m)")
 
     def _params(self, axes):
         q_bp = np.array(_quat.qfrom_matrix(axes))
-        return _PYTHON, np.concatenate([[self.slot], axes.ravel(), q_bp])
+        return _PYTHON, np.concatenate([[self.callback.slot], axes.ravel(), q_bp])
 
     def __repr__(self):
         return f"PythonTorque({getattr(self.function, '__name__', self.function)!r})"

@@ -45,12 +45,13 @@ from typing import TYPE_CHECKING, Any, Literal, cast
 
 from pydantic import model_validator
 
-from tumble._validate import as_array
+from tumble._validate import ValidationError, as_array
 from tumble.scenario._errors import ScenarioError, in_file
 from tumble.scenario._run import Run
 from tumble.scenario._values import _Bool, _Number, _Table, _Text
 from tumble.sweep import dispersions as _d
 from tumble.sweep import outcomes as _o
+from tumble.sweep.plan import store_name_problem
 
 if TYPE_CHECKING:
     import numpy as np
@@ -173,6 +174,30 @@ class ScenarioModel:
         return f"ScenarioModel({self.source!r}, keys={list(self.parameters)})"
 
 
+def _component_problems(run: Run, table: SweepTable) -> list[tuple[str, str]]:
+    """``(key, problem)`` for each ``component`` series whose field the scenario's trajectory lacks or whose
+    index is out of range, found on a run of the nominal model over the first two output times (before any
+    chunk runs: a sweep refused after it ran every chunk is an hour lost)."""
+    import dataclasses
+
+    import numpy as np
+
+    components = [(f"sweep.{kind}.{name}", entry.series_function())
+                  for kind, group in (("outcomes", table.outcomes), ("statistics", table.statistics))
+                  for name, entry in group.items() if entry.series == "component" and entry.name is not None]
+    if not components:
+        return []
+    one = {name: np.reshape(value, (1, -1)) for name, value in run.initial.items()}  # a batch of one, as a chunk
+    probe = dataclasses.replace(run, t=run.t[:2], initial=one).simulate()
+    problems = []
+    for where, component in components:
+        try:
+            component(probe)
+        except ValidationError as exc:
+            problems.append((where, f"component: {exc}"))
+    return problems
+
+
 def as_run(problem: Run | Problem) -> Run:
     """The :class:`~tumble.scenario.Run` of a built scenario (the rigid kind's problem converts itself)."""
     return problem if isinstance(problem, Run) else problem.as_run()
@@ -189,6 +214,10 @@ def sweep_arguments(scenario: Scenario, samples: int | None = None) -> dict:
         problems, dispersions, states, parameters = [], {}, {}, []
         for key, entry in table.dispersions.items():
             where = f"sweep.dispersions.{key}"
+            if not all(part.isidentifier() for part in key.split(".")):
+                problems.append((where, "a dispersion replaces a whole value, named by its dotted key (e.g. "
+                                        "'initial.omega'): no index into an array or an array of tables"))
+                continue
             if key.split(".")[0] in _SHARED:
                 problems.append((where, f"the samples of a sweep share {', '.join(_SHARED)}: cannot disperse {key}"))
                 continue
@@ -207,12 +236,17 @@ def sweep_arguments(scenario: Scenario, samples: int | None = None) -> dict:
         statistics: dict[str, Callable] = {}
         for group, out, make in ((table.outcomes, outcomes, "outcome_function"),
                                  (table.statistics, statistics, "series_function")):
+            kind = "outcomes" if out is outcomes else "statistics"
             for name, series in group.items():
+                taken = store_name_problem(name)
+                if taken is not None:
+                    problems.append((f"sweep.{kind}.{name}", f"{taken}; give another name"))
+                    continue
                 try:
                     out[name] = getattr(series, make)()
                 except ValueError as exc:
-                    kind = "outcomes" if out is outcomes else "statistics"
                     problems.append((f"sweep.{kind}.{name}", str(exc).partition("\n")[0]))
+        problems += _component_problems(run, table)
         if problems:
             raise ScenarioError(scenario.source, problems)
     model = ScenarioModel(scenario, parameters) if parameters else run.model

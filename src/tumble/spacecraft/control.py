@@ -222,15 +222,15 @@ class PythonLaw:
     """
 
     function: object
-    slot: int = field(init=False, repr=False)
+    callback: _callback.Callback = field(init=False, repr=False)  # registered per process
 
     def __post_init__(self):
-        object.__setattr__(self, "slot", _callback.register(
-            self, self.function, field="controller", signature="(t, q, omega, wheel_speeds)",
+        object.__setattr__(self, "callback", _callback.Callback(
+            self.function, field="controller", signature="(t, q, omega, wheel_speeds)",
             returns="3 finite numbers (torque command, body axes, N·m)"))
 
     def _programs(self, rate_inertia) -> tuple[Program, ...]:
-        return (_laws.python_program("python_law", self.slot),)
+        return (_laws.python_program("python_law", self.callback.slot),)
 
 
 @dataclass(frozen=True, eq=False)
@@ -247,7 +247,7 @@ class WheelTorques:
     torques: Any  # a function of time, or samples (len(t), n_w) or (n_w,): an array (len(t), n_w) once validated
     t: object = None
     interpolation: str = "linear"
-    slot: int | None = field(init=False, repr=False, default=None)
+    callback: _callback.Callback | None = field(init=False, repr=False, default=None)  # a function's, per process
 
     def __post_init__(self):
         if self.interpolation not in ("linear", "previous"):
@@ -255,8 +255,8 @@ class WheelTorques:
         if callable(self.torques):
             if self.t is not None:
                 raise ValidationError("t: a function of time needs no sample times")
-            object.__setattr__(self, "slot", _callback.register(
-                self, self.torques, field="controller", signature="(t, q, omega, wheel_speeds)",
+            object.__setattr__(self, "callback", _callback.Callback(
+                self.torques, field="controller", signature="(t, q, omega, wheel_speeds)",
                 returns="one finite number per wheel (motor torque, N·m)"))
             return
         values = as_array(self.torques, "torques")
@@ -276,11 +276,11 @@ class WheelTorques:
     @property
     def wheels(self) -> int | None:
         """The number of wheels the samples are for (None for a Python function)."""
-        return None if self.slot is not None else self.torques.shape[1]
+        return None if self.callback is not None else self.torques.shape[1]
 
     def _programs(self, rate_inertia) -> tuple[Program, ...]:
-        if self.slot is not None:
-            return (_laws.python_program("wheel_python", self.slot),)
+        if self.callback is not None:
+            return (_laws.python_program("wheel_python", self.callback.slot),)
         return (_laws.wheel_table_program(self.t, self.torques, self.interpolation == "previous"),)
 
 

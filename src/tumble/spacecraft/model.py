@@ -267,6 +267,11 @@ class Spacecraft(Model):
             programs.append(_environment.gravity_gradient_program(self.orbit.elements()))
         return tuple(programs)
 
+    def __getstate__(self) -> dict:
+        """Pickled without the compiled programs: a Python law's holds its callback slot, a number of this
+        process (:mod:`tumble._callback`); the receiving process compiles them again with its own."""
+        return {name: value for name, value in self.__dict__.items() if name != "_programs"}
+
     def _thruster_program(self) -> Program | None:
         """The thrusters' program: each serves the body axis of its largest torque component, with its sign."""
         if not self.thrusters:

@@ -28,7 +28,7 @@ import types
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
-from tumble._validate import ValidationError, output_times
+from tumble._validate import ValidationError, output_times, require_memory
 from tumble.simulate import _solver_options, as_model
 from tumble.sweep.dispersions import (
     Dispersion,
@@ -52,7 +52,7 @@ from tumble.sweep.outcomes import (
 )
 from tumble.sweep.plan import _is_builder, make_plan
 from tumble.sweep.runner import local_cluster, run_chunks
-from tumble.sweep.store import SweepStore
+from tumble.sweep.store import StoreMismatchError, SweepStore, stored_chunk, writing
 
 if TYPE_CHECKING:
     import xarray
@@ -64,7 +64,8 @@ if TYPE_CHECKING:
     from tumble.simulate import Model
     from tumble.torques import TorqueLike
 
-__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "Dispersion", "Normal", "Uniform", "TruncatedNormal", "Grid",
+__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "StoreMismatchError", "Dispersion", "Normal",
+           "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
            "Component", "Max", "Final", "SettlingTime", "CrossingTime"]
 
@@ -129,8 +130,11 @@ def sweep(
         (sample, time, 3), the model's extras and totals, chunked by sample
         (with a store, they go to disk as the chunks come).
     chunk : int
-        Samples per Dask task (default: a chunk's run takes about 200 MB,
-        ``tumble.ensemble.SAMPLES_PER_CHUNK`` body-samples, at most ``samples``).
+        Samples per Dask task. Default: the samples shared evenly between the
+        workers (``ceil(samples / W)``, ``W`` the cluster's worker threads; 1
+        with ``workers=0``), so that a small sweep uses every worker, and at
+        most ``tumble.ensemble.SAMPLES_PER_CHUNK`` body-samples (a chunk's run
+        takes about 200 MB); resuming a store, the store's.
     store : path of a Zarr store (directory), or None
         Where the results are written as they come; an existing store of the
         same sweep is resumed (only missing chunks are computed), one of
@@ -168,16 +172,30 @@ def sweep(
     percentiles = tuple(float(p) for p in percentiles)
     if any(not 0.0 <= p <= 100.0 for p in percentiles):
         raise ValidationError(f"percentiles: must lie in [0, 100], got {list(percentiles)}")
+    if chunk is None and store is not None:
+        chunk = stored_chunk(store)  # resuming: the store's, whatever the cluster now
     plan = make_plan(model, dispersions or {}, samples=samples, seed=seed, chunk=chunk, t=times, method=m.name,
                      options=options, torque=torque, outcomes=dict(outcomes or {}), series=dict(statistics or {}),
-                     fixed=initial_state, trajectories=trajectories)
-    result = SweepStore(store, plan)
-    computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
-    if computed or not result.complete or not result.has_percentiles(percentiles):
-        result.finalize(percentiles)
+                     fixed=initial_state, trajectories=trajectories, parallel=_parallel(client, workers))
+    require_memory(plan.client_bytes(in_memory=store is None), "samples",
+                   f"{plan.samples} samples (the store's sample index and the outcomes' percentiles"
+                   f"{'; in memory, every value kept' if store is None else ''})")
+    with writing(store):  # one writer at a time; the temporaries of killed runs removed
+        result = SweepStore(store, plan)
+        computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
+        if computed or not result.complete or not result.has_percentiles(percentiles):
+            result.finalize(percentiles)
     ds = result.dataset()
     ds.attrs["chunks_computed"] = computed
     return ds
+
+
+def _parallel(client: Client | None, workers: int | None) -> int:
+    """The chunks a sweep can run at once: the client's worker threads, ``workers`` of a local cluster (default
+    one per core), 1 in this process."""
+    if client is not None:
+        return max(1, sum(client.nthreads().values()))
+    return (os.cpu_count() or 1) if workers is None else max(1, int(workers))
 
 
 def _is_scenario(model) -> bool:

@@ -99,7 +99,20 @@ class Component:
                            if np.size(self.index) else ())
 
     def __call__(self, traj: Trajectory) -> np.ndarray:
-        data = getattr(traj, self.name)
+        try:
+            data = getattr(traj, self.name)
+        except AttributeError:
+            data = None
+        if not isinstance(data, np.ndarray) or data.ndim < 2:
+            fields = sorted(name for name in ("omega", "q", "energy", "momentum_body", "momentum_inertial")
+                            if getattr(traj, name, None) is not None) + sorted(traj.extras)
+            raise ValidationError(f"name: the trajectory has no sampled field {self.name!r} (it has "
+                                  f"{', '.join(fields)})")
+        components = data.shape[2:]
+        if len(self.index) != len(components) or any(not -n <= i < n for i, n in
+                                                       zip(self.index, components, strict=True)):
+            raise ValidationError(f"index: {self.name} has components of shape {components}: give one index "
+                                  f"per axis, each in range, got {list(self.index)}")
         return data[(slice(None), slice(None), *self.index)]
 
 

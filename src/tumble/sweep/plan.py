@@ -29,6 +29,7 @@ import hashlib
 import inspect
 import json
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, TypeGuard
@@ -172,6 +173,17 @@ class Plan:
                                              _members(state, m).items()}) for j, model in enumerate(models)]
         return _stack(members)
 
+    def client_bytes(self, *, in_memory: bool) -> float:
+        """A lower bound of the bytes the client process holds at once for the whole sweep (float64 words):
+        the store's sample index, and each outcome read whole for its percentiles (its values and NumPy's
+        partitioned copy); in memory, also every value kept per sample (the dispersed inputs, the outcomes,
+        the series per output time and, with ``trajectories``, at least 11 words per output time)."""
+        words = 1 + 2 * len(self.outcomes)
+        if in_memory:
+            words += (sum(math.prod(d.shape) for d in self.dispersions.values()) + len(self.outcomes)
+                      + len(self.t) * (len(self.series) + (11 if self.trajectories else 0)))
+        return 8.0 * float(self.samples) * words
+
     # -- what the store records -------------------------------------------------------
 
     def settings(self) -> dict:
@@ -196,8 +208,33 @@ class Plan:
         }
 
     def token(self) -> str:
-        """A short digest of :meth:`settings` (the Dask keys of this sweep's tasks)."""
+        """A short digest of :meth:`settings` (it names this sweep's Dask tasks)."""
         return hashlib.sha256(json.dumps(self.settings(), sort_keys=True).encode()).hexdigest()[:16]
+
+    def digest(self, *, strict: bool = True) -> str:
+        """A digest of everything the samples' results depend on, the same in every process: the whole plan
+        through :func:`dask.base.tokenize` (arrays by their bytes, dataclasses by their fields, other objects
+        and functions by their pickle: a model's data, a tabulated torque's values, a scenario's every table,
+        a lambda's code). :meth:`settings` shows what a person reads; this catches what it leaves out.
+
+        A plan that Dask cannot tokenize (an object whose pickle does not load back in this process) is
+        digested from its pickle's bytes (SHA-256 of :func:`cloudpickle.dumps`), when two of them agree.
+
+        ``strict``: refuse a plan that does not pickle the same way twice (what a store records must be
+        found again when the sweep resumes); otherwise such a plan gets a digest of its own, never repeated."""
+        import cloudpickle
+        from dask.base import tokenize
+        from dask.tokenize import TokenizationError
+
+        try:
+            return tokenize(self, ensure_deterministic=strict)
+        except TokenizationError as exc:
+            pickled = [cloudpickle.dumps(self) for _ in range(2)]
+            if pickled[0] == pickled[1]:
+                return hashlib.sha256(pickled[0]).hexdigest()
+            raise ValidationError(f"store: this sweep cannot be recorded for resuming (its model, torque or "
+                                  f"functions do not pickle the same way twice: {exc}); run it without a store"
+                                  ) from None
 
 
 def _is_builder(model: object) -> TypeGuard[Callable[..., Any]]:
@@ -245,12 +282,13 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
               chunk: int | None, t: np.ndarray, method: str, options: dict[str, Any], torque: TorqueLike | ArrayLike,
               outcomes: dict[str, Callable[[Trajectory], np.ndarray]],
               series: dict[str, Callable[[Trajectory], np.ndarray]], fixed: Mapping[str, ArrayLike],
-              trajectories: bool = False) -> Plan:
-    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`)."""
+              trajectories: bool = False, parallel: int = 1) -> Plan:
+    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`); ``parallel``: the
+    chunks the cluster runs at once (for the default chunk)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
     drawn = {str(name): as_dispersion(d, name) for name, d in dispersions.items()}
-    samples, chunk = _sizes(drawn, samples, chunk, len(t))
+    samples, chunk = _sizes(drawn, samples, chunk, len(t), parallel)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise ValidationError(f"seed: must be an integer >= 0, got {seed!r}")
     builder = _is_builder(model)
@@ -278,9 +316,10 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
                 outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
 
 
-def _sizes(dispersions: dict, samples, chunk, n_times: int) -> tuple[int, int]:
+def _sizes(dispersions: dict, samples, chunk, n_times: int, parallel: int) -> tuple[int, int]:
     """The number of samples (default: one per grid point when every dispersion is a grid) and the chunk
-    (default: :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
+    (default: the samples shared evenly between ``parallel`` workers, and at most
+    :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
     if samples is None:
         if not any(isinstance(d, Grid) for d in dispersions.values()) or any(d.n_raw for d in dispersions.values()):
             raise ValidationError("samples: needed unless every dispersion is a grid (then one sample per point)")
@@ -291,7 +330,7 @@ def _sizes(dispersions: dict, samples, chunk, n_times: int) -> tuple[int, int]:
     if chunk is None:
         from tumble.ensemble import SAMPLES_PER_CHUNK
 
-        chunk = max(1, min(samples, SAMPLES_PER_CHUNK // n_times))
+        chunk = max(1, min(math.ceil(samples / parallel), SAMPLES_PER_CHUNK // n_times))
     if int(chunk) < 1:
         raise ValidationError(f"chunk: must be >= 1 sample, got {chunk}")
     return samples, int(chunk)
@@ -334,13 +373,35 @@ def _check_inertia(d: Dispersion) -> None:
                               f"Grid of (3, 3) tensors (kg m^2), got {type(d).__name__} of shape {d.shape}")
 
 
+#: Names of the store's own variables and dimensions, and the suffixes of the variables it derives from an
+#: outcome or a series (:mod:`tumble.sweep.store`): no outcome or series may take them.
+STORE_NAMES = ("sample", "time", "percentile", "chunk", "done")
+DERIVED_SUFFIXES = ("_percentiles", "_count", "_mean", "_std", "_min", "_max")
+
+
+def store_name_problem(name: str) -> str | None:
+    """Why ``name`` cannot name an outcome or a series (it is, or may become, another variable of the store),
+    or None."""
+    if not str(name).isidentifier():
+        return "must be an identifier"
+    if name in STORE_NAMES:
+        return f"{name!r} is a variable of the store itself ({', '.join(STORE_NAMES)})"
+    if name.endswith(DERIVED_SUFFIXES) or re.search(r"_dim\d+$", name):
+        return (f"names ending in {', '.join(DERIVED_SUFFIXES)} or _dimN are the store's statistics and "
+                f"dimensions of other outcomes")
+    return None
+
+
 def _check_reductions(outcomes: dict, series: dict, dispersions: dict, trajectories: bool) -> None:
-    """Outcome and series names: identifiers, none the name of a dispersed input, of each other or of a
-    kept trajectory field; each function describable in the store."""
+    """Outcome and series names: identifiers, none a name of the store's own (:func:`store_name_problem`), of
+    a dispersed input, of each other or of a kept trajectory field; each function describable in the store."""
     taken = set(dispersions) | ({"q", "omega", "energy", "momentum_body"} if trajectories else set())
     for group, kind in ((outcomes, "outcomes"), (series, "statistics")):
         for name, f in group.items():
-            if not str(name).isidentifier() or name in taken or (kind == "statistics" and name in outcomes):
-                raise ValidationError(f"{kind}[{name!r}]: names must be identifiers, different from the "
-                                      f"dispersed inputs and from each other")
+            problem = store_name_problem(name)
+            if problem is not None:
+                raise ValidationError(f"{kind}[{name!r}]: {problem}; give another name")
+            if name in taken or (kind == "statistics" and name in outcomes):
+                raise ValidationError(f"{kind}[{name!r}]: names must be different from the dispersed inputs "
+                                      f"and from each other")
             describe(f)

@@ -10,6 +10,10 @@ machines, dask-jobqueue, Kubernetes): only the chunks' small results travel
 back to the client, which writes them to the store, so the workers need no
 shared file system.
 
+The chunks are submitted as a window that moves as they complete (four per
+worker thread, at least :data:`IN_FLIGHT`), so that a sweep of millions of
+chunks holds a few of them at a time on the client and the scheduler.
+
 A task that fails with an exception is retried ``retries`` times; a task whose
 worker dies (killed, out of memory) is given to another worker by the
 scheduler, as Dask does for every task. On Ctrl-C the tasks not finished are
@@ -18,7 +22,11 @@ cancelled and the chunks already written stay in the store.
 
 from __future__ import annotations
 
+import itertools
 import os
+import signal
+import threading
+import uuid
 from collections.abc import Callable
 from contextlib import contextmanager
 from typing import TYPE_CHECKING
@@ -33,6 +41,9 @@ if TYPE_CHECKING:
 __all__ = ["local_cluster", "run_chunks"]
 
 _TRIM = "MALLOC_TRIM_THRESHOLD_"  # glibc's malloc setting that Dask gives its workers
+#: The fewest chunks submitted at once (else four per worker thread): more are submitted as these complete,
+#: so that the client and the scheduler hold a window of the sweep's tasks, not millions of them.
+IN_FLIGHT = 32
 
 
 def local_cluster(workers: int | None = None) -> LocalCluster:
@@ -49,9 +60,26 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     from distributed import LocalCluster
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
-    with _glibc_malloc_defaults():
+    with _glibc_malloc_defaults(), _interrupts_ignored():
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
                             dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
+
+
+@contextmanager
+def _interrupts_ignored():
+    """Worker processes spawned inside ignore SIGINT: Ctrl-C in a terminal reaches every process of its group,
+    and is the client's to handle (it cancels the chunks in flight and closes the cluster); a worker that took
+    it printed Dask's tracebacks, 60-90 lines. An ignored signal stays ignored across ``exec`` and Python
+    leaves it so. This process's handler comes back after (from the main thread only: elsewhere nothing is
+    changed)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextmanager
@@ -120,16 +148,26 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         client = Client(cluster)
     elif workers is not None:
         raise ValidationError("workers: give it only without client= (a client's cluster has its own workers)")
-    token = plan.token()
-    futures = {}
+    # keys of this call alone: two sweeps on one scheduler never share a task, whatever their settings
+    run = f"tumble-sweep-{plan.token()}-{uuid.uuid4().hex}"
+    futures: dict = {}  # the chunks in flight: future → chunk
+
+    def submit(k: int):
+        future = client.submit(_run_chunk, plan, k, key=f"{run}-{k}", retries=retries, pure=False)
+        futures[future] = k
+        return future
+
+    todo = iter(missing)
+    window = max(IN_FLIGHT, 4 * sum(client.nthreads().values()))
     try:
-        for k in missing:
-            futures[client.submit(_run_chunk, plan, k, key=f"tumble-sweep-{token}-{k}", retries=retries,
-                                  pure=False)] = k
+        queue = as_completed([submit(k) for k in itertools.islice(todo, window)], loop=client.loop)
         done = total - len(missing)
-        for future in as_completed(futures):
-            store.write(futures[future], future.result())
+        for future in queue:  # on this client, default or not
+            store.write(futures.pop(future), future.result())
             future.release()
+            following = next(todo, None)
+            if following is not None:
+                queue.add(submit(following))
             done += 1
             if progress is not None:
                 progress(done, total)

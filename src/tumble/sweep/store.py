@@ -22,11 +22,25 @@ chunk's results are whole Zarr chunks, each written atomically by Zarr's
 local store (a temporary file, then a rename). A chunk counts as done only
 when its flag in ``done`` is set, after its data: an interruption (Ctrl-C, a
 killed client) loses at most the chunks in flight, and running the same sweep
-on the store computes only the chunks not done. The sweep's settings
-(:meth:`tumble.sweep.plan.Plan.settings`) are the group's attribute
-``tumble_sweep``; a store written with other settings is refused, naming the
-first setting that differs. The store is created under a temporary name and
-renamed into place, so its name never points at a half-made store.
+on the store computes only the chunks not done. Resuming checks that each
+chunk marked done has its file in every per-sample array, and computes again
+a chunk whose file is gone (every chunk is written, even one whose values are
+all the fill value, NaN, so a missing file is always a lost chunk).
+
+The sweep's settings (:meth:`tumble.sweep.plan.Plan.settings`) are the
+group's attribute ``tumble_sweep``, and a digest of its whole content
+(:meth:`~tumble.sweep.plan.Plan.digest`: the model's data, a tabulated
+torque's values, a scenario's every table, ...) the attribute
+``tumble_sweep_digest``; a store written with other settings or content is
+refused with :class:`StoreMismatchError`, naming the first setting that
+differs, rather than mixed with this sweep's chunks.
+
+One process writes a store at a time: it holds the lock ``.NAME.lock`` beside
+it (:func:`tumble.trajectory.write_atomic`'s lock) while it runs, and a second
+writer is refused. The store is created under a temporary name
+``.NAME.*.tmp`` and renamed into place, so its name never points at a
+half-made store; holding the lock, a writer removes the temporaries that a
+killed run left (:func:`writing`).
 
 The per-time statistics merge the chunks' moments in chunk order with
 :mod:`tumble.ensemble`'s exact pairwise update (Chan, Golub & LeVeque 1979),
@@ -45,12 +59,12 @@ has one), and ``OUTCOME_count`` says how many of the samples that is.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
-import tempfile
 import warnings
-from collections.abc import Iterable
+from collections.abc import Iterable, Iterator
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -63,11 +77,59 @@ from tumble._validate import ValidationError
 from tumble.ensemble import STATISTICS, _merge, moments
 from tumble.sweep.plan import ChunkResult, Plan
 
-__all__ = ["SweepStore", "SETTINGS_ATTR", "COMPLETE_ATTR"]
+__all__ = ["SweepStore", "StoreMismatchError", "stored_chunk", "temporary", "writing", "SETTINGS_ATTR", "DIGEST_ATTR",
+           "COMPLETE_ATTR"]
 
-#: Group attributes: the sweep's settings, and whether its statistics are written.
+#: Group attributes: the sweep's settings, the digest of its content, and whether its statistics are written.
 SETTINGS_ATTR = "tumble_sweep"
+DIGEST_ATTR = "tumble_sweep_digest"
 COMPLETE_ATTR = "tumble_sweep_complete"
+
+
+class StoreMismatchError(ValidationError):
+    """The store given to a sweep was written by another sweep (other settings, or other model or torque data
+    under the same settings): resuming on it would mix the two."""
+
+
+@contextlib.contextmanager
+def writing(path: str | os.PathLike[str] | None) -> Iterator[None]:
+    """Hold the writer's lock of the Zarr store ``path`` (``.NAME.lock`` beside it) while the block runs, after
+    removing the temporaries ``.NAME.XXXXXXXX.tmp`` of killed runs (no live writer owns them: a writer holds the lock).
+    Another process writing ``path`` now: :class:`FileExistsError`. ``None`` (in memory): nothing to hold."""
+    if path is None:
+        yield
+        return
+    from tumble._files import _exclusive, _remove_stale
+
+    path = os.fspath(path)
+    directory, name = os.path.split(os.path.abspath(path))
+    if not os.path.isdir(directory):
+        raise FileNotFoundError(f"store: directory {directory!r} does not exist")
+    with _exclusive(os.path.join(directory, f".{name}.lock"), path):
+        _remove_stale(directory, name)
+        yield
+
+
+def stored_chunk(path: str | os.PathLike[str]) -> int | None:
+    """The chunk of the sweep stored at ``path``, or None where there is no readable sweep store."""
+    import zarr
+
+    try:
+        settings = dict(zarr.open_group(os.fspath(path), mode="r", zarr_format=3).attrs).get(SETTINGS_ATTR)
+    except Exception:  # noqa: BLE001 - not a store: the sweep refuses it in SweepStore, naming why
+        return None
+    chunk = settings.get("chunk") if isinstance(settings, dict) else None
+    return chunk if isinstance(chunk, int) and not isinstance(chunk, bool) else None
+
+
+def temporary(path: str) -> str:
+    """A new empty directory beside the store ``path`` (``.NAME.XXXXXXXX.tmp``), to be renamed onto it when
+    whole."""
+    from tumble._files import new_temporary_directory
+
+    return new_temporary_directory(path)
+
+
 #: Values of a series read at once when taking its percentiles (float64 words): 256 MB.
 _BLOCK_WORDS = 2**25
 
@@ -111,22 +173,56 @@ class SweepStore:
         return self._memory is not None or (self.path is not None and os.path.exists(self.path))
 
     def _check(self) -> None:
-        """Refuse a store that is not this sweep's; read which chunks are done."""
+        """Refuse a store that is not this sweep's; read which chunks are done, and mark again as not done
+        each chunk whose file is missing from one of the per-sample arrays."""
         try:
             group = self._group("r")
-            stored = dict(group.attrs).get(SETTINGS_ATTR)
+            attrs = dict(group.attrs)
         except Exception as exc:  # noqa: BLE001 - any unreadable directory is "not a sweep store"
             raise ValidationError(f"store: {self.path} exists and is not a tumble sweep store ({exc})") from None
+        stored = attrs.get(SETTINGS_ATTR)
         if not isinstance(stored, dict):
             raise ValidationError(f"store: {self.path} exists and is not a tumble sweep store (no {SETTINGS_ATTR} "
                                   "attribute); give a new path")
         here = self.plan.settings()
         for key in here:
             if stored.get(key) != here[key]:
-                raise ValidationError(f"store: {self.path} was written with other settings: {key} = "
-                                      f"{stored.get(key)!r} there, {here[key]!r} here; give a new path or the "
-                                      "same settings")
+                raise StoreMismatchError(f"store: {self.path} was written with other settings: {key} = "
+                                         f"{stored.get(key)!r} there, {here[key]!r} here; give a new path, the "
+                                         "same settings, or delete the store to start again")
+        if DIGEST_ATTR not in attrs:
+            raise StoreMismatchError(f"store: {self.path} was written by an earlier tumble, which did not record "
+                                     "the sweep's content: it cannot be checked to be this sweep's; give a new "
+                                     "path, or delete the store to start again")
+        if attrs[DIGEST_ATTR] != self._digest():
+            raise StoreMismatchError(f"store: {self.path} was written by another sweep: the settings agree but not "
+                                     "the content (the model's or a torque's data, a scenario's tables, a "
+                                     "function's code); give a new path, or delete the store to start again")
         self._done = np.asarray(group["done"][:], dtype=bool)
+        lost = [k for k in np.flatnonzero(self._done) if not self._chunk_on_disk(group, int(k))]
+        if lost:
+            writable = self._group()
+            for k in lost:
+                writable["done"][k] = False
+            writable.attrs[COMPLETE_ATTR] = False
+            self._done[lost] = False
+
+    def _chunk_on_disk(self, group, k: int) -> bool:
+        """Whether chunk ``k`` of every per-sample array has its (non-empty) file in the store."""
+        assert self.path is not None  # a store on disk: one in memory is never resumed
+        for name, array in group.arrays():
+            dims = array.metadata.dimension_names or ()
+            if name == "sample" or not dims or dims[0] != "sample":  # the coordinate: one chunk, written whole
+                continue
+            key = array.metadata.encode_chunk_key((k,) + (0,) * (array.ndim - 1))
+            file = os.path.join(self.path, name, *key.split("/"))
+            if not os.path.isfile(file) or os.path.getsize(file) == 0:
+                return False
+        return True
+
+    def _digest(self) -> str:
+        """The plan's content digest, strict for a store on disk (it must be found again on resuming)."""
+        return self.plan.digest(strict=self.path is not None)
 
     @property
     def complete(self) -> bool:
@@ -160,7 +256,8 @@ class SweepStore:
         variables["done"] = ("chunk",), (plan.n_chunks,), np.dtype(bool)
         coords = {"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})}
         # as Zarr's JSON gives them back: lists for tuples
-        attrs = json.loads(json.dumps({SETTINGS_ATTR: plan.settings(), COMPLETE_ATTR: False}))
+        attrs = json.loads(json.dumps({SETTINGS_ATTR: plan.settings(), DIGEST_ATTR: self._digest(),
+                                       COMPLETE_ATTR: False}))
         return variables, coords, attrs
 
     def _create(self, first: ChunkResult) -> None:
@@ -179,10 +276,7 @@ class SweepStore:
         ds = xr.Dataset({name: (dims, da.zeros(shape, chunks=(1 if name == "done" else c, *shape[1:]), dtype=dtype))
                          for name, (dims, shape, dtype) in variables.items()}, coords=coords, attrs=attrs)
         encoding = {name: {"fill_value": None} for name in ds.data_vars}
-        parent = os.path.dirname(os.path.abspath(self.path))
-        if not os.path.isdir(parent):
-            raise FileNotFoundError(f"store: directory {parent!r} does not exist")
-        tmp = tempfile.mkdtemp(dir=parent, prefix=f".{os.path.basename(self.path)}.", suffix=".tmp")
+        tmp = temporary(self.path)
         try:
             ds.to_zarr(tmp, mode="a", compute=False, consolidated=False, encoding=encoding, zarr_format=3)
             os.rename(tmp, self.path)  # atomic; fails if the name appeared meanwhile
@@ -202,7 +296,9 @@ class SweepStore:
     def _array(self, name):
         """The store's array ``name`` (a NumPy array in memory, a Zarr array on disk), opened once."""
         if name not in self._arrays:
-            self._arrays[name] = self._memory[name].values if self._memory is not None else self._group()[name]
+            # on disk every chunk is written, even one all of fill values (NaN): a missing file is a lost chunk
+            self._arrays[name] = (self._memory[name].values if self._memory is not None else
+                                  self._group()[name].with_config({"write_empty_chunks": True}))
         return self._arrays[name]
 
     # -- statistics -------------------------------------------------------------------
@@ -238,7 +334,11 @@ class SweepStore:
         ds = xr.Dataset(data, coords={"percentile": p})
         if self._memory is not None:
             self._memory = self._memory.drop_vars(list(ds.variables), errors="ignore").merge(ds)
-        else:
+        else:  # statistics of other percentiles (a resumed sweep may ask for others) are replaced whole
+            group = self._group()
+            for name in ds.variables:
+                if name in group:
+                    del group[name]
             ds.to_zarr(self.path, mode="a", consolidated=False, zarr_format=3)
         (self._memory if self._memory is not None else self._group()).attrs[COMPLETE_ATTR] = True
 

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -28,6 +27,7 @@ from tumble._validate import ValidationError
 from tumble.ensemble import SAMPLES_PER_CHUNK
 from tumble.rigid import RigidBodies
 from tumble.simulate import as_model, simulate
+from tumble.sweep.store import temporary, writing
 
 if TYPE_CHECKING:
     import xarray
@@ -60,6 +60,24 @@ def _chunk_of(model, lo: int, hi: int):
     return RigidBodies(model.inertia[lo:hi], model.moments[lo:hi], model.axes[lo:hi], masses)
 
 
+def _template(ds: xarray.Dataset, n: int, chunk: int) -> xarray.Dataset:
+    """The whole store of ``n`` members laid out from the first chunk's ``ds``: the members' arrays empty
+    (Dask zeros, written as their chunks come, chunked by ``chunk`` members), the others whole."""
+    import dask.array as da
+    import xarray as xr
+
+    def members(var):
+        shape = tuple(n if d == "body" else size for d, size in zip(var.dims, var.shape, strict=True))
+        chunks = tuple(chunk if d == "body" else size for d, size in zip(var.dims, var.shape, strict=True))
+        return var.dims, da.zeros(shape, chunks=chunks), var.attrs
+
+    template = xr.Dataset({name: members(var) for name, var in ds.data_vars.items() if "body" in var.dims},
+                          coords={**{name: c for name, c in ds.coords.items() if name != "body"},
+                                  "body": ("body", np.arange(n), ds["body"].attrs)},
+                          attrs=ds.attrs)
+    return template.assign({name: var for name, var in ds.data_vars.items() if "body" not in var.dims})
+
+
 def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike, store: str | os.PathLike[str], *,
                       t: ArrayLike, initial_state: dict, options: dict, chunk: int | None = None,
                       progress: Callable[[int, int], None] | None = None) -> xarray.Dataset:
@@ -71,15 +89,11 @@ def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike
     ``chunk`` defaults to ``tumble.ensemble.SAMPLES_PER_CHUNK // len(t)`` members (about 200 MB a chunk);
     ``progress(done, total)`` counts members.
     """
-    import dask.array as da
     import xarray as xr
 
     path = os.fspath(store)
     if os.path.exists(path):
         raise ValidationError(f"store: {path} exists; give a new path (a run is never written over another)")
-    parent = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(parent):
-        raise FileNotFoundError(f"store: directory {parent!r} does not exist")
     model = as_model(model)
     values = {name: np.asarray(v) for name, v in initial_state.items() if v is not None}
     n = _members(model, values)
@@ -89,46 +103,38 @@ def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike
     chunk = max(1, SAMPLES_PER_CHUNK // max(1, t.size)) if chunk is None else int(chunk)
     if chunk < 1:
         raise ValidationError(f"chunk: must be >= 1 member, got {chunk}")
-    tmp = None
-    summed: dict[str, int] = {}  # the solver statistics, summed over the chunks
-    try:
-        for lo in range(0, n, chunk):
-            hi = min(n, lo + chunk)
-            part: dict[str, Any] = {name: v[lo:hi] if np.ndim(v) == 2 else v for name, v in values.items()}
-            traj = simulate(_chunk_of(model, lo, hi), t=t, **options, **part)
-            ds = traj.to_xarray()
-            # labels as variable-length strings: Zarr 3 specifies those, not NumPy's fixed-width ones
-            ds = ds.assign_coords({name: c.astype(object) for name, c in ds.coords.items() if c.dtype.kind == "U"})
-            if "body" not in ds.dims:
-                ds = ds.expand_dims(body=[0], axis=1).transpose("time", "body", ...)
-            if tmp is None:  # the whole store, laid out from the first chunk
-                tmp = tempfile.mkdtemp(dir=parent, prefix=f".{os.path.basename(path)}.", suffix=".tmp")
-                template = xr.Dataset(
-                    {name: (var.dims, da.zeros(tuple(n if d == "body" else s for d, s in zip(var.dims, var.shape,
-                                                                                           strict=True)),
-                                               chunks=tuple(chunk if d == "body" else s for d, s in
-                                                            zip(var.dims, var.shape, strict=True))), var.attrs)
-                     for name, var in ds.data_vars.items() if "body" in var.dims},
-                    coords={**{name: c for name, c in ds.coords.items() if name != "body"},
-                            "body": ("body", np.arange(n), ds["body"].attrs)},
-                    attrs=ds.attrs)
-                fixed = {name: var for name, var in ds.data_vars.items() if "body" not in var.dims}
-                template = template.assign(fixed)  # written now; the members' arrays as their chunks come
-                template.to_zarr(tmp, mode="a", compute=False, consolidated=False, zarr_format=3)
-            region = ds.drop_vars([name for name, var in ds.variables.items() if "body" not in var.dims])
-            region = region.assign_coords(body=np.arange(lo, hi))
-            region.to_zarr(tmp, region={"body": slice(lo, hi)}, consolidated=False, zarr_format=3)
-            for key in _SUMMED:
-                summed[key] = summed.get(key, 0) + int(ds.attrs.get(key, 0))
-            if progress is not None:
-                progress(hi, n)
-        import zarr
+    with writing(path):  # one writer at a time; the temporaries of killed runs removed
+        tmp = None
+        summed: dict[str, int] = {}  # the solver statistics, summed over the chunks
+        try:
+            for lo in range(0, n, chunk):
+                hi = min(n, lo + chunk)
+                part: dict[str, Any] = {name: v[lo:hi] if np.ndim(v) == 2 else v for name, v in values.items()}
+                traj = simulate(_chunk_of(model, lo, hi), t=t, **options, **part)
+                ds = traj.to_xarray()
+                # labels as variable-length strings: Zarr 3 specifies those, not NumPy's fixed-width ones
+                ds = ds.assign_coords({name: c.astype(object) for name, c in ds.coords.items()
+                                       if c.dtype.kind == "U"})
+                if "body" not in ds.dims:
+                    ds = ds.expand_dims(body=[0], axis=1).transpose("time", "body", ...)
+                if tmp is None:  # the whole store, laid out from the first chunk
+                    tmp = temporary(path)
+                    template = _template(ds, n, chunk)
+                    template.to_zarr(tmp, mode="a", compute=False, consolidated=False, zarr_format=3)
+                region = ds.drop_vars([name for name, var in ds.variables.items() if "body" not in var.dims])
+                region = region.assign_coords(body=np.arange(lo, hi))
+                region.to_zarr(tmp, region={"body": slice(lo, hi)}, consolidated=False, zarr_format=3)
+                for key in _SUMMED:
+                    summed[key] = summed.get(key, 0) + int(ds.attrs.get(key, 0))
+                if progress is not None:
+                    progress(hi, n)
+            import zarr
 
-        assert tmp is not None  # n >= 1: the first chunk made it
-        zarr.open_group(tmp, mode="r+", zarr_format=3).attrs.update(summed)
-        os.rename(tmp, path)
-    except BaseException:
-        if tmp is not None:
-            shutil.rmtree(tmp, ignore_errors=True)
-        raise
+            assert tmp is not None  # n >= 1: the first chunk made it
+            zarr.open_group(tmp, mode="r+", zarr_format=3).attrs.update(summed)
+            os.rename(tmp, path)
+        except BaseException:
+            if tmp is not None:
+                shutil.rmtree(tmp, ignore_errors=True)
+            raise
     return xr.open_zarr(path, consolidated=False, zarr_format=3)
