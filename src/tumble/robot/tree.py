@@ -271,11 +271,26 @@ class RobotTree(ChainMotion):
     def __setattr__(self, name, value):
         raise AttributeError(f"{type(self).__name__} is immutable: cannot set {name!r}")
 
+    def __reduce__(self):
+        """Pickled as what it is built from (links, parents, gravity, name, frames, mimic), so that another
+        process (a Dask worker, a resumed sweep) builds the same tree, and the same content digest, without its
+        scratch arrays."""
+        return _rebuild, (type(self), self._links, self._parents, self._gravity, self._name, self._frames,
+                          self._mimic)
+
     def __repr__(self):
         name = "" if self._name is None else f"{self._name!r}, "
         base = "floating base, " if self._floating else ""
         return (f"{type(self).__name__}({name}{base}{len(self._links)} links, {self.dof} joint coordinates, "
                 f"mass={self.mass:.6g} kg)")
+
+
+def _rebuild(cls: type, links, parents, gravity, name, frames, mimic) -> RobotTree:
+    """A tree of class ``cls`` (a subclass too: its own constructor takes other arguments) built by
+    :class:`RobotTree`'s constructor, for :meth:`RobotTree.__reduce__`."""
+    tree = cls.__new__(cls)
+    RobotTree.__init__(tree, links, parents, gravity=gravity, name=name, frames=frames, mimic=mimic)
+    return tree
 
 
 def _frame(frame, nb: int) -> Frame:

@@ -38,7 +38,7 @@ differs, rather than mixed with this sweep's chunks.
 One process writes a store at a time: it holds the lock ``.NAME.lock`` beside
 it (:func:`tumble.trajectory.write_atomic`'s lock) while it runs, and a second
 writer is refused. The store is created under a temporary name
-``.NAME.*.tmp`` and renamed into place, so its name never points at a
+``.NAME.XXXXXXXX.tmp`` and renamed into place, so its name never points at a
 half-made store; holding the lock, a writer removes the temporaries that a
 killed run left (:func:`writing`).
 
@@ -94,7 +94,8 @@ class StoreMismatchError(ValidationError):
 @contextlib.contextmanager
 def writing(path: str | os.PathLike[str] | None) -> Iterator[None]:
     """Hold the writer's lock of the Zarr store ``path`` (``.NAME.lock`` beside it) while the block runs, after
-    removing the temporaries ``.NAME.XXXXXXXX.tmp`` of killed runs (no live writer owns them: a writer holds the lock).
+    removing the temporaries ``.NAME.XXXXXXXX.tmp`` of killed runs (no live writer owns them: a writer holds the
+    lock).
     Another process writing ``path`` now: :class:`FileExistsError`. ``None`` (in memory): nothing to hold."""
     if path is None:
         yield
