@@ -1,0 +1,25 @@
+"""Attitude estimation: determination from vector observations, Kalman and complementary filters.
+
+=============================  ==================================================================
+``triad``, ``davenport``,      attitude from vector observations (Wahba's problem); QUEST also
+``quest``                      gives the attitude-error covariance
+``mekf``                       multiplicative extended Kalman filter: attitude error + gyro bias,
+                               star tracker quaternions and vector observations, batched over runs
+=============================  ==================================================================
+
+The estimators are compiled functions on arrays, free of any model: they
+take measurements (from :mod:`tumble.estimation.sensors`, from
+:mod:`tumble.ins`, or from a file) and return estimates. Conventions as
+everywhere in tumble: SI units, ``q`` scalar-first body → inertial, rates in
+body axes; attitude errors are rotation vectors ``δθ`` in body axes with
+``q_true = q̂ ⊗ exp(δθ/2)``. See ``docs/estimation.md``.
+"""
+
+from tumble.estimation._determination import AttitudeEstimate, davenport, quest, triad
+
+__all__ = [
+    "AttitudeEstimate",
+    "davenport",
+    "quest",
+    "triad",
+]
