@@ -16,10 +16,14 @@ body axes; attitude errors are rotation vectors ``δθ`` in body axes with
 """
 
 from tumble.estimation._determination import AttitudeEstimate, davenport, quest, triad
+from tumble.estimation._mekf import FilterResult, covariance_matrix, mekf
 
 __all__ = [
     "AttitudeEstimate",
+    "FilterResult",
+    "covariance_matrix",
     "davenport",
+    "mekf",
     "quest",
     "triad",
 ]
