@@ -5,6 +5,8 @@
 ``quest``                      gives the attitude-error covariance
 ``mekf``                       multiplicative extended Kalman filter: attitude error + gyro bias,
                                star tracker quaternions and vector observations, batched over runs
+``sensors``                    measurement models: star tracker, coarse and fine Sun sensors,
+                               magnetometer, each read from a true motion with its own seed
 =============================  ==================================================================
 
 The estimators are compiled functions on arrays, free of any model: they
@@ -17,6 +19,7 @@ body axes; attitude errors are rotation vectors ``δθ`` in body axes with
 
 from tumble.estimation._determination import AttitudeEstimate, davenport, quest, triad
 from tumble.estimation._mekf import FilterResult, covariance_matrix, mekf
+from tumble.estimation import sensors
 
 __all__ = [
     "AttitudeEstimate",
@@ -24,6 +27,7 @@ __all__ = [
     "covariance_matrix",
     "davenport",
     "mekf",
+    "sensors",
     "quest",
     "triad",
 ]
