@@ -5,6 +5,8 @@
 ``quest``                      gives the attitude-error covariance
 ``mekf``                       multiplicative extended Kalman filter: attitude error + gyro bias,
                                star tracker quaternions and vector observations, batched over runs
+``madgwick``, ``mahony``,      AHRS filters for gyro + accelerometer + magnetometer, batched
+``ahrs_ekf``
 ``sensors``                    measurement models: star tracker, coarse and fine Sun sensors,
                                magnetometer, each read from a true motion with its own seed
 =============================  ==================================================================
@@ -17,6 +19,7 @@ body axes; attitude errors are rotation vectors ``δθ`` in body axes with
 ``q_true = q̂ ⊗ exp(δθ/2)``. See ``docs/estimation.md``.
 """
 
+from tumble.estimation._ahrs import ahrs_ekf, madgwick, mahony
 from tumble.estimation._determination import AttitudeEstimate, davenport, quest, triad
 from tumble.estimation._mekf import FilterResult, covariance_matrix, mekf
 from tumble.estimation import sensors
@@ -24,8 +27,11 @@ from tumble.estimation import sensors
 __all__ = [
     "AttitudeEstimate",
     "FilterResult",
+    "ahrs_ekf",
     "covariance_matrix",
     "davenport",
+    "madgwick",
+    "mahony",
     "mekf",
     "sensors",
     "quest",
