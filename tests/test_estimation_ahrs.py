@@ -41,6 +41,9 @@ FILTERS = {
     "mahony": (mahony, {"k_p": 1.0, "k_i": 0.3}),
     "ekf": (ahrs_ekf, {"inclination": INCLINATION}),
 }
+#: Largest angle (rad) between tumble's and the peer's estimates: the same arithmetic for Madgwick and Mahony;
+#: tumble's EKF normalises the predicted quaternion before the update, the peer's does not (6e-7 rad here).
+AGREEMENT = {"madgwick": 1e-12, "mahony": 1e-12, "ekf": 1e-5}
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +63,7 @@ def test_ahrs_filter_matches_the_peer_and_is_no_less_accurate(data, name):
     err_peer = attitude.relative_angle(peer[settled], q_true[settled])
     rms_ours, rms_peer = np.sqrt(np.mean(err_ours**2)), np.sqrt(np.mean(err_peer**2))
     assert rms_ours <= rms_peer * (1.0 + 1e-6)
-    assert attitude.relative_angle(ours, peer).max() < 1e-6  # the same filter, in tumble's frame
+    assert attitude.relative_angle(ours, peer).max() < AGREEMENT[name]  # the same filter, in tumble's frame
     assert rms_ours < np.radians(3.0)
 
 
