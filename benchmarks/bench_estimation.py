@@ -47,7 +47,7 @@ def main() -> None:
     print(f"{K} samples at {1 / DT:.0f} Hz; tumble's batch: {args.runs} runs; times per sample in µs, "
           "min / median of 5")
     print(f"{'filter':9} {'rms err tumble':>14} {'rms err ahrs':>12} {'max Δ (rad)':>11} "
-          f"{'ahrs, 1 run':>14} {'tumble, 1 run':>15} {'tumble, batch (wall)':>21} {"(CPU÷cores)":>14} "
+          f"{'ahrs, 1 run':>14} {'tumble, 1 run':>15} {'tumble, batch (wall)':>21} {'(CPU÷cores)':>14} "
           f"{'speed-up':>9}")
     for name, (fn, options) in FILTERS.items():
         ours = fn(rate, accel, mag, DT, q0=q_true[0], **options)  # compiles

@@ -3,14 +3,13 @@ magnetometer data tumble generated from a tumbling body (accuracy against tumble
 
 import numpy as np
 import pytest
+from ahrs_peer import run_peer
 
 import tumble
 from tumble import attitude
 from tumble.estimation import ahrs_ekf, madgwick, mahony
 from tumble.estimation.sensors import Magnetometer
 from tumble.ins import Imu, SensorErrors
-
-from ahrs_peer import run_peer
 
 pytest.importorskip("ahrs")
 

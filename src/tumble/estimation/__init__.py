@@ -19,10 +19,10 @@ body axes; attitude errors are rotation vectors ``δθ`` in body axes with
 ``q_true = q̂ ⊗ exp(δθ/2)``. See ``docs/estimation.md``.
 """
 
+from tumble.estimation import sensors
 from tumble.estimation._ahrs import ahrs_ekf, madgwick, mahony
 from tumble.estimation._determination import AttitudeEstimate, davenport, quest, triad
 from tumble.estimation._mekf import FilterResult, covariance_matrix, mekf
-from tumble.estimation import sensors
 
 __all__ = [
     "AttitudeEstimate",

@@ -158,7 +158,8 @@ class StarTracker:
         R_bs = attitude.to_matrix(self.mounting)
         return R_bs @ np.diag([self.sigma_cross**2, self.sigma_cross**2, self.sigma_about**2]) @ R_bs.T
 
-    def sample(self, t, q=None, *, directions: dict | None = None, seed: Seed = None) -> Measurements:
+    def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
+               directions: dict | None = None, seed: Seed = None) -> Measurements:
         """Measured attitudes (M, 4) of the truth (Trajectory, or ``t``, ``q``).
 
         ``directions`` maps ``"sun"``/``"earth"``/``"moon"`` to the direction of that body from the spacecraft in
@@ -204,7 +205,8 @@ class CoarseSunSensor:
         object.__setattr__(self, "sigma", require_non_negative(self.sigma, "sigma"))
         require_positive(self.rate, "rate")
 
-    def sample(self, t, q=None, *, sun: ArrayLike, seed: Seed = None) -> Measurements:
+    def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
+               sun: ArrayLike, seed: Seed = None) -> Measurements:
         """Head outputs (M, J); ``sun``: direction to the Sun, inertial axes, (3,) or one per truth time."""
         t, q = _truth(t, q)
         out_t = sample_times(t, self.rate, self.latency)
@@ -235,7 +237,8 @@ class FineSunSensor:
         if not 0.0 < float(self.field_of_view) <= math.pi:
             raise ValidationError(f"field_of_view: must be a half-angle in (0, π] rad, got {self.field_of_view}")
 
-    def sample(self, t, q=None, *, sun: ArrayLike, seed: Seed = None) -> Measurements:
+    def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
+               sun: ArrayLike, seed: Seed = None) -> Measurements:
         """Measured Sun directions (M, 3), unit, NaN outside the field of view."""
         t, q = _truth(t, q)
         out_t = sample_times(t, self.rate, self.latency)
@@ -272,7 +275,8 @@ class Magnetometer:
         object.__setattr__(self, "errors", m)
         require_positive(self.rate, "rate")
 
-    def sample(self, t, q=None, *, field_inertial: ArrayLike, seed: Seed = None) -> Measurements:
+    def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
+               field_inertial: ArrayLike, seed: Seed = None) -> Measurements:
         """Measured field (M, 3), T; ``field_inertial``: the field in inertial axes, (3,) or one per truth time."""
         t, q = _truth(t, q)
         out_t = sample_times(t, self.rate, self.latency)
