@@ -96,8 +96,31 @@ def test_mekf_with_vector_observations_tracks_the_attitude(truth):
     ({"star_tracker": np.tile([1.0, 0, 0, 0], (3, 1)), "star_tracker_covariance": -np.eye(3)},
      "star_tracker_covariance: must be positive definite"),
     ({"rate": np.zeros((3, 3))}, "rate: must have shape"),
+    ({"star_tracker": np.zeros((3, 4)), "star_tracker_covariance": np.eye(3)},
+     "star_tracker: a measurement must be non-zero"),
 ])
 def test_mekf_bad_input_names_the_field_and_rule(change, message):
     args = {"rate": np.zeros((2, 3)), "q0": [1.0, 0, 0, 0], "P0": np.eye(6), "arw": 1e-4, "rrw": 1e-6} | change
     with pytest.raises(tumble.ValidationError, match=message):
         mekf([0.0, 1.0, 2.0], args.pop("rate"), **args)
+
+
+@pytest.mark.parametrize("omega", [[0.3, -1.2, 0.7], [1e-5, 2e-5, -1e-5], [0.0, 0.0, 0.0]])
+def test_mekf_transition_matrix_is_the_exponential_of_the_error_dynamics(omega):
+    """Φ's closed form (both branches: |ω̂|Δt above and below 1e-3) against expm(F Δt) of δẋ = F δx,
+    F = [[−[ω̂×], −I], [0, 0]]; with σ_u = 0 the process noise is σ_v²Δt I on the attitude."""
+    from scipy.linalg import expm
+
+    from tumble.estimation._mekf import _propagate
+
+    dt, arw = 0.2, 1e-3
+    w = np.array(omega)
+    skew = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+    F = np.zeros((6, 6))
+    F[:3, :3], F[:3, 3:] = -skew, -np.eye(3)
+    q, beta, P = np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3), np.zeros((6, 6))
+    Phi, W = np.empty((6, 6)), np.empty((3, 3))
+    _propagate(q, beta, P, w, dt, arw**2, 0.0, Phi, W)
+    np.testing.assert_allclose(Phi, expm(F * dt), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(P, np.diag([arw**2 * dt] * 3 + [0.0] * 3), rtol=0, atol=1e-20)
+    np.testing.assert_allclose(q, attitude.from_rotvec(w * dt), rtol=0, atol=1e-15)

@@ -240,6 +240,8 @@ def _runs(value, name: str, tail: tuple[int, ...], runs: int) -> np.ndarray:
         raise ValidationError(f"{name}: must have shape {tail} or {(runs, *tail)}, got {arr.shape}")
     if np.isinf(arr).any():
         raise ValidationError(f"{name}: must be finite or NaN (no measurement), found inf")
+    if name in ("star_tracker", "vectors") and np.any(~arr.any(axis=-1)):
+        raise ValidationError(f"{name}: a measurement must be non-zero (NaN where there is none)")
     return readonly(np.broadcast_to(arr, (runs, *tail)))
 
 
