@@ -233,14 +233,15 @@ def covariance_matrix(value, name: str, size: int) -> np.ndarray:
     return readonly(0.5 * (c + c.T))
 
 
-def _runs(value, name: str, tail: tuple[int, ...], runs: int) -> np.ndarray:
-    """``value`` (tail) or (runs, *tail) broadcast to (runs, *tail), read-only and contiguous."""
+def _runs(value, name: str, tail: tuple[int, ...], runs: int, *, measured: bool = False) -> np.ndarray:
+    """``value`` (tail) or (runs, *tail) broadcast to (runs, *tail), read-only and contiguous; with ``measured``,
+    rows of measurements: NaN where there is none, else non-zero."""
     arr = as_array(value, name, tail=tail, finite=False)
     if arr.shape not in (tail, (runs, *tail)):
         raise ValidationError(f"{name}: must have shape {tail} or {(runs, *tail)}, got {arr.shape}")
     if np.isinf(arr).any():
         raise ValidationError(f"{name}: must be finite or NaN (no measurement), found inf")
-    if name in ("star_tracker", "vectors") and np.any(~arr.any(axis=-1)):
+    if measured and np.any(~arr.any(axis=-1)):
         raise ValidationError(f"{name}: a measurement must be non-zero (NaN where there is none)")
     return readonly(np.broadcast_to(arr, (runs, *tail)))
 
@@ -286,14 +287,14 @@ def mekf(t: ArrayLike, rate: ArrayLike, *, q0: ArrayLike, P0: ArrayLike, arw: fl
     else:
         if star_tracker_covariance is None:
             raise ValidationError("star_tracker_covariance: must be given with star_tracker")
-        q_st = _runs(star_tracker, "star_tracker", (K, 4), runs)
+        q_st = _runs(star_tracker, "star_tracker", (K, 4), runs, measured=True)
         R_st = covariance_matrix(star_tracker_covariance, "star_tracker_covariance", 3)
     if vectors is None:
         vec, ref, sig = np.full((runs, K, 0, 3), np.nan), np.zeros((K, 0, 3)), np.zeros(0)
     else:
         v = as_array(vectors, "vectors", tail=(3,), finite=False)
         m = v.shape[-2] if v.ndim >= 3 else 0
-        vec = _runs(v, "vectors", (K, m, 3), runs)
+        vec = _runs(v, "vectors", (K, m, 3), runs, measured=True)
         if references is None or vector_sigma is None:
             raise ValidationError("references: must be given with vectors (and vector_sigma)")
         ref_arr = as_array(references, "references", tail=(m, 3))
