@@ -81,29 +81,28 @@ def _earth_field(q, mx, my, mz):
 
 
 @njit(cache=True)
-def _madgwick_step(q, w, a, m, dt, beta):
+def _madgwick_step(q, omega, a, m, dt, beta):
     ax, ay, az = _unit3(a)
     mx, my, mz = _unit3(m)
     bx, bz = _earth_field(q, mx, my, mz)
-    qw, qx, qy, qz = q[0], q[1], q[2], q[3]
-    f = np.array([2.0 * (qx * qz - qw * qy) - ax,
-                  2.0 * (qw * qx + qy * qz) - ay,
-                  2.0 * (0.5 - qx * qx - qy * qy) - az,
-                  2.0 * bx * (0.5 - qy * qy - qz * qz) + 2.0 * bz * (qx * qz - qw * qy) - mx,
-                  2.0 * bx * (qx * qy - qw * qz) + 2.0 * bz * (qw * qx + qy * qz) - my,
-                  2.0 * bx * (qw * qy + qx * qz) + 2.0 * bz * (0.5 - qx * qx - qy * qy) - mz])
-    J = np.array([[-2.0 * qy, 2.0 * qz, -2.0 * qw, 2.0 * qx],
-                  [2.0 * qx, 2.0 * qw, 2.0 * qz, 2.0 * qy],
-                  [0.0, -4.0 * qx, -4.0 * qy, 0.0],
-                  [-2.0 * bz * qy, 2.0 * bz * qz, -4.0 * bx * qy - 2.0 * bz * qw, -4.0 * bx * qz + 2.0 * bz * qx],
-                  [-2.0 * bx * qz + 2.0 * bz * qx, 2.0 * bx * qy + 2.0 * bz * qw, 2.0 * bx * qx + 2.0 * bz * qz,
-                   -2.0 * bx * qw + 2.0 * bz * qy],
-                  [2.0 * bx * qy, 2.0 * bx * qz - 4.0 * bz * qx, 2.0 * bx * qw - 4.0 * bz * qy, 2.0 * bx * qx]])
-    g = J.T @ f
-    n = math.sqrt(g @ g)
-    if n > 0.0:
-        g *= beta / n
-    _euler_step(q, w[0], w[1], w[2], dt, g[0], g[1], g[2], g[3])
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    # f (eq. 31 with d = ẑ, b = [b_x, 0, b_z]) and the gradient Jᵀf of eq. 34, J of eq. 32, by components
+    f1 = 2.0 * (x * z - w * y) - ax
+    f2 = 2.0 * (w * x + y * z) - ay
+    f3 = 2.0 * (0.5 - x * x - y * y) - az
+    f4 = 2.0 * bx * (0.5 - y * y - z * z) + 2.0 * bz * (x * z - w * y) - mx
+    f5 = 2.0 * bx * (x * y - w * z) + 2.0 * bz * (w * x + y * z) - my
+    f6 = 2.0 * bx * (w * y + x * z) + 2.0 * bz * (0.5 - x * x - y * y) - mz
+    gw = -2.0 * y * f1 + 2.0 * x * f2 - 2.0 * bz * y * f4 + (-2.0 * bx * z + 2.0 * bz * x) * f5 + 2.0 * bx * y * f6
+    gx = (2.0 * z * f1 + 2.0 * w * f2 - 4.0 * x * f3 + 2.0 * bz * z * f4 + (2.0 * bx * y + 2.0 * bz * w) * f5
+          + (2.0 * bx * z - 4.0 * bz * x) * f6)
+    gy = (-2.0 * w * f1 + 2.0 * z * f2 - 4.0 * y * f3 + (-4.0 * bx * y - 2.0 * bz * w) * f4
+          + (2.0 * bx * x + 2.0 * bz * z) * f5 + (2.0 * bx * w - 4.0 * bz * y) * f6)
+    gz = (2.0 * x * f1 + 2.0 * y * f2 + (-4.0 * bx * z + 2.0 * bz * x) * f4 + (-2.0 * bx * w + 2.0 * bz * y) * f5
+          + 2.0 * bx * x * f6)
+    n = qnorm(gw, gx, gy, gz)
+    s = beta / n if n > 0.0 else 0.0
+    _euler_step(q, omega[0], omega[1], omega[2], dt, s * gw, s * gx, s * gy, s * gz)
 
 
 @njit(cache=True)

@@ -41,11 +41,12 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import ArrayLike
 
+from tumble import attitude
 from tumble._quat import qexp, qlog, qmul, qnorm, qrotate_inv
 from tumble._validate import ValidationError, as_array, increasing_times, readonly, require_non_negative
 from tumble.attitude import _as_quat
 
-__all__ = ["FilterResult", "mekf"]
+__all__ = ["FilterResult", "covariance_matrix", "mekf"]
 
 #: Below this rotation per step (rad), Φ's coefficients are taken from their Taylor series (error < θ⁴/120).
 _SMALL_TURN = 1e-3
@@ -72,8 +73,6 @@ class FilterResult:
 
     def error(self, q_true: ArrayLike, bias_true: ArrayLike) -> np.ndarray:
         """Estimation error ``[δθ, δβ]`` (…, K, 6) against the truth: ``q_true = q̂ ⊗ exp(δθ/2)``, ``δβ = β − β̂``."""
-        from tumble import attitude
-
         dtheta = attitude.to_rotvec(attitude.multiply(attitude.conjugate(self.q), q_true))
         return np.concatenate([dtheta, np.asarray(bias_true) - self.bias], axis=-1)
 
