@@ -96,6 +96,7 @@ def test_mekf_with_vector_observations_tracks_the_attitude(truth):
     ({"star_tracker": np.tile([1.0, 0, 0, 0], (3, 1)), "star_tracker_covariance": -np.eye(3)},
      "star_tracker_covariance: must be positive definite"),
     ({"rate": np.zeros((3, 3))}, "rate: must have shape"),
+    ({"bias0": [0.0, np.nan, 0.0]}, "bias0: must be finite"),
     ({"star_tracker": np.zeros((3, 4)), "star_tracker_covariance": np.eye(3)},
      "star_tracker: a measurement must be non-zero"),
 ])

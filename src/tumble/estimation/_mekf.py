@@ -235,10 +235,10 @@ def covariance_matrix(value, name: str, size: int) -> np.ndarray:
 def _runs(value, name: str, tail: tuple[int, ...], runs: int, *, measured: bool = False) -> np.ndarray:
     """``value`` (tail) or (runs, *tail) broadcast to (runs, *tail), read-only and contiguous; with ``measured``,
     rows of measurements: NaN where there is none, else non-zero."""
-    arr = as_array(value, name, tail=tail, finite=False)
+    arr = as_array(value, name, tail=tail, finite=not measured)
     if arr.shape not in (tail, (runs, *tail)):
         raise ValidationError(f"{name}: must have shape {tail} or {(runs, *tail)}, got {arr.shape}")
-    if np.isinf(arr).any():
+    if measured and np.isinf(arr).any():
         raise ValidationError(f"{name}: must be finite or NaN (no measurement), found inf")
     if measured and np.any(~arr.any(axis=-1)):
         raise ValidationError(f"{name}: a measurement must be non-zero (NaN where there is none)")
