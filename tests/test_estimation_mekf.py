@@ -30,8 +30,9 @@ def truth():
     return grid[::2], traj.q[::2], inc.rate
 
 
-def _monte_carlo(truth, star_every: int, seed: int = 5):
-    """RUNS runs: their true biases (R, K, 3), and the MEKF's estimates with a star tracker every star_every steps."""
+def _draws(truth, star_every: int, seed: int):
+    """RUNS runs' true biases (R, K, 3) and the filter's inputs: gyro rates, initial attitudes, star tracker
+    quaternions every star_every steps (NaN between), P0."""
     t, q_true, rate_true = truth
     K = t.size
     rng = np.random.default_rng(seed)
@@ -43,7 +44,13 @@ def _monte_carlo(truth, star_every: int, seed: int = 5):
     star = attitude.multiply(q_true, attitude.from_rotvec(noise))
     star[:, np.arange(K) % star_every != 0] = np.nan
     P0 = np.diag([ANGLE_SIGMA**2] * 3 + [BIAS_SIGMA**2] * 3)
-    est = mekf(t, rate, q0=q0, P0=P0, arw=ARW, rrw=RRW, star_tracker=star, star_tracker_covariance=ST_COV)
+    return bias, rate, q0, star, P0
+
+
+def _monte_carlo(truth, star_every: int, seed: int = 5):
+    """RUNS runs: their true biases (R, K, 3), and the MEKF's estimates with a star tracker every star_every steps."""
+    bias, rate, q0, star, P0 = _draws(truth, star_every, seed)
+    est = mekf(truth[0], rate, q0=q0, P0=P0, arw=ARW, rrw=RRW, star_tracker=star, star_tracker_covariance=ST_COV)
     return bias, est
 
 
@@ -125,3 +132,15 @@ def test_mekf_transition_matrix_is_the_exponential_of_the_error_dynamics(omega):
     np.testing.assert_allclose(Phi, expm(F * dt), rtol=0, atol=1e-14)
     np.testing.assert_allclose(P, np.diag([arw**2 * dt] * 3 + [0.0] * 3), rtol=0, atol=1e-20)
     np.testing.assert_allclose(q, attitude.from_rotvec(w * dt), rtol=0, atol=1e-15)
+
+
+def test_mekf_batch_of_runs_equals_each_run_alone(truth):
+    """prange over runs: every run of a batch gives bit for bit what it gives alone."""
+    bias, est = _monte_carlo(truth, star_every=4, seed=3)
+    _, rate, q0, star, P0 = _draws(truth, star_every=4, seed=3)
+    for i in (0, 117):
+        alone = mekf(truth[0], rate[i], q0=q0[i], P0=P0, arw=ARW, rrw=RRW, star_tracker=star[i],
+                     star_tracker_covariance=ST_COV)
+        assert alone.q.shape == (truth[0].size, 4)
+        np.testing.assert_array_equal(alone.q, est.q[i])
+        np.testing.assert_array_equal(alone.covariance, est.covariance[i])
