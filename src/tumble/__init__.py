@@ -32,7 +32,7 @@ __version__ = "0.2.1"
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
 _LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep", "examples", "viewer")
+         "robot", "sweep", "examples", "viewer", "estimation")
 
 
 def __getattr__(name):
@@ -54,6 +54,7 @@ __all__ = [
     "attitude",
     "dynamics",
     "ensemble",
+    "estimation",
     "examples",
     "flexible",
     "ins",
