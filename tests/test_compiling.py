@@ -87,3 +87,26 @@ def test_simulate_announces_a_first_compile_and_a_cached_run_is_silent(tmp_path)
     assert re.fullmatch(r"tumble: compiling the rk4 path of RigidBody \(tumble\.[\w.]+: first use of this model "
                         r"kind and method here; cached for later runs\)\.\.\.\n", first.stderr), first.stderr
     assert cached.stderr == ""
+
+
+# -- import tumble stays light -------------------------------------------------------------------------------
+
+# what `import tumble` must not load: the writers, the figures, the viewer's bundle, the sweeps' scheduler, the
+# scenario files' validation, the CLI, the file lock (each loaded by the feature that uses it)
+HEAVY = ("dask", "distributed", "matplotlib", "plotly", "xarray", "zarr", "h5netcdf", "h5py", "pandas", "pydantic",
+         "typer", "rich", "psutil", "filelock", "defusedxml")
+
+
+def test_import_tumble_imports_nothing_heavy_and_compiles_nothing(tmp_path):
+    probe = ("import sys, numba.core.event as event\n"
+             "class Count(event.Listener):\n"
+             "    compiles = 0\n"
+             "    def on_start(self, e): Count.compiles += 1\n"
+             "    def on_end(self, e): pass\n"
+             "event.register('numba:compile', Count())\n"
+             "import tumble\n"
+             f"print(sorted({{m.partition('.')[0] for m in sys.modules}} & set({HEAVY!r})), Count.compiles)\n")
+    env = {**os.environ, "PYTHONPATH": SRC, "NUMBA_CACHE_DIR": str(tmp_path)}
+    done = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120,
+                          check=True)
+    assert done.stdout == "[] 0\n"

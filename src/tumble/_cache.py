@@ -110,6 +110,12 @@ def content_key(package: Path = PACKAGE) -> str:
     return digest.hexdigest()
 
 
+@functools.cache
+def _in_package(py_file: str) -> bool:
+    """True when ``py_file`` is a file of tumble's package, installed as a directory (not in a zip)."""
+    return PACKAGE.is_dir() and os.path.realpath(py_file).startswith(str(PACKAGE) + os.sep)
+
+
 def _keyed_by_content(locator: type) -> type:
     """A subclass of one of Numba's file-backed cache locators that stamps the functions defined in tumble's
     package with :func:`content_key`, where ``locator`` puts them; other functions it leaves to the next
@@ -118,9 +124,7 @@ def _keyed_by_content(locator: type) -> type:
     class ContentKeyed(locator):
         @classmethod
         def from_function(cls, py_func, py_file):
-            if not PACKAGE.is_dir() or not Path(py_file).resolve().is_relative_to(PACKAGE):
-                return None
-            return super().from_function(py_func, py_file)
+            return super().from_function(py_func, py_file) if _in_package(py_file) else None
 
         def get_source_stamp(self):
             return content_key()

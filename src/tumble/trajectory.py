@@ -46,7 +46,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
 
-import filelock
 import numpy as np
 
 from ._validate import ValidationError, as_array
@@ -766,6 +765,8 @@ def write_atomic(path: str | os.PathLike, write: Callable[[str], None]) -> None:
 @contextlib.contextmanager
 def _exclusive(lock_path: str, path: str):
     """Hold an exclusive lock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
+    import filelock  # here, not at module level: `import tumble` stays light
+
     lock = filelock.FileLock(lock_path, timeout=0, is_singleton=False)
     try:
         lock.acquire()
