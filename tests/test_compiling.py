@@ -42,8 +42,8 @@ def test_a_long_compile_is_announced_once_on_stderr_naming_the_function_and_the_
     with _compiling.notice("the rk4 path of RigidBody", delay=0.05):
         _compile_two_laws()
     lines = capsys.readouterr().err.splitlines()
-    assert lines == ["tumble: compiling test_compiling._compile_two_laws.<locals>.<lambda> for the rk4 path of RigidBody (a compiled function "
-                     "of yours, first called in this process)..."]
+    assert lines == ["tumble: compiling test_compiling._compile_two_laws.<locals>.<lambda> for the rk4 path of "
+                     "RigidBody (a compiled function of yours, first called in this process)..."]
 
 
 def test_a_compile_shorter_than_the_delay_says_nothing(capsys):
@@ -68,7 +68,8 @@ def test_the_notice_is_a_log_record_where_logging_enables_it(capsys, caplog):
     with _compiling.notice("a run", delay=0.05):
         _compile_two_laws()
     assert [(r.name, r.levelno) for r in caplog.records] == [("tumble", logging.INFO)]
-    assert caplog.records[0].getMessage().startswith("compiling test_compiling._compile_two_laws.<locals>.<lambda> for a run (")
+    assert caplog.records[0].getMessage().startswith(
+        "compiling test_compiling._compile_two_laws.<locals>.<lambda> for a run (")
     assert capsys.readouterr().err == ""
 
 
