@@ -22,7 +22,7 @@ import numpy as np
 if TYPE_CHECKING:
     from tumble.simulate import Model, SolverOptions
 
-__all__ = ["KINDS", "paths"]
+__all__ = ["KINDS", "kind_path", "methods", "paths"]
 
 _OMEGA0 = np.array([0.1, 1.0, 0.1])  # rad/s
 _T = np.array([0.0, 0.02, 0.04])  # s: a few steps
@@ -130,7 +130,7 @@ def _options(method: str) -> SolverOptions:
     return {"rtol": 1e-10, "atol": 1e-12} if method == "dop853" else {} if method == "exact" else {"dt": 0.01}
 
 
-def _simulate(kind: str, method: str) -> Callable[[], None]:
+def kind_path(kind: str, method: str) -> Callable[[], None]:
     """A path: ``simulate`` of the model of ``kind`` under ``method``."""
 
     def run() -> None:
@@ -142,7 +142,7 @@ def _simulate(kind: str, method: str) -> Callable[[], None]:
     return run
 
 
-def _methods(kind: str) -> list[str]:
+def methods(kind: str) -> list[str]:
     """The methods whose needs the kernel of ``kind`` provides (:func:`tumble.integrate.check_method`'s rule)."""
     from tumble import integrate
 
@@ -179,7 +179,7 @@ def paths() -> dict[str, Callable[[], None]]:
     """Path name -> the call that compiles it, in the order ``tumble warmup`` runs them: ``"KIND, METHOD"`` for
     each kind of :data:`KINDS` and each method it provides, then the first session's paths."""
     return {
-        **{f"{kind}, {method}": _simulate(kind, method) for kind in KINDS for method in _methods(kind)},
+        **{f"{kind}, {method}": kind_path(kind, method) for kind in KINDS for method in methods(kind)},
         "demo racket": _racket,
         "a batch, rk4": _rigid_paths(members=2, method="rk4"),
         "a batch, dop853": _rigid_paths(members=2, method="dop853"),
