@@ -66,13 +66,7 @@ class _Watch(event.Listener):
         self._due = self._said = False
 
     def on_start(self, event) -> None:
-        self._started(event.data["dispatcher"])
-
-    def on_end(self, event) -> None:
-        with self._lock:
-            self._compiling.pop()
-
-    def _started(self, dispatcher) -> None:
+        dispatcher = event.data["dispatcher"]
         with self._lock:
             self._compiling.append(dispatcher)
             if self._timer is None:
@@ -83,6 +77,11 @@ class _Watch(event.Listener):
             self._said |= say
         if say:
             _say(_what(dispatcher, self._purpose))
+
+    def on_end(self, event) -> None:
+        with self._lock:
+            if self._compiling:  # a compile of another thread may have started before the watch
+                self._compiling.pop()
 
     def _fire(self) -> None:
         with self._lock:
