@@ -122,3 +122,26 @@ def test_the_layers_left_out_of_the_key_compile_nothing_and_no_compiled_module_i
         reached = {name for name in _module_level_imports(path)
                    if any(name == module or name.startswith(module + ".") for module in left_out_modules)}
         assert not reached, f"{path.relative_to(SRC)} imports {reached}: they must be in the key"
+
+
+@pytest.mark.slow
+def test_cache_info_counts_the_compiled_functions_and_cache_clear_removes_them(tmp_path):
+    cache = tmp_path / "cache"
+    _run(SRC.parent, cache)  # compiles attitude.to_rotvec's loop into the empty NUMBA_CACHE_DIR
+    env = {**os.environ, "PYTHONPATH": str(SRC.parent), "NUMBA_CACHE_DIR": str(cache)}
+
+    def tumble_cache(command):
+        done = subprocess.run([sys.executable, "-m", "tumble", "cache", command], env=env, capture_output=True,
+                              text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        return dict(line.split(None, 1) for line in done.stdout.splitlines())
+
+    indexes = list(cache.rglob("*.nbi"))
+    data = list(cache.rglob("*.nbc"))
+    assert indexes and data
+    info = tumble_cache("info")
+    assert info["cache"] == str(cache) and info["key"] == _cache.content_key()
+    assert info["functions"] == str(len(indexes))
+    assert tumble_cache("clear")["removed"].startswith(f"{len(indexes) + len(data)} files, ")
+    assert not list(cache.rglob("*.nb[ic]"))
+    assert tumble_cache("info")["functions"] == "0"

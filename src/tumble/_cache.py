@@ -44,7 +44,8 @@ import tempfile
 import warnings
 from pathlib import Path
 
-__all__ = ["PACKAGE", "UNCOMPILED", "content_key", "ensure_writable_cache", "sources", "use_content_key"]
+__all__ = ["PACKAGE", "UNCOMPILED", "cache_directories", "cached_files", "content_key", "ensure_writable_cache",
+           "sources", "use_content_key"]
 
 #: The directory of the tumble package.
 PACKAGE = Path(__file__).resolve().parent
@@ -147,3 +148,26 @@ def use_content_key() -> None:
     backed = [locator for locator in locators if issubclass(locator, caching._SourceFileBackedLocatorMixin)
               and "Zip" not in locator.__name__]
     locators[:0] = [_keyed_by_content(locator) for locator in backed]
+
+
+def cache_directories(package: Path = PACKAGE) -> list[Path]:
+    """The existing directories where Numba keeps compiled code of ``package``'s functions, named as Numba names
+    them: for each source directory, its directory under ``NUMBA_CACHE_DIR`` when that is set, else its
+    ``__pycache__`` and (Numba's fallback when that is not writable) its directory under the user's cache
+    directory."""
+    from numba.core import caching, config
+    from numba.misc.appdirs import AppDirs
+
+    found = []
+    for directory in sorted({path.parent for path in package.rglob("*.py") if "__pycache__" not in path.parts}):
+        subpath = caching._CacheLocator.get_suitable_cache_subpath(str(directory / "__init__.py"))
+        user_wide = Path(AppDirs(appname="numba", appauthor=False).user_cache_dir) / subpath
+        candidates = [Path(config.CACHE_DIR) / subpath] if config.CACHE_DIR else [directory / "__pycache__", user_wide]
+        found += [candidate for candidate in candidates if candidate.is_dir()]
+    return found
+
+
+def cached_files(package: Path = PACKAGE) -> list[Path]:
+    """Numba's index (``.nbi``) and data (``.nbc``) files of ``package``'s compiled functions."""
+    return [path for directory in cache_directories(package) for pattern in ("*.nbi", "*.nbc")
+            for path in sorted(directory.glob(pattern))]

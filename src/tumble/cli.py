@@ -11,6 +11,7 @@
     tumble info out.nc | out.zarr
     tumble view out.nc -o out.html [--scenario SCENARIO.toml] [--frames 600] [--axis x]
     tumble warmup [PATH ...] [--list]
+    tumble cache info | clear
     tumble --version
 
 Exit codes: 0 success; 2 an error (a one-line message per problem on
@@ -464,6 +465,41 @@ def warmup(
             notices.setLevel(level)
     where = config.CACHE_DIR or "__pycache__ beside tumble's source"
     _print_rows([("compiled", f"{len(chosen)} paths in {time.perf_counter() - start:.1f} s"), ("cache", where)])
+
+
+cache_app = typer.Typer(help="Numba's on-disk cache of tumble's compiled code.", no_args_is_help=True)
+app.add_typer(cache_app, name="cache")
+
+
+def _cache_where() -> str:
+    from numba.core import config
+
+    return config.CACHE_DIR or "__pycache__ beside tumble's source"
+
+
+@cache_app.command("info")
+def cache_info() -> None:
+    """Where tumble's compiled code is cached, the content key it is stamped with (docs/architecture.md, "The
+    compiled-code cache"), and how many compiled functions it holds, in how many bytes."""
+    from tumble import _cache
+
+    files = _cache.cached_files()
+    _print_rows([("cache", _cache_where()), ("key", _cache.content_key()),
+                 ("functions", str(sum(path.suffix == ".nbi" for path in files))),
+                 ("size", f"{sum(path.stat().st_size for path in files) / 1e6:.1f} MB")])
+
+
+@cache_app.command("clear")
+def cache_clear() -> None:
+    """Delete tumble's compiled code from Numba's cache: each model kind and method compiles again on its next
+    use (or run tumble warmup). Never needed for correctness: stale code is found by its key."""
+    from tumble import _cache
+
+    files = _cache.cached_files()
+    size = sum(path.stat().st_size for path in files)
+    for path in files:
+        path.unlink(missing_ok=True)
+    _print_rows([("cache", _cache_where()), ("removed", f"{len(files)} files, {size / 1e6:.1f} MB")])
 
 
 def _info_store(path: Path) -> None:
