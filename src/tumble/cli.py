@@ -433,8 +433,6 @@ def warmup(
     import logging
     import time
 
-    from numba.core import config
-
     from tumble import _warmup
 
     known = _warmup.paths()
@@ -463,18 +461,19 @@ def warmup(
                     progress(len(chosen), len(chosen), "compiled")
         finally:
             notices.setLevel(level)
-    where = config.CACHE_DIR or "__pycache__ beside tumble's source"
-    _print_rows([("compiled", f"{len(chosen)} paths in {time.perf_counter() - start:.1f} s"), ("cache", where)])
+    _print_rows([("compiled", f"{len(chosen)} paths in {time.perf_counter() - start:.1f} s"),
+                 ("cache", _cache_where())])
+
+
+def _cache_where() -> str:
+    """Where Numba caches tumble's compiled code (docs/architecture.md, "The compiled-code cache")."""
+    from numba.core import config
+
+    return config.CACHE_DIR or "__pycache__ beside tumble's source"
 
 
 cache_app = typer.Typer(help="Numba's on-disk cache of tumble's compiled code.", no_args_is_help=True)
 app.add_typer(cache_app, name="cache")
-
-
-def _cache_where() -> str:
-    from numba.core import config
-
-    return config.CACHE_DIR or "__pycache__ beside tumble's source"
 
 
 @cache_app.command("info")
