@@ -101,13 +101,12 @@ def _chain() -> tuple[Model, dict[str, Any]]:
 
 
 def _tree() -> tuple[Model, dict[str, Any]]:
-    """A floating base with two one-link arms: a tree (two children of one link)."""
+    """A tree: a shoulder link carrying two one-link arms, turning about z, falling along −z."""
     from tumble.robot import Link, RobotTree
 
-    rod = {"mass": 1.0, "com": (0.5, 0.0, 0.0), "inertia": np.diag([1e-3, 0.085, 0.085])}
-    base = Link(joint="floating", mass=10.0, inertia=np.diag([1.0, 1.2, 1.4]))
-    arms = [Link(axis=(0.0, 0.0, 1.0), origin_position=(0.0, side, 0.0), **rod) for side in (0.5, -0.5)]
-    return RobotTree([base, *arms], [-1, 0, 0]), {}
+    rod = {"mass": 1.0, "com": (0.5, 0.0, 0.0), "inertia": np.diag([1e-3, 0.085, 0.085]), "axis": (0.0, 1.0, 0.0)}
+    links = [Link(**rod), *(Link(origin_position=(1.0, side, 0.0), **rod) for side in (0.2, -0.2))]
+    return RobotTree(links, [-1, 0, 0]), {"q0": [0.3, -0.5, 0.2]}
 
 
 #: model kind -> a function giving a model of that kind and its initial state (keyword arguments of simulate).
