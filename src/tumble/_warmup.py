@@ -46,16 +46,19 @@ def _spacecraft() -> tuple[Model, dict[str, Any]]:
 
 
 def _flexible() -> tuple[Model, dict[str, Any]]:
+    import tumble
     from tumble.flexible import FlexibleBody, Mode
 
-    return FlexibleBody(_INERTIA, [Mode(3.0, 0.0, [0.3, 0.5, 0.2])]), {"omega0": _OMEGA0, "eta0": [0.05]}
+    body = FlexibleBody(tumble.RigidBody(_INERTIA), (Mode(3.0, 0.0, np.array([0.3, 0.5, 0.2])),))
+    return body, {"omega0": _OMEGA0, "eta0": [0.05]}
 
 
 def _slosh() -> tuple[Model, dict[str, Any]]:
     import tumble
     from tumble.slosh import Pendulum, SloshBody
 
-    body = SloshBody(tumble.RigidBody(_INERTIA, mass=10.0), Pendulum(mass=2.0, length=0.5, hinge=[0.3, -0.2, 0.4]))
+    pendulum = Pendulum(mass=2.0, length=0.5, hinge=np.array([0.3, -0.2, 0.4]))
+    body = SloshBody(tumble.RigidBody(_INERTIA, mass=10.0), pendulum)
     return body, {"omega0": _OMEGA0, "direction0": [1.0, 1.0, 0.0]}
 
 
@@ -104,8 +107,12 @@ def _tree() -> tuple[Model, dict[str, Any]]:
     """A tree: a shoulder link carrying two one-link arms, turning about z, falling along −z."""
     from tumble.robot import Link, RobotTree
 
-    rod = {"mass": 1.0, "com": (0.5, 0.0, 0.0), "inertia": np.diag([1e-3, 0.085, 0.085]), "axis": (0.0, 1.0, 0.0)}
-    links = [Link(**rod), *(Link(origin_position=(1.0, side, 0.0), **rod) for side in (0.2, -0.2))]
+    def rod(origin: tuple[float, float, float]) -> Link:
+        """A 1 kg, 1 m rod along x from the joint, turning about y."""
+        return Link(axis=np.array([0.0, 1.0, 0.0]), origin_position=np.array(origin), mass=1.0,
+                    com=np.array([0.5, 0.0, 0.0]), inertia=np.diag([1e-3, 0.085, 0.085]))
+
+    links = [rod((0.0, 0.0, 0.0)), rod((1.0, 0.2, 0.0)), rod((1.0, -0.2, 0.0))]
     return RobotTree(links, [-1, 0, 0]), {"q0": [0.3, -0.5, 0.2]}
 
 
