@@ -7,15 +7,14 @@ is then cached on disk, docs/architecture.md). :func:`notice` watches Numba's
 compile has been under way for :data:`DELAY` seconds it says, once, what is
 compiled and why::
 
-    tumble: compiling the rk4 path of SpacecraftModel (tumble.integrate._fixed.run_one: first use of this
-    model kind and method here; cached for later runs)...
+    tumble: compiling the rk4 path of RigidBody (tumble.attitude._from_matrix_loop: first use of this model
+    kind and method here; cached for later runs)...
 
-Where the line goes follows :mod:`logging`: it is an INFO record of the
-``"tumble"`` logger when that logger is enabled for INFO (the application
-configured logging so); when neither that logger nor its parents were given a
-level that enables it, and the logger ``"tumble"`` has no level of its own,
-it is written to stderr. ``logging.getLogger("tumble").setLevel(logging.WARNING)``
-or the environment variable ``TUMBLE_QUIET=1`` silences it.
+Where the line goes: nowhere with the environment variable ``TUMBLE_QUIET=1``;
+as an INFO record of the ``"tumble"`` logger where logging is configured to
+pass it (``logging.basicConfig(level=logging.INFO)``, say); else, while the
+``"tumble"`` logger has no level of its own, to stderr. So
+``logging.getLogger("tumble").setLevel(logging.WARNING)`` silences it too.
 """
 
 from __future__ import annotations
@@ -39,9 +38,11 @@ logger = logging.getLogger("tumble")
 
 def _say(line: str) -> None:
     """Write ``line`` as :mod:`tumble._compiling` says: a log record, stderr, or nothing."""
+    if os.environ.get("TUMBLE_QUIET", "") not in ("", "0"):
+        return
     if logger.isEnabledFor(logging.INFO):
         logger.info(line)
-    elif logger.level == logging.NOTSET and os.environ.get("TUMBLE_QUIET", "") in ("", "0"):
+    elif logger.level == logging.NOTSET:
         print(f"tumble: {line}", file=sys.stderr, flush=True)
 
 
