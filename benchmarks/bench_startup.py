@@ -1,20 +1,24 @@
-"""A first run, measured: ``import tumble``, the first ``tumble demo racket``, the first one-body ``simulate``
-of each method, each in a new Python process with an empty Numba cache (cold) and with the cache that run
-left (warm).
+"""A first run, measured: ``import tumble``, the first ``tumble demo racket``, and the first ``simulate`` of
+every built-in model kind under every method it provides (the paths of ``tumble warmup``,
+``tumble._warmup``), each in a new Python process with an empty Numba cache (cold: a fresh install) and with
+the cache that run left (warm).
 
-    python benchmarks/bench_startup.py [--repeats 5] [--src DIR] [--methods rk4 dop853 ...]
+    python benchmarks/bench_startup.py [--repeats 5 | --quick] [--src DIR] [--kinds RigidBody ...]
+                                       [--methods rk4 dop853 ...]
 
 ``--src`` measures another checkout's ``src`` (e.g. an older commit in a git worktree, for a before/after
 table); the default is the tumble this script imports. Every row is min / median over ``--repeats`` (at
-least 5) new processes, in wall time and in CPU time of the process (user + system, from
-``getrusage(RUSAGE_CHILDREN)``), each cold row with a new empty ``NUMBA_CACHE_DIR``. Goals (issue 16, on an
-idle 2-core machine with an empty cache): first ``tumble demo racket`` ≤ 3 s wall, first one-body
-``simulate`` of each method ≤ 2 s, ``import tumble`` ≤ 0.3 s. On a shared machine read the CPU column.
+least 5) new processes, or one with ``--quick``, in wall time and in CPU time of the process (user + system,
+from ``getrusage(RUSAGE_CHILDREN)``), each cold row with a new empty ``NUMBA_CACHE_DIR``; a warm row
+includes ``import tumble``. Goals (issues 16 and 29, on an idle 2-core machine): ``import tumble`` ≤ 0.3 s,
+first ``tumble demo racket`` ≤ 3 s, first call of a model kind's default method ≤ 2 s, a cached call ≤ 0.5 s
+including the import. On a shared machine read the CPU columns.
 """
 
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import resource
 import shutil
@@ -27,16 +31,11 @@ from pathlib import Path
 
 from _timing import REPEATS, machine
 
-METHODS = ("dop853", "rk4", "cf4", "splitting2", "splitting4", "exact_split2", "exact_split4", "exact")
-
 IMPORT = "import tumble"
-SIMULATE = """
-import numpy as np, tumble
-method = {method!r}
-options = {{"rtol": 1e-10, "atol": 1e-12}} if method == "dop853" else {{}} if method == "exact" else {{"dt": 0.01}}
-tumble.simulate(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), [0.1, 1.0, 0.1], t=[0.0, 0.5, 1.0], method=method,
-                **options)
-"""
+DEFAULT_METHOD = "dop853"  # simulate's
+SIMULATE = "from tumble._warmup import kind_path; kind_path({kind!r}, {method!r})()"
+# the kinds and the methods each provides, as tumble warmup finds them (in the tumble measured)
+KINDS = "from tumble._warmup import KINDS, methods; print(repr({kind: methods(kind) for kind in KINDS}))"
 RACKET = "import sys; from tumble.cli import app; sys.argv = ['tumble', 'demo', 'racket', '-q', '-o', {out!r}, " \
          "'--plot', {png!r}]; app()"
 
@@ -66,27 +65,36 @@ def row(name: str, code: str, env: dict, repeats: int, goal: str) -> None:
         for k in (0, 1):
             values = [r[k] for r in runs]
             cells.append(f"{min(values):7.2f} / {statistics.median(values):7.2f}")
-    print(f"{name:<24} {cells[0]}  {cells[1]}   {cells[2]}  {cells[3]}   {goal}", flush=True)
+    print(f"{name:<28} {cells[0]}  {cells[1]}   {cells[2]}  {cells[3]}   {goal}", flush=True)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=REPEATS)
+    parser.add_argument("--quick", action="store_true", help="one new process per row instead of --repeats")
     parser.add_argument("--src", type=Path, default=None, help="a checkout's src directory to measure")
-    parser.add_argument("--methods", nargs="*", default=list(METHODS))
+    parser.add_argument("--kinds", nargs="*", default=None, help="model kinds to measure (default: all)")
+    parser.add_argument("--methods", nargs="*", default=None, help="methods to measure (default: all)")
     args = parser.parse_args()
-    repeats = max(args.repeats, REPEATS)
+    repeats = 1 if args.quick else max(args.repeats, REPEATS)
     src = (args.src or Path(__file__).resolve().parents[1] / "src").resolve()
-    env = {**os.environ, "PYTHONPATH": str(src)}
+    env = {**os.environ, "PYTHONPATH": str(src), "TUMBLE_QUIET": "1"}
+    kinds = ast.literal_eval(subprocess.run([sys.executable, "-c", KINDS], env=env, check=True, capture_output=True,
+                                            text=True).stdout)
     print(machine())
-    print(f"tumble from {src}; {repeats} new processes per row, min / median, s")
-    print(f"{'':<24} {'cold wall':^17}  {'cold CPU':^17}   {'warm wall':^17}  {'warm CPU':^17}   goal (cold wall)")
+    print(f"tumble from {src}; {repeats} new process{'es' if repeats > 1 else ''} per row, min / median, s")
+    print(f"{'':<28} {'cold wall':^17}  {'cold CPU':^17}   {'warm wall':^17}  {'warm CPU':^17}   goal (cold wall)")
     row("import tumble", IMPORT, env, repeats, "<= 0.3 s")
     with tempfile.TemporaryDirectory() as out:
         row("tumble demo racket", RACKET.format(out=f"{out}/racket.nc", png=f"{out}/racket.png"), env, repeats,
             "<= 3 s")
-    for method in args.methods:
-        row(f"simulate, {method}", SIMULATE.format(method=method), env, repeats, "<= 2 s")
+    for kind, provided in kinds.items():
+        if args.kinds is not None and kind not in args.kinds:
+            continue
+        for method in provided:
+            if args.methods is None or method in args.methods:
+                row(f"{kind}, {method}", SIMULATE.format(kind=kind, method=method), env, repeats,
+                    "<= 2 s (the default method)" if method == DEFAULT_METHOD else "")
 
 
 if __name__ == "__main__":

@@ -321,20 +321,32 @@ def test_cli_does_not_import_back():
 
 def test_warmup_compiles_what_a_new_process_then_loads_from_the_cache():
     env = {**os.environ, "PYTHONPATH": str(Path(tumble.__file__).parents[1])}
-    done = subprocess.run([sys.executable, "-m", "tumble", "warmup", "one body, rk4", "--quiet"], env=env,
+    env.pop("TUMBLE_QUIET", None)
+    done = subprocess.run([sys.executable, "-m", "tumble", "warmup", "RigidBody, rk4"], env=env,
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     assert re.match(r"compiled\s+1 paths in [\d.]+ s\ncache\s+", done.stdout), done.stdout
+    # not on a terminal, the display is one line per path, naming it; no compile notice besides
+    assert done.stderr == "compiling RigidBody, rk4 (1/1)\n"
     # a new process making the same call compiles nothing: Numba's cache log shows loads and no save
-    child = "from tumble._warmup import PATHS; PATHS['one body, rk4']()"
+    child = "from tumble._warmup import paths; paths()['RigidBody, rk4']()"
     log = subprocess.run([sys.executable, "-c", child], env={**env, "NUMBA_DEBUG_CACHE": "1"},
                          capture_output=True, text=True, timeout=600, check=True).stdout
     assert "[cache] data loaded" in log and "[cache] data saved" not in log, log
 
 
-def test_warmup_refuses_an_unknown_path_and_lists_them():
-    result = invoke("warmup", "one body, rk5")
+def test_warmup_lists_every_built_in_kind_under_the_methods_it_provides_and_refuses_an_unknown_path():
+    result = invoke("warmup", "RigidBody, rk5")
     assert result.exit_code == 2
-    assert result.stderr.startswith("error: PATH: unknown 'one body, rk5'; the paths are 'demo racket', ")
+    assert result.stderr.startswith("error: PATH: unknown 'RigidBody, rk5'; the paths are 'RigidBody, rk4', ")
     listed = invoke("warmup", "--list").stdout.splitlines()
-    assert listed[0] == "demo racket" and "one body, exact" in listed and len(listed) == 13
+    kinds = {"RigidBody", "Spacecraft", "FlexibleBody", "SloshBody", "VariableBody", "MovingHuman", "Gyroscope",
+             "GimbaledGyro", "SerialChain", "RobotTree"}
+    by_kind = {kind: [name.split(", ")[1] for name in listed if name.split(", ")[0] == kind] for kind in kinds}
+    assert by_kind["RigidBody"] == list(tumble.integrate.METHODS)  # every method applies to a rigid body
+    assert by_kind["GimbaledGyro"] == ["rk4", "dop853"]  # no body rate: cf4 refused (tests/test_models.py)
+    assert all("rk4" in methods and "dop853" in methods for methods in by_kind.values()), by_kind
+    assert listed[-5:] == ["demo racket", "a batch, rk4", "a batch, dop853", "heavy top, rk4", "heavy top, dop853"]
+    assert len(listed) == sum(map(len, by_kind.values())) + 5
+
+

@@ -15,9 +15,10 @@ sloshing and shape-changing bodies, spacecraft, robot arms, gyroscopes)
 implements :class:`tumble.Model` and runs through it.
 """
 
-from tumble._cache import ensure_writable_cache
+from tumble._cache import ensure_writable_cache, use_content_key
 
 ensure_writable_cache()  # before any compiled module: a read-only install must still import
+use_content_key()  # and compiled code is stale when any source compiled into it changes (docs/architecture.md)
 
 from tumble import attitude, dynamics, integrate, limits, torques  # noqa: E402
 from tumble._validate import ValidationError  # noqa: E402

@@ -19,7 +19,6 @@ import stat
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
-import filelock
 
 from tumble._validate import ValidationError
 
@@ -239,6 +238,8 @@ def _sync(path: str) -> None:
 @contextlib.contextmanager
 def _exclusive(lock_path: str, path: str) -> Iterator[None]:
     """Hold an exclusive lock on ``lock_path`` (created, and removed after), or refuse: another writer has it."""
+    import filelock  # imported when a file is first written: `import tumble` stays light
+
     lock = filelock.FileLock(lock_path, timeout=0, is_singleton=False)
     try:
         lock.acquire()

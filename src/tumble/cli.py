@@ -11,6 +11,7 @@
     tumble info out.nc | out.zarr
     tumble view out.nc -o out.html [--scenario SCENARIO.toml] [--frames 600] [--axis x]
     tumble warmup [PATH ...] [--list]
+    tumble cache info | clear
     tumble --version
 
 Exit codes: 0 success; 2 an error (a one-line message per problem on
@@ -430,37 +431,85 @@ def warmup(
     paths: Annotated[list[str] | None, typer.Argument(
         help="Paths to compile, by name (default: all of them; --list shows them).", show_default=False)] = None,
     list_paths: Annotated[bool, typer.Option("--list", help="List the paths and exit.")] = False,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress display.")] = False,
 ) -> None:
-    """Compile the common paths into Numba's on-disk cache, so that a session's first simulation starts at once.
+    """Compile every built-in model kind under every method it provides into Numba's on-disk cache, so that a
+    session's first simulation starts at once.
 
-    Each path (the quick-start demo, one body under every method, a batch, a heavy top) runs a simulation of
-    a few steps; the compiled code is cached beside tumble's source (or in NUMBA_CACHE_DIR), where every later
-    process loads it in milliseconds. Run it once after installing (it takes a minute or two).
+    Each path ("RigidBody, rk4", ..., "RobotTree, dop853", then the quick-start demo, a batch, a heavy top)
+    runs a simulation of a few steps; the compiled code is cached beside tumble's source (or in
+    NUMBA_CACHE_DIR), where every later process loads it in milliseconds. The progress display names the path
+    being compiled (a bar on a terminal, one line per path otherwise). Run it once after installing.
     """
+    import logging
     import time
 
-    from numba.core import config
+    from tumble import _warmup
 
-    from tumble._warmup import PATHS
-
+    known = _warmup.paths()
     if list_paths:
-        typer.echo("\n".join(PATHS))
+        typer.echo("\n".join(known))
         return
     with _exit_codes():
-        unknown = [name for name in paths or () if name not in PATHS]
+        unknown = [name for name in paths or () if name not in known]
         if unknown:
             raise ValidationError(f"PATH: unknown {', '.join(map(repr, unknown))}; the paths are "
-                                  f"{', '.join(map(repr, PATHS))}")
-        chosen = list(paths or PATHS)
+                                  f"{', '.join(map(repr, known))}")
+        chosen = list(paths or known)
         start = time.perf_counter()
-        with _progress_bar("compiling", enabled=not quiet, unit="paths") as progress:
-            for done, name in enumerate(chosen):
-                PATHS[name]()
+        notices = logging.getLogger("tumble")
+        level = notices.level
+        notices.setLevel(logging.WARNING)  # the display names what is compiled: no compile notices besides
+        try:
+            with _progress_bar("compiling", enabled=not quiet, unit="paths") as progress:
+                for done, name in enumerate(chosen):
+                    if progress is not None:
+                        progress(done, len(chosen), name)
+                    elif not quiet:
+                        _stderr.print(f"compiling {name} ({done + 1}/{len(chosen)})", highlight=False)
+                    known[name]()
                 if progress is not None:
-                    progress(done + 1, len(chosen))
-    where = config.CACHE_DIR or "__pycache__ beside tumble's source"
-    _print_rows([("compiled", f"{len(chosen)} paths in {time.perf_counter() - start:.1f} s"), ("cache", where)])
+                    progress(len(chosen), len(chosen), "compiled")
+        finally:
+            notices.setLevel(level)
+    _print_rows([("compiled", f"{len(chosen)} paths in {time.perf_counter() - start:.1f} s"),
+                 ("cache", _cache_where())])
+
+
+def _cache_where() -> str:
+    """Where Numba caches tumble's compiled code (docs/architecture.md, "The compiled-code cache")."""
+    from numba.core import config
+
+    return config.CACHE_DIR or "__pycache__ beside tumble's source"
+
+
+cache_app = typer.Typer(help="Numba's on-disk cache of tumble's compiled code.", no_args_is_help=True)
+app.add_typer(cache_app, name="cache")
+
+
+@cache_app.command("info")
+def cache_info() -> None:
+    """Where tumble's compiled code is cached, the content key it is stamped with (docs/architecture.md, "The
+    compiled-code cache"), and how many compiled functions it holds, in how many bytes."""
+    from tumble import _cache
+
+    files = _cache.cached_files()
+    _print_rows([("cache", _cache_where()), ("key", _cache.content_key()),
+                 ("functions", str(sum(path.suffix == ".nbi" for path in files))),
+                 ("size", f"{sum(path.stat().st_size for path in files) / 1e6:.1f} MB")])
+
+
+@cache_app.command("clear")
+def cache_clear() -> None:
+    """Delete tumble's compiled code from Numba's cache: each model kind and method compiles again on its next
+    use (or run tumble warmup). Never needed for correctness: stale code is found by its key."""
+    from tumble import _cache
+
+    files = _cache.cached_files()
+    size = sum(path.stat().st_size for path in files)
+    for path in files:
+        path.unlink(missing_ok=True)
+    _print_rows([("cache", _cache_where()), ("removed", f"{len(files)} files, {size / 1e6:.1f} MB")])
 
 
 def _info_store(path: Path) -> None:
@@ -503,8 +552,9 @@ def _check_outputs(outputs: list[tuple[str, Path | None]], *, inputs: tuple[Path
 
 @contextmanager
 def _progress_bar(description: str, *, enabled: bool,
-                  unit: str = "samples") -> Iterator[Callable[[int, int], None] | None]:
-    """A rich progress bar on stderr, as a ``progress(done, total)`` callback; ``None`` when not a terminal."""
+                  unit: str = "samples") -> Iterator[Callable[..., None] | None]:
+    """A rich progress bar on stderr, as a ``progress(done, total[, description])`` callback; ``None`` when not
+    a terminal."""
     if not (enabled and _stderr.is_terminal):
         yield None
         return
@@ -512,7 +562,7 @@ def _progress_bar(description: str, *, enabled: bool,
                TimeRemainingColumn())
     with Progress(*columns, console=_stderr, transient=True) as bar:
         task = bar.add_task(description, total=None)
-        yield lambda done, total: bar.update(task, completed=done, total=total)
+        yield lambda done, total, what=description: bar.update(task, completed=done, total=total, description=what)
 
 
 def _png(figure, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:

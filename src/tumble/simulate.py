@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple, TypedDict, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import _callback, attitude, integrate
+from tumble import _callback, _compiling, attitude, integrate
 from tumble._validate import ValidationError, as_array, output_times, require_finite
 from tumble._vec import norm
 from tumble.trajectory import Extra, Trajectory
@@ -313,7 +313,7 @@ def simulate(
     model.check_run(m, times, options.get("dt"))
     # Python functions wrapped while compiling live through the run, outputs included (a model may
     # evaluate its torque law at the samples)
-    with _callback.keep_alive():
+    with _callback.keep_alive(), _compiling.notice(f"the {m.name} path of {type(model).__name__}"):
         kernel = model.compile(torque, float(times[0]))
         who = f"a {type(model).__name__}" + (f" under torque={torque!r}" if torque is not None else "")
         integrate.check_method(m.name, kernel.provides, who)
