@@ -441,7 +441,7 @@ class Spacecraft(Model):
         if self.gravity_gradient:
             add("gravity_gradient_torque", core(_kernel.AUX_GRAVITY), ("xyz",), "N m",
                 "gravity-gradient torque, body axes")
-        if kernel.torque_codes is not None:
+        if kernel.torque_codes.size:
             add("external_torque", core(_kernel.AUX_EXTERNAL), ("xyz",), "N m",
                 "external torque of the torque argument, body axes")
         if self.damper is not None:
