@@ -16,7 +16,8 @@ from numba import njit
 
 from tumble import _quat, torques
 from tumble._vec import cross, matvec_flat
-from tumble.kernels.spacecraft import _commands, cmgs, damper, environment, laws, magnetorquers, thrusters, wheels
+from tumble.kernels.spacecraft import (_commands, cmgs, damper, environment, laws, magnetorquers, residual_dipole,
+                                      thrusters, wheels)
 from tumble.kernels.spacecraft._base import inline, lane, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_WHEELS, J,
@@ -31,6 +32,7 @@ ACTUATORS = {
     "thrusters": lambda lane, direct: thrusters.kernel(lane),
     "magnetorquers": lambda lane, direct: magnetorquers.kernel(lane),
     "damper": lambda lane, direct: damper.kernel(lane),
+    "residual_dipole": lambda lane, direct: residual_dipole.kernel(lane),
 }
 
 # The empty sums (Numba's inliner takes no *args, so one per signature).
