@@ -84,3 +84,14 @@ step = 1.0
 """)
     np.testing.assert_array_equal(scenario.model.residual_dipole.dipole, [DIPOLE, 0.0, 0.0])
     np.testing.assert_array_equal(scenario.model.magnetic_field, [FIELD, 0.0, 0.0])
+
+
+def test_viewer_draws_the_dipole_along_body_x(swing):
+    from tumble import viewer
+
+    scene = viewer.scene(swing, model=needle(), frames=50)
+    line = {line.name: line.points for line in scene.lines}["residual dipole"]
+    hub = scene.solids[0].rotation                                    # R(q) of the frames
+    tips = line[:, 1] / np.linalg.norm(line[:, 1], axis=-1, keepdims=True)
+    np.testing.assert_allclose(tips, hub[:, :, 0], atol=1e-15)        # R(q) x̂: the needle's direction
+    np.testing.assert_array_equal(line[:, 0], 0.0)
