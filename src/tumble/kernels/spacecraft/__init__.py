@@ -53,7 +53,7 @@ from __future__ import annotations
 import collections
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 from numba.extending import overload
 
 from tumble import _protocol, torques
@@ -84,8 +84,15 @@ class SpacecraftModel(collections.namedtuple("SpacecraftModel", CORE_FIELDS + PA
     route       : the kind index of the actuator that delivers the torque command, or −1
     size        : length of the state vector
     aux_size    : length of the diagnostics of one sample
-    torque_params, torque_codes : the program of ``torque=`` (:func:`tumble.torques.compile_program`
-                  in body axes, params (1, n)); no terms without one
+    torque_at, torque_terms : the program of ``torque=`` (:func:`tumble.torques.compile_program` in body
+                  axes) in ``data``: its parameters, then its ``2 × torque_terms`` codes (as float64) from
+                  ``data[torque_at]`` on; no terms without one. In ``data``, not arrays of their own: every
+                  array of the model costs a reference count at each call that passes the model
+    python_calls : None, or 1 when a control law (``"python_law"``, ``"wheel_python"``) or the torque
+                  program calls a Python function. The one part of the composition in the Numba type: a
+                  spacecraft without one runs a right-hand side and discrete update compiled without
+                  reference counting (they allocate nothing), one with one the same compiled with it, since
+                  a Python call allocates its arguments. So the kind compiles twice at most.
 
     then one int64 field per kind of :data:`PARTS`: :data:`ABSENT` (−1) when the spacecraft has no such part,
     else where the part is, ``(p, n, s, a)`` (:class:`Slices`) packed into one int64 (:func:`pack`). Every
@@ -106,6 +113,11 @@ class SpacecraftModel(collections.namedtuple("SpacecraftModel", CORE_FIELDS + PA
         """True when a control law or the torque program calls a Python function (the batch then runs on one core)."""
         return any(getattr(self, kind) != ABSENT for kind in _PYTHON) or torques.calls_python(self.torque_codes)
 
+    @property
+    def torque_codes(self) -> np.ndarray:
+        """The codes of the torque program (pairs (code, start in ``data``), int64; empty without one)."""
+        return self.data[self.torque_at:self.torque_at + 2 * self.torque_terms].astype(np.int64)
+
 
 def assemble(inertia, rate_inertia, period: float, t0: float, programs, route: str | None,
              torque=None) -> SpacecraftModel:
@@ -125,12 +137,19 @@ def assemble(inertia, rate_inertia, period: float, t0: float, programs, route: s
             layout[kind] = pack(Slices(p, part.count, s, a))
             blocks.append(np.ravel(part.params))
             p, s, a = p + part.params.size, s + part.state, a + part.aux
-    codes, block = torques.compile_program(torque, np.eye(3), offset=0)
+    codes, block = torques.compile_program(torque, np.eye(3), offset=p)
+    blocks += [block, codes]
     return SpacecraftModel(
         data=np.ascontiguousarray(np.concatenate([np.asarray(b, dtype=np.float64) for b in blocks])),
         route=-1 if route is None else PARTS.index(route), size=s, aux_size=a,
-        torque_params=np.ascontiguousarray(block[None, :]), torque_codes=codes,
+        torque_at=p + block.size, torque_terms=codes.size // 2,
+        python_calls=1 if any(kind in by_kind for kind in _PYTHON) or torques.calls_python(codes) else None,
         **{kind: layout.get(kind, ABSENT) for kind in PARTS})
+
+
+def _python(model) -> bool:
+    """Whether the (Numba) model type calls Python functions (its ``python_calls`` field is not None)."""
+    return not isinstance(model.types[model.fields.index("python_calls")], types.NoneType)
 
 
 def slices(model: SpacecraftModel, kind: str) -> Slices | None:
@@ -143,7 +162,7 @@ def slices(model: SpacecraftModel, kind: str) -> Slices | None:
 # (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
 @_protocol.implements(_protocol.rhs, SpacecraftModel)
 def _spacecraft_rhs(model, b0, t, Y, OUT):
-    derivative, _, _ = _assemble(Y.ndim)
+    derivative, _, _ = _assemble(Y.ndim, _python(model))
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
             derivative(model, t, Y, 0, OUT, Y, _STORE[0])
@@ -156,7 +175,7 @@ def _spacecraft_rhs(model, b0, t, Y, OUT):
 
 @_protocol.implements(_protocol.project, SpacecraftModel)
 def _spacecraft_project(model, b0, t, Y):
-    _, sample, discrete = _assemble(Y.ndim)
+    _, sample, discrete = _assemble(Y.ndim, _python(model))
     has_hold, _ = locator("hold")
     if Y.ndim == 1:
         normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
@@ -193,7 +212,7 @@ def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload 
 
 @overload(_evaluate, jit_options={"cache": True})
 def _evaluate_overload(model, t, y, aux):
-    derivative, _, _ = _assemble(1)
+    derivative, _, _ = _assemble(1, _python(model))
 
     def impl(model, t, y, aux):
         out = np.empty(y.shape[1])
@@ -209,7 +228,7 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sample, _ = _assemble(1)
+    _, sample, _ = _assemble(1, _python(model))
     return lambda model, t, y: sample(model, t, y, 0)
 
 

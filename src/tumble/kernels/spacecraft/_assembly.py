@@ -129,9 +129,11 @@ def _or_present(previous, has):
     return inline(lambda model: previous(model) or has(model))
 
 
-def _environment():
+def _environment(python):
     """``field(model, t, q) -> B`` (T, body axes), ``gravity(model, t, q) -> τ_gg`` and
-    ``external(model, t, q, ω) -> τ`` (the torque program), N·m, body axes."""
+    ``external(model, t, q, ω) -> τ`` (the torque program, its Python terms only in the variant that calls
+    Python, ``python``), N·m, body axes."""
+    program = torques.evaluate if python else torques.evaluate_compiled
     has_dipole, where_dipole = locator("dipole_field")
     has_uniform, where_uniform = locator("uniform_field")
     has_gravity, where_gravity = locator("gravity_gradient")
@@ -158,17 +160,23 @@ def _environment():
     @inline
     def external(model, t, qw, qx, qy, qz, w1, w2, w3):
         e1 = e2 = e3 = 0.0
-        if model.torque_codes.shape[0] > 0:
-            e1, e2, e3 = torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.torque_params, 0,
-                                          model.torque_codes)
+        if model.torque_terms > 0:
+            d = model.data
+            c = model.torque_at
+            e1, e2, e3 = program(t, qw, qx, qy, qz, w1, w2, w3, d.reshape((1, d.shape[0])), 0,
+                                 d[c:c + 2 * model.torque_terms])
         return e1, e2, e3
 
     return field, gravity, external
 
 
 @functools.lru_cache(maxsize=None)
-def assemble(ndim):
-    """Compile-time assembly for states of ``ndim``: ``(derivative, sample, discrete)``.
+def assemble(ndim, python):
+    """Compile-time assembly for states of ``ndim``: ``(derivative, sample, discrete)``; ``python``: the
+    variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative
+    and the discrete update, which then allocate nothing, are compiled without reference counting: the
+    runtime tests of the parts split the refcount pairs of the model's arrays over branches that Numba's
+    pruner cannot join, and counting them made the RK4 step 5.5 times slower).
     ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` of the member in lane ``j`` of the block
     ``y`` (or of the state vector ``y``, ``ndim`` 1) into ``out`` and, when ``store``, its diagnostics into
     ``aux``; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
@@ -178,7 +186,7 @@ def assemble(ndim):
     access = lane(ndim)
     at, put, put3 = access
     direct = _commands.make_direct(access)
-    commands = _commands.controller(access)
+    commands = _commands.controller(access, python)
     held, hold = _commands.zero_order_hold(access, direct)
     has_hold, where_hold = locator("hold")
     has_integral, where_integral = locator("mrp_integral")
@@ -187,7 +195,7 @@ def assemble(ndim):
     momenta, energies = _sum_momenta(actuators), _sum_energies(actuators)
     torques_on_hub = _sum_torques(actuators)
     sample_parts, discrete = _sample_all(actuators)
-    field, gravity, external = _environment()
+    field, gravity, external = _environment(python)
 
     @inline
     def controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
@@ -214,7 +222,7 @@ def assemble(ndim):
 
     # Not inlined: one compiled function that the right-hand side and the diagnostics
     # (:func:`tumble.kernels.spacecraft.evaluate`) share, so that the model type compiles it once.
-    @njit
+    @njit(_nrt=python)
     def derivative(model, t, y, j, out, aux, store):
         d = model.data
         qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
@@ -248,7 +256,7 @@ def assemble(ndim):
             put3(aux, AUX_ACTUATOR, j, x1, x2, x3)
             put3(aux, AUX_EXTERNAL, j, e1, e2, e3)
 
-    @inline
+    @njit(_nrt=python)
     def sample(model, t, y, j):
         if has_hold(model):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)

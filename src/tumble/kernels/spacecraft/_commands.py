@@ -44,8 +44,9 @@ def make_speeds(lane):
     return speeds
 
 
-def make_torque_law(lane, speeds):
-    """``law(model, t, y, j, q, ω, H) -> u_c`` (N·m, body axes) of the torque law present (zero without one)."""
+def make_torque_law(lane, speeds, python):
+    """``law(model, t, y, j, q, ω, H) -> u_c`` (N·m, body axes) of the torque law present (zero without one);
+    the Python law only in the variant that calls Python (``python``)."""
     at = lane.at
     has_pd, where_pd = locator("pd")
     has_mrp, where_mrp = locator("mrp")
@@ -71,14 +72,21 @@ def make_torque_law(lane, speeds):
                 v2 = ki * (k * at(y, s + laws.INTEGRAL + 1, j) + z2)
                 v3 = ki * (k * at(y, s + laws.INTEGRAL + 2, j) + z3)
             u1, u2, u3 = laws.mrp_torque(model, p, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, v1, v2, v3)
-        elif has_python(model):
+        return u1, u2, u3
+
+    if not python:
+        return law
+
+    @inline
+    def law_or_python(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3):
+        if has_python(model):
             p, _, _, _ = where_python(model)
             u = laws.call_python(int(model.data[p + laws.SLOT]), t, qw, qx, qy, qz, w1, w2, w3,
                                  speeds(model, y, j, w1, w2, w3), 3)
-            u1, u2, u3 = u[0], u[1], u[2]
-        return u1, u2, u3
+            return u[0], u[1], u[2]
+        return law(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3)
 
-    return law
+    return law_or_python
 
 
 def make_dipole_law(lane):
@@ -105,9 +113,9 @@ def make_dipole_law(lane):
     return law
 
 
-def make_wheel_law(speeds):
+def make_wheel_law(speeds, python):
     """``source(model, t, y, j, q, ω)``: the motor-torque law of the wheels evaluated once per evaluation of the
-    commands (the module docstring)."""
+    commands (the module docstring); the Python law only in the variant that calls Python (``python``)."""
     has_table, where_table = locator("wheel_table")
     has_python, where_python = locator("wheel_python")
     _, where_wheels = locator("wheels")  # a wheel-torque law needs wheels (Spacecraft checks it)
@@ -118,14 +126,21 @@ def make_wheel_law(speeds):
             p, _, _, _ = where_table(model)
             _, nw, _, _ = where_wheels(model)
             return WHEEL_TABLE, p, nw, model.data
+        return NO_WHEEL_LAW, 0, 0, model.data
+
+    if not python:
+        return source
+
+    @inline
+    def source_or_python(model, t, y, j, qw, qx, qy, qz, w1, w2, w3):
         if has_python(model):
             p, _, _, _ = where_python(model)
             _, nw, _, _ = where_wheels(model)
             return WHEEL_PYTHON, p, nw, laws.call_python(int(model.data[p + laws.SLOT]), t, qw, qx, qy, qz,
                                                          w1, w2, w3, speeds(model, y, j, w1, w2, w3), nw)
-        return NO_WHEEL_LAW, 0, 0, model.data
+        return source(model, t, y, j, qw, qx, qy, qz, w1, w2, w3)
 
-    return source
+    return source_or_python
 
 
 def make_direct(lane):
@@ -146,10 +161,12 @@ def make_direct(lane):
     return direct
 
 
-def controller(lane):
-    """``commands(model, t, y, j, q, ω, H, B) -> (u_c, m_c, source)``: the control laws as evaluated now."""
+def controller(lane, python):
+    """``commands(model, t, y, j, q, ω, H, B) -> (u_c, m_c, source)``: the control laws as evaluated now (the
+    Python laws only in the variant that calls Python, ``python``)."""
     speeds = make_speeds(lane)
-    torque_law, dipole_law, source = make_torque_law(lane, speeds), make_dipole_law(lane), make_wheel_law(speeds)
+    torque_law, dipole_law = make_torque_law(lane, speeds, python), make_dipole_law(lane)
+    source = make_wheel_law(speeds, python)
     magnetorquers_index = PARTS.index("magnetorquers")
 
     @inline

@@ -16,7 +16,7 @@ PARTS = ("hold", "wheels", "cmgs", "thrusters", "magnetorquers", "damper", "pd",
          "gravity_gradient", "residual_dipole")
 
 #: The fields of ``SpacecraftModel`` before the parts' (one int64 per kind of :data:`PARTS` follows them).
-CORE_FIELDS = ("data", "route", "size", "aux_size", "torque_params", "torque_codes")
+CORE_FIELDS = ("data", "route", "size", "aux_size", "torque_at", "torque_terms", "python_calls")
 
 #: The field of a kind the spacecraft lacks.
 ABSENT = -1
