@@ -413,7 +413,7 @@ def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: 
     qw, qx, qy, qz = qw * s, qx * s, qy * s, qz * s
     t1 = t2 = t3 = 0.0
     for k in range(0, codes.shape[0], 2):
-        code, o = codes[k], codes[k + 1]
+        code, o = int(codes[k]), int(codes[k + 1])  # codes may be held as float64 (a spacecraft's data)
         if code == _CONST_BODY:
             a, b, c = P[row, o], P[row, o + 1], P[row, o + 2]
         elif code == _CONST_INERTIAL:
@@ -455,8 +455,8 @@ def evaluate(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2
     """
     t1, t2, t3 = evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
     for k in range(0, codes.shape[0], 2):
-        if codes[k] == _PYTHON:
-            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes[k + 1])
+        if int(codes[k]) == _PYTHON:
+            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, int(codes[k + 1]))
             t1 += a
             t2 += b
             t3 += c
