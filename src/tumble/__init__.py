@@ -28,7 +28,7 @@ from tumble.limits import RigidityWarning  # noqa: E402
 from tumble.simulate import Model, simulate  # noqa: E402
 from tumble.trajectory import Trajectory, load  # noqa: E402
 
-__version__ = "0.2.1"
+__version__ = "0.3.0"
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
