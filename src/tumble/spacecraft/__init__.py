@@ -21,7 +21,7 @@ from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, Reactio
 from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MRPFeedback, PythonLaw, QuaternionPD,
                                        RateDamping, WheelTorques)
 from tumble.spacecraft.damper import SphericalDamper, simulate_damped
-from tumble.spacecraft.environment import DipoleField
+from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft, simulate
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
@@ -29,7 +29,7 @@ from tumble.spacecraft.passive import gravity_gradient_stability, gravity_gradie
 
 __all__ = [
     "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "MRPFeedback", "Magnetorquers",
-    "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel",
+    "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
     "SaturationWarning", "SingularityWarning", "Spacecraft", "SphericalDamper", "Thruster", "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",
     "pyramid_wheels", "save_spacecraft_figure", "simulate", "simulate_damped", "spacecraft_figure", "spin_stability",
