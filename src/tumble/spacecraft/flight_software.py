@@ -1,0 +1,98 @@
+"""The flight-software loop: a gyro and a star tracker read at the control period, the MEKF, and the control
+law fed the estimate instead of the truth (:mod:`tumble.kernels.spacecraft.flight_software`).
+
+The estimator is :func:`tumble.estimation.mekf`'s compiled step; the sensors are
+the MEKF's own models (gyro angle and rate random walks, star-tracker noise in
+body axes), their noise drawn from a counter-based generator keyed by the seed
+of each run (``sensor_seed0``), so that a run is reproducible per seed and a
+batch of seeds is a Monte-Carlo over sensor noise. ``docs/estimation.md``,
+"The flight-software loop".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tumble._validate import ValidationError, as_array, require_non_negative, require_positive
+from tumble.kernels.spacecraft import flight_software as _kernel
+from tumble.kernels.spacecraft._base import Program
+
+__all__ = ["FlightSoftware"]
+
+#: Seeds are held in the float64 state: whole numbers below 2⁵³.
+MAX_SEED = 2**53
+
+
+@dataclass(frozen=True)
+class FlightSoftware:
+    """Gyro + star tracker + MEKF in the loop, sampled at the spacecraft's ``control_period`` ``T``.
+
+    gyro_arw : σ_v, the gyro's angle random walk, rad/√s
+    gyro_rrw : σ_u, its rate random walk (bias instability), rad/s^1.5
+    star_tracker_sigma : σ_st, the star tracker's noise about each body axis, rad (a number or 3)
+    attitude_sigma0, bias_sigma0 : the filter's initial 1σ uncertainty of the attitude (rad) and the bias (rad/s)
+    delay : the computation delay in control periods, 0 or 1: the command computed at ``t_k`` acts from
+        ``t_k + delay·T`` (zero before the first one is out)
+    sensor_noise : False: the sensors read the truth exactly (the filter keeps its noise model)
+    seed : the default of ``sensor_seed0`` (each run's noise seed, a whole number in [0, 2⁵³))
+
+    The filter models the sensors as they are (the same σ_v, σ_u, σ_st). The initial estimate is
+    ``q_estimate0`` (default ``q0``) and ``bias_estimate0`` (default 0); the gyro's true bias starts at
+    ``gyro_bias0`` (default 0) and walks with σ_u.
+    """
+
+    gyro_arw: float
+    gyro_rrw: float
+    star_tracker_sigma: float | np.ndarray
+    attitude_sigma0: float = 1e-2
+    bias_sigma0: float = 1e-4
+    delay: int = 1
+    sensor_noise: bool = True
+    seed: int = 0
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "gyro_arw", require_non_negative(self.gyro_arw, "gyro_arw"))
+        set_(self, "gyro_rrw", require_non_negative(self.gyro_rrw, "gyro_rrw"))
+        sigma = np.broadcast_to(as_array(self.star_tracker_sigma, "star_tracker_sigma"), (3,)).copy() \
+            if np.ndim(self.star_tracker_sigma) <= 1 and np.size(self.star_tracker_sigma) in (1, 3) else None
+        if sigma is None or np.any(sigma <= 0.0):
+            raise ValidationError(f"star_tracker_sigma: must be a number or 3 numbers > 0 (rad), got "
+                                  f"{self.star_tracker_sigma!r}")
+        sigma.setflags(write=False)
+        set_(self, "star_tracker_sigma", sigma)
+        set_(self, "attitude_sigma0", require_positive(self.attitude_sigma0, "attitude_sigma0"))
+        set_(self, "bias_sigma0", require_positive(self.bias_sigma0, "bias_sigma0"))
+        if self.delay not in (0, 1) or isinstance(self.delay, bool):
+            raise ValidationError(f"delay: must be 0 or 1 control period, got {self.delay!r}")
+        if not isinstance(self.sensor_noise, (bool, np.bool_)):
+            raise ValidationError(f"sensor_noise: must be True or False, got {self.sensor_noise!r}")
+        check_seed(self.seed, "seed")
+
+    @property
+    def covariance0(self) -> np.ndarray:
+        """The filter's initial covariance of ``[δθ, δβ]``: diag(σ_θ² I, σ_β² I) (rad², rad²/s²)."""
+        return np.diag(np.repeat([self.attitude_sigma0**2, self.bias_sigma0**2], 3))
+
+    def _program(self) -> Program:
+        return _kernel.program(self.gyro_arw, self.gyro_rrw, self.star_tracker_sigma, self.delay,
+                               bool(self.sensor_noise))
+
+
+def check_seed(seed, name: str) -> np.ndarray:
+    """``seed`` (a number or an array) as float64, each a whole number in [0, 2⁵³), else a ValidationError."""
+    values = as_array(seed, name)
+    if np.any(values != np.floor(values)) or np.any(values < 0) or np.any(values >= MAX_SEED):
+        raise ValidationError(f"{name}: must be whole numbers in [0, 2**53), got {seed!r}")
+    return values
+
+
+def initial_state(fsw: FlightSoftware, values: dict[str, np.ndarray], y0: np.ndarray, s: int) -> None:
+    """Write the flight software's initial state (estimate, covariance, true gyro bias, seed) into the rows of
+    ``y0`` (N, size) at its state offset ``s``; ``values`` holds the state fields, each (N, size)."""
+    for offset, name in ((_kernel.Q_EST, "q_estimate0"), (_kernel.BIAS_EST, "bias_estimate0"),
+                         (_kernel.GYRO_BIAS, "gyro_bias0"), (_kernel.SEED, "sensor_seed0")):
+        y0[:, s + offset:s + offset + values[name].shape[-1]] = values[name]
+    y0[:, s + _kernel.COVARIANCE:s + _kernel.COVARIANCE + 36] = fsw.covariance0.ravel()
