@@ -114,3 +114,33 @@ def test_bad_flight_software_is_refused(change, message):
 def test_a_bad_seed_is_refused():
     with pytest.raises(ValidationError, match=r"^sensor_seed0: must be whole numbers"):
         tumble.simulate(demo.spacecraft(), np.zeros(3), t=_times(1.0), method="rk4", dt=demo.DT, sensor_seed0=-1.0)
+
+
+def test_scenario_table_runs_the_loop():
+    """``[spacecraft.flight_software]`` and the ``[initial]`` keys of its state give the run of the library."""
+    from tumble.scenario import parse_scenario
+
+    scenario = parse_scenario("""
+[spacecraft]
+moments = [10.0, 12.0, 8.0]
+wheel_pyramid = {inertia = 0.02}
+control_period = 0.5
+flight_software = {gyro_arw = 1e-5, gyro_rrw = 1e-8, star_tracker_sigma = [5e-5, 5e-5, 1e-4], seed = 3}
+[[spacecraft.controller]]
+kind = "quaternion_pd"
+natural_frequency = 0.2
+[initial]
+omega = [0.0, 0.0, 0.0]
+gyro_bias = [1e-5, 0.0, -1e-5]
+[time]
+stop = 5.0
+step = 0.5
+[solver]
+dt = 0.1
+""")
+    traj = scenario.run()
+    craft = Spacecraft(inertia=np.diag([10.0, 12.0, 8.0]), wheels=pyramid_wheels(0.02), controller=QuaternionPD(0.2),
+                       control_period=0.5, flight_software=FlightSoftware(1e-5, 1e-8, [5e-5, 5e-5, 1e-4], seed=3))
+    expected = tumble.simulate(craft, np.zeros(3), t=traj.t, method="rk4", dt=0.1, gyro_bias0=[1e-5, 0.0, -1e-5])
+    np.testing.assert_array_equal(traj.knowledge_error, expected.knowledge_error)
+    np.testing.assert_array_equal(traj.gyro_bias[0], [1e-5, 0.0, -1e-5])
