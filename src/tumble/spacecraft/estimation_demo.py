@@ -25,6 +25,7 @@ from tumble.spacecraft.actuators import pyramid_wheels
 from tumble.spacecraft.control import QuaternionPD
 from tumble.spacecraft.flight_software import FlightSoftware
 from tumble.spacecraft.model import Spacecraft
+from tumble.trajectory import Trajectory
 
 __all__ = ["FSW", "TARGET", "demo_estimation", "dispersions", "loop_response", "monte_carlo", "spacecraft"]
 
@@ -44,15 +45,16 @@ def spacecraft(fsw: FlightSoftware | None = FSW, natural_frequency: float = 0.2)
                       controller=law, control_period=PERIOD, flight_software=fsw)
 
 
-def monte_carlo(runs: int, *, duration: float, seed: int = 0, craft: Spacecraft | None = None):
+def monte_carlo(runs: int, *, duration: float, seed: int = 0, craft: Spacecraft | None = None) -> Trajectory:
     """``runs`` runs of ``craft`` (default :func:`spacecraft`) from rest at the identity, outputs at every
     sample: run ``i`` has the noise seed ``seed + i`` and draws its gyro bias and initial estimate error
     (with ``numpy.random.default_rng(seed)``) from the filter's initial spread."""
     craft = spacecraft() if craft is None else craft
     assert craft.flight_software is not None
     t = np.arange(0.0, duration + 0.5 * PERIOD, PERIOD)
-    return simulate(craft, np.zeros((runs, 3)), t=t, method="rk4", dt=DT,
-                    **dispersions(craft.flight_software, runs, seed))
+    initial = dispersions(craft.flight_software, runs, seed)
+    return simulate(craft, np.zeros((runs, 3)), t=t, method="rk4", dt=DT, q_estimate0=initial["q_estimate0"],
+                    gyro_bias0=initial["gyro_bias0"], sensor_seed0=initial["sensor_seed0"])
 
 
 def dispersions(fsw: FlightSoftware, runs: int, seed: int) -> dict[str, np.ndarray]:
@@ -66,19 +68,20 @@ def dispersions(fsw: FlightSoftware, runs: int, seed: int) -> dict[str, np.ndarr
             "sensor_seed0": seed + np.arange(runs, dtype=float)[:, None]}
 
 
-def loop_response(traj, start: int, knowledge_error: np.ndarray, rate_error: np.ndarray, *,
+def loop_response(traj: Trajectory, start: int, knowledge_error: np.ndarray, rate_error: np.ndarray, *,
                   initial: bool = True) -> np.ndarray:
     """The control error (K − start, …, 3) from sample ``start`` on as the linear response of the demo's sampled
     loop to the estimator's errors ``knowledge_error`` and ``rate_error`` (ω̂ − ω) at the samples (K, …, 3),
     from the state of ``traj`` at ``start`` (``initial``) or from rest at the target.
 
     In fine pointing the loop is linear and decoupled per axis (PD gains ∝ J; the gyroscopic term is second
-    order): with θ = −control error, the law commands ``a_k = −ω_n² (θ_k + e_k) − 2ζω_n (θ̇_k + n_k)`` from
-    the estimate, and it acts one period later (:data:`FSW`'s delay) on the double integrator
+    order): with θ = −control error, the law commands ``a_k = −ω_n² (θ_k + e_k) − 2ζω_n (θ̇_k + n_k)``
+    from the estimate, and it acts one period later (:data:`FSW`'s delay) on the double integrator
     ``θ̈ = a``, exact under a zero-order hold: ``θ ← θ + T θ̇ + ½ T² a``, ``θ̇ ← θ̇ + T a``."""
     craft = spacecraft()
     law = craft.controller[0]
     wn, zeta = law.natural_frequency, law.damping_ratio
+    assert traj.omega is not None  # a spacecraft's hub rate
     theta, rate = -traj.control_error[start], traj.omega[start]
     acting = traj.torque_command[start] / np.diag(craft.rate_inertia)
     if not initial:

@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_non_negative, require_positive
 from tumble.kernels.spacecraft import flight_software as _kernel
@@ -81,7 +82,7 @@ class FlightSoftware:
                                bool(self.sensor_noise))
 
 
-def check_seed(seed, name: str) -> np.ndarray:
+def check_seed(seed: ArrayLike, name: str) -> np.ndarray:
     """``seed`` (a number or an array) as float64, each a whole number in [0, 2⁵³), else a ValidationError."""
     values = as_array(seed, name)
     if np.any(values != np.floor(values)) or np.any(values < 0) or np.any(values >= MAX_SEED):
