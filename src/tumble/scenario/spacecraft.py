@@ -198,14 +198,20 @@ class ResidualDipoleTable(_Table):
 
 
 class FlightSoftwareTable(_Table):
-    """``[spacecraft.flight_software]``: a gyro (``gyro_arw``, rad/√s; ``gyro_rrw``, rad/s^1.5) and a star
-    tracker (``star_tracker_sigma``, rad: a number or 3) read through the MEKF at ``control_period``, the law
-    fed the estimate; ``delay`` (0 or 1 period), ``sensor_noise``, ``seed``, and the filter's initial
-    ``attitude_sigma0`` (rad) and ``bias_sigma0`` (rad/s)."""
+    """``[spacecraft.flight_software]``: a gyro (``gyro_arw``, rad/√s; ``gyro_rrw``, rad/s^1.5) and attitude
+    sensors — a star tracker (``star_tracker_sigma``, rad: a number or 3; ``star_tracker_every`` samples), a
+    fine Sun sensor (``sun_sensor_sigma``, rad; ``sun_direction``, inertial), a magnetometer
+    (``magnetometer_sigma``, rad) — read through the MEKF at ``control_period``, the law fed the estimate;
+    ``delay`` (0 or 1 period), ``sensor_noise``, ``seed``, and the filter's initial ``attitude_sigma0`` (rad)
+    and ``bias_sigma0`` (rad/s)."""
 
     gyro_arw: _Number
     gyro_rrw: _Number
-    star_tracker_sigma: _Positive | _Vector
+    star_tracker_sigma: _Positive | _Vector | None = None
+    star_tracker_every: Annotated[int, Field(strict=True)] = 1
+    sun_sensor_sigma: _Positive | None = None
+    sun_direction: _Vector | None = None
+    magnetometer_sigma: _Positive | None = None
     attitude_sigma0: _Positive = 1e-2
     bias_sigma0: _Positive = 1e-4
     delay: Annotated[int, Field(strict=True)] = 1
@@ -213,9 +219,8 @@ class FlightSoftwareTable(_Table):
     seed: Annotated[int, Field(strict=True)] = 0
 
     def build(self) -> FlightSoftware:
-        return FlightSoftware(self.gyro_arw, self.gyro_rrw, np.array(self.star_tracker_sigma),
-                              attitude_sigma0=self.attitude_sigma0, bias_sigma0=self.bias_sigma0, delay=self.delay,
-                              sensor_noise=self.sensor_noise, seed=self.seed)
+        return FlightSoftware(**{name: np.array(value) if isinstance(value, list) else value
+                                 for name, value in self})
 
 
 class FieldTable(_Table):

@@ -1,9 +1,10 @@
-"""The flight-software loop: a gyro and a star tracker read at the control period, the MEKF, and the control
-law fed the estimate instead of the truth (:mod:`tumble.kernels.spacecraft.flight_software`).
+"""The flight-software loop: a gyro, a star tracker and direction sensors (a fine Sun sensor, a magnetometer)
+read at the control period, the MEKF, and the control law fed the estimate instead of the truth
+(:mod:`tumble.kernels.spacecraft.flight_software`).
 
 The estimator is :func:`tumble.estimation.mekf`'s compiled step; the sensors are
 the MEKF's own models (gyro angle and rate random walks, star-tracker noise in
-body axes), their noise drawn from a counter-based generator keyed by the seed
+body axes, direction noise across the direction), their noise drawn from a counter-based generator keyed by the seed
 of each run (``sensor_seed0``), so that a run is reproducible per seed and a
 batch of seeds is a Monte-Carlo over sensor noise. ``docs/estimation.md``,
 "The flight-software loop".
@@ -28,11 +29,17 @@ MAX_SEED = 2**53
 
 @dataclass(frozen=True)
 class FlightSoftware:
-    """Gyro + star tracker + MEKF in the loop, sampled at the spacecraft's ``control_period`` ``T``.
+    """Gyro + star tracker and/or direction sensors + MEKF in the loop, sampled at the spacecraft's
+    ``control_period`` ``T``.
 
     gyro_arw : σ_v, the gyro's angle random walk, rad/√s
     gyro_rrw : σ_u, its rate random walk (bias instability), rad/s^1.5
-    star_tracker_sigma : σ_st, the star tracker's noise about each body axis, rad (a number or 3)
+    star_tracker_sigma : σ_st, the star tracker's noise about each body axis, rad (a number or 3), or None
+    star_tracker_every : the star tracker reads every n-th sample (n ≥ 1; its rate is 1/(n T))
+    sun_sensor_sigma, sun_direction : a fine Sun sensor's noise (rad) and the Sun's direction (3, inertial
+        axes, normalised here), or None
+    magnetometer_sigma : a magnetometer's direction noise (rad; it reads the spacecraft's ``magnetic_field``),
+        or None
     attitude_sigma0, bias_sigma0 : the filter's initial 1σ uncertainty of the attitude (rad) and the bias (rad/s)
     delay : the computation delay in control periods, 0 or 1: the command computed at ``t_k`` acts from
         ``t_k + delay·T`` (zero before the first one is out)
@@ -46,7 +53,11 @@ class FlightSoftware:
 
     gyro_arw: float
     gyro_rrw: float
-    star_tracker_sigma: float | np.ndarray
+    star_tracker_sigma: float | np.ndarray | None = None
+    star_tracker_every: int = 1
+    sun_sensor_sigma: float | None = None
+    sun_direction: np.ndarray | None = None
+    magnetometer_sigma: float | None = None
     attitude_sigma0: float = 1e-2
     bias_sigma0: float = 1e-4
     delay: int = 1
@@ -57,13 +68,27 @@ class FlightSoftware:
         set_ = object.__setattr__
         set_(self, "gyro_arw", require_non_negative(self.gyro_arw, "gyro_arw"))
         set_(self, "gyro_rrw", require_non_negative(self.gyro_rrw, "gyro_rrw"))
-        sigma = np.broadcast_to(as_array(self.star_tracker_sigma, "star_tracker_sigma"), (3,)).copy() \
-            if np.ndim(self.star_tracker_sigma) <= 1 and np.size(self.star_tracker_sigma) in (1, 3) else None
-        if sigma is None or np.any(sigma <= 0.0):
-            raise ValidationError(f"star_tracker_sigma: must be a number or 3 numbers > 0 (rad), got "
-                                  f"{self.star_tracker_sigma!r}")
-        sigma.setflags(write=False)
-        set_(self, "star_tracker_sigma", sigma)
+        if self.star_tracker_sigma is not None:
+            set_(self, "star_tracker_sigma", _axes_sigma(self.star_tracker_sigma))
+        if not isinstance(self.star_tracker_every, (int, np.integer)) or self.star_tracker_every < 1:
+            raise ValidationError(f"star_tracker_every: must be a whole number ≥ 1 (samples), got "
+                                  f"{self.star_tracker_every!r}")
+        for name in ("sun_sensor_sigma", "magnetometer_sigma"):
+            if getattr(self, name) is not None:
+                set_(self, name, require_positive(getattr(self, name), name))
+        if (self.sun_sensor_sigma is None) != (self.sun_direction is None):
+            raise ValidationError("sun_direction: give it with sun_sensor_sigma (the fine Sun sensor), or neither")
+        if self.sun_direction is not None:
+            sun = as_array(self.sun_direction, "sun_direction")
+            if sun.shape != (3,) or not np.any(sun):
+                raise ValidationError(f"sun_direction: must be 3 numbers, not all zero (inertial axes), got "
+                                      f"{self.sun_direction!r}")
+            sun = sun / np.linalg.norm(sun)
+            sun.setflags(write=False)
+            set_(self, "sun_direction", sun)
+        if self.star_tracker_sigma is None and self.sun_sensor_sigma is None and self.magnetometer_sigma is None:
+            raise ValidationError("star_tracker_sigma: the filter needs an attitude sensor: a star tracker, a Sun "
+                                  "sensor or a magnetometer")
         set_(self, "attitude_sigma0", require_positive(self.attitude_sigma0, "attitude_sigma0"))
         set_(self, "bias_sigma0", require_positive(self.bias_sigma0, "bias_sigma0"))
         if self.delay not in (0, 1) or isinstance(self.delay, bool):
@@ -78,8 +103,22 @@ class FlightSoftware:
         return np.diag(np.repeat([self.attitude_sigma0**2, self.bias_sigma0**2], 3))
 
     def _program(self) -> Program:
-        return _kernel.program(self.gyro_arw, self.gyro_rrw, self.star_tracker_sigma, self.delay,
-                               bool(self.sensor_noise))
+        tracker = self.star_tracker_sigma is not None
+        return _kernel.program(self.gyro_arw, self.gyro_rrw, self.star_tracker_sigma if tracker else np.ones(3),
+                               self.star_tracker_every if tracker else 0, self.delay, bool(self.sensor_noise),
+                               self.sun_sensor_sigma or 0.0,
+                               self.sun_direction if self.sun_direction is not None else np.zeros(3),
+                               self.magnetometer_sigma or 0.0)
+
+
+def _axes_sigma(value) -> np.ndarray:
+    """σ about each body axis: a number or 3 numbers > 0 (rad), as (3,), else a ValidationError."""
+    sigma = as_array(value, "star_tracker_sigma")
+    if sigma.shape not in ((), (1,), (3,)) or np.any(sigma <= 0.0):
+        raise ValidationError(f"star_tracker_sigma: must be a number or 3 numbers > 0 (rad), got {value!r}")
+    sigma = np.broadcast_to(sigma, (3,)).copy()
+    sigma.setflags(write=False)
+    return sigma
 
 
 def check_seed(seed: ArrayLike, name: str) -> np.ndarray:

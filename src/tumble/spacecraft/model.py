@@ -192,6 +192,8 @@ class Spacecraft(Model):
             return
         if self.control_period is None:
             raise ValidationError("flight_software: needs a control_period (its sensors and filter run at it)")
+        if self.flight_software.magnetometer_sigma is not None and self.magnetic_field is None:
+            raise ValidationError("flight_software: a magnetometer needs a magnetic_field")
         if self._torque_law() is None or any(isinstance(law, WheelTorques) for law in self.controller):
             raise ValidationError("flight_software: needs a torque law (QuaternionPD, MRPFeedback, RateDamping, "
                                   "ConstantTorque or a Python law) and no WheelTorques (whose commands it does "

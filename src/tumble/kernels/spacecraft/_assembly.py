@@ -262,7 +262,7 @@ def assemble(ndim):
             b1, b2, b3 = field(model, t, qw, qx, qy, qz)
             if has_fsw(model):  # the laws read the flight software's estimate, not the truth
                 p, _, s, _ = where_fsw(model)
-                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], y, j)
+                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], y, j, b1, b2, b3)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
             h1, h2, h3 = momenta(model, y, j)
             u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,

@@ -1,5 +1,5 @@
-"""The flight software: gyro and star tracker sampled at the control period, the MEKF, the estimate fed to the
-control law, the command held after a computation delay.
+"""The flight software: gyro, star tracker, Sun sensor and magnetometer sampled at the control period, the
+MEKF, the estimate fed to the control law, the command held after a computation delay.
 
 At each sample time ``t_k = t₀ + k T`` of the zero-order hold (``T`` the
 control period) the part, in order:
@@ -16,10 +16,15 @@ control period) the part, in order:
    ``θ_k`` the rotation vector of the true attitude increment (body axes: a
    rate-integrating gyro with ideal coning compensation). The rate the control
    law reads is the gyro's rate at ``t_k``, ``ω(t_k) + β_k`` plus the same noise
-   sample. Star tracker: ``q̃_k = q_k ⊗ exp(v/2)``, ``v ~ N(0, diag(σ_st²))``,
-   body axes.
+   sample. Star tracker (every ``n_st``-th sample): ``q̃_k = q_k ⊗ exp(v/2)``,
+   ``v ~ N(0, diag(σ_st²))``, body axes. Fine Sun sensor and magnetometer: the
+   direction ``r`` (inertial: the Sun's, fixed; the field's ``R(q) B``, ``B`` the
+   spacecraft's field in body axes) seen in body axes, ``b = R(q)ᵀ r``, turned by
+   a rotation vector ``v ~ N(0, σ² I)``, so that its error ``v × b`` has the
+   covariance ``σ² (I − b bᵀ)`` of the MEKF's vector model (Shuster's).
 2. **Runs the MEKF step** (:mod:`tumble.estimation._mekf`'s compiled kernels):
-   propagate ``(q̂, β̂, P)`` with ``ω̃_k`` over ``T``, then the star-tracker update.
+   propagate ``(q̂, β̂, P)`` with ``ω̃_k`` over ``T``, then the updates of the
+   sensors present (star tracker, Sun sensor, magnetometer).
 3. **Gives the control law the estimate** ``q̂_k``, ``ω̂_k = ω̃(t_k) − β̂_k``; the
    command it computes acts after the computation delay, 0 or one period ``T``:
    with one, the command of ``t_k`` is held from ``t_{k+1}`` (the part keeps it
@@ -29,8 +34,7 @@ With ``sensor_noise`` off the sensors read the truth exactly (bias ``β`` includ
 constant) while the filter keeps its noise model, so that the loop fed a perfect
 truth reproduces the truth-fed controller.
 
-Parameters at ``p``: σ_v (rad/√s), σ_u (rad/s^1.5), σ_st (3, rad), the delay (0 or 1
-period), the noise switch. State slice at ``s``: see the offsets below; the
+Parameters at ``p``: below (a σ of 0 or ``n_st`` of 0: no such sensor). State slice at ``s``: see the offsets below; the
 derivatives of all of it are zero (it changes only at the samples).
 """
 
@@ -40,17 +44,21 @@ import math
 
 import numpy as np
 
-from tumble._quat import qexp, qlog, qmul
-from tumble.estimation._mekf import _propagate, _update_star_tracker
+from tumble._quat import qexp, qlog, qmul, qrotate, qrotate_inv
+from tumble.estimation._mekf import _propagate, _update_star_tracker, _update_vector
 from tumble.kernels.spacecraft._base import Lane, Program, inline
 
 # Parameters:
 ARW = 0            # σ_v, rad/√s
 RRW = 1            # σ_u, rad/s^1.5
 ST_SIGMA = 2       # σ_st (3), rad, body axes
-DELAY = 5          # the computation delay in periods: 0 or 1
-NOISE = 6          # 1: noisy sensors, 0: perfect ones
-SIZE = 7
+ST_EVERY = 5       # n_st: the star tracker reads every n_st-th sample (0: none)
+DELAY = 6          # the computation delay in periods: 0 or 1
+NOISE = 7          # 1: noisy sensors, 0: perfect ones
+SUN_SIGMA = 8      # σ of the fine Sun sensor, rad (0: none)
+SUN_DIRECTION = 9  # the Sun's direction (3), inertial axes, unit
+MAG_SIGMA = 12     # σ of the magnetometer's direction, rad (0: none)
+SIZE = 13
 # State slice:
 Q_EST = 0          # q̂ (4)
 BIAS_EST = 4       # β̂ (3), rad/s
@@ -63,8 +71,9 @@ SEED = 59          # the noise seed (an integer < 2⁵³)
 COUNT = 60         # samples taken so far
 STATE = 61
 
-#: Draws per sample: n_u (3), n_v (3), v (3).
-DRAWS = 9
+#: Draws per sample: n_u (3), n_v (3), then the star tracker's, the Sun sensor's and the magnetometer's v (3 each).
+DRAWS = 15
+_STAR, _SUN, _FIELD = 6, 9, 12
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _MIX1 = np.uint64(0xBF58476D1CE4E5B9)
@@ -73,9 +82,11 @@ _S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(
 _TWO53 = 2.0 ** -53
 
 
-def program(arw: float, rrw: float, star_tracker_sigma, delay: int, noise: bool) -> Program:
-    """The flight software's :class:`~tumble.kernels.spacecraft._base.Program` (parameters: module docstring)."""
-    params = np.concatenate([[arw, rrw], star_tracker_sigma, [delay, 1.0 if noise else 0.0]]).astype(np.float64)
+def program(arw: float, rrw: float, star_tracker_sigma, star_tracker_every: int, delay: int, noise: bool,
+            sun_sensor_sigma: float, sun_direction, magnetometer_sigma: float) -> Program:
+    """The flight software's :class:`~tumble.kernels.spacecraft._base.Program` (parameters: the offsets above)."""
+    params = np.concatenate([[arw, rrw], star_tracker_sigma, [star_tracker_every, delay, 1.0 if noise else 0.0],
+                             [sun_sensor_sigma], sun_direction, [magnetometer_sigma]]).astype(np.float64)
     return Program("flight_software", params, state=STATE)
 
 
@@ -115,9 +126,9 @@ def normal(seed, k, i):
 def kernel(lane: Lane):
     """``(step, delayed)`` of the flight software for the state access ``lane``.
 
-    ``step(model, p, s, period, y, j) -> (q̂, ω̂)``: the sensors and the MEKF at a sample time (in place);
-    ``delayed(model, p, s, y, j, u, m) ->
-    (u, m)``: the command that acts now, given the one just computed."""
+    ``step(model, p, s, period, y, j, B) -> (q̂, ω̂)``: the sensors and the MEKF at a sample time (in place;
+    ``B`` the field, T, body axes); ``delayed(model, p, s, y, j, u, m) -> (u, m)``: the command that acts now,
+    given the one just computed."""
     at, put, put3 = lane
 
     @inline
@@ -133,7 +144,18 @@ def kernel(lane: Lane):
             put(y, offset + i, j, values[i])
 
     @inline
-    def step(model, p, s, period, y, j):
+    def observe(q_hat, beta_hat, P, qw, qx, qy, qz, r1, r2, r3, sigma, noise, seed, k, draw):
+        """The MEKF's update with a direction sensor of noise ``sigma`` reading ``r`` (inertial axes)."""
+        b1, b2, b3 = qrotate_inv(qw, qx, qy, qz, r1, r2, r3)
+        nw, nx, ny, nz = qexp(noise * sigma * normal(seed, k, draw), noise * sigma * normal(seed, k, draw + 1),
+                              noise * sigma * normal(seed, k, draw + 2))
+        measured, reference = np.empty(3), np.empty(3)
+        measured[0], measured[1], measured[2] = qrotate(nw, nx, ny, nz, b1, b2, b3)
+        reference[0], reference[1], reference[2] = r1, r2, r3
+        _update_vector(q_hat, beta_hat, P, measured, reference, sigma)
+
+    @inline
+    def step(model, p, s, period, y, j, f1, f2, f3):
         d = model.data
         k = int(at(y, s + COUNT, j))
         seed = int(at(y, s + SEED, j))
@@ -159,16 +181,25 @@ def kernel(lane: Lane):
                 beta[i] += walk * normal(seed, k, i)
                 rate[i] = theta[i] / period + 0.5 * (beta[i] + previous) + rate_noise[i]
             _propagate(q_hat, beta_hat, P, rate, period, arw * arw, rrw * rrw, np.empty((6, 6)), np.empty((3, 3)))
-        R = np.zeros((3, 3))
-        v = np.empty(3)
-        for i in range(3):
-            sigma = d[p + ST_SIGMA + i]
-            R[i, i] = sigma * sigma
-            v[i] = noise * sigma * normal(seed, k, 6 + i)
-        dw, dx, dy, dz = qexp(v[0], v[1], v[2])
-        q_meas = np.empty(4)
-        q_meas[0], q_meas[1], q_meas[2], q_meas[3] = qmul(qw, qx, qy, qz, dw, dx, dy, dz)
-        _update_star_tracker(q_hat, beta_hat, P, q_meas, R)
+        every = int(d[p + ST_EVERY])
+        if every > 0 and k % every == 0:
+            R = np.zeros((3, 3))
+            v = np.empty(3)
+            for i in range(3):
+                sigma = d[p + ST_SIGMA + i]
+                R[i, i] = sigma * sigma
+                v[i] = noise * sigma * normal(seed, k, _STAR + i)
+            dw, dx, dy, dz = qexp(v[0], v[1], v[2])
+            q_meas = np.empty(4)
+            q_meas[0], q_meas[1], q_meas[2], q_meas[3] = qmul(qw, qx, qy, qz, dw, dx, dy, dz)
+            _update_star_tracker(q_hat, beta_hat, P, q_meas, R)
+        if d[p + SUN_SIGMA] > 0.0:
+            o = p + SUN_DIRECTION
+            observe(q_hat, beta_hat, P, qw, qx, qy, qz, d[o], d[o + 1], d[o + 2], d[p + SUN_SIGMA], noise, seed, k,
+                    _SUN)
+        if d[p + MAG_SIGMA] > 0.0:
+            r1, r2, r3 = qrotate(qw, qx, qy, qz, f1, f2, f3)
+            observe(q_hat, beta_hat, P, qw, qx, qy, qz, r1, r2, r3, d[p + MAG_SIGMA], noise, seed, k, _FIELD)
         w1 = at(y, 4, j) + beta[0] + rate_noise[0] - beta_hat[0]
         w2 = at(y, 5, j) + beta[1] + rate_noise[1] - beta_hat[1]
         w3 = at(y, 6, j) + beta[2] + rate_noise[2] - beta_hat[2]
