@@ -46,7 +46,7 @@ class FlightSoftware:
     sensor_noise : False: the sensors read the truth exactly (the filter keeps its noise model)
     seed : the default of ``sensor_seed0`` (each run's noise seed, a whole number in [0, 2⁵³))
 
-    The filter models the sensors as they are (the same σ_v, σ_u, σ_st). The initial estimate is
+    The filter models the sensors as they are (the same σ of each). The initial estimate is
     ``q_estimate0`` (default ``q0``) and ``bias_estimate0`` (default 0); the gyro's true bias starts at
     ``gyro_bias0`` (default 0) and walks with σ_u.
     """
