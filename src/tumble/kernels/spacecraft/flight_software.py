@@ -34,8 +34,8 @@ With ``sensor_noise`` off the sensors read the truth exactly (bias ``β`` includ
 constant) while the filter keeps its noise model, so that the loop fed a perfect
 truth reproduces the truth-fed controller.
 
-Parameters at ``p``: below (a σ of 0 or ``n_st`` of 0: no such sensor). State slice at ``s``: see the offsets below; the
-derivatives of all of it are zero (it changes only at the samples).
+Parameters at ``p`` and the state slice at ``s``: the offsets below (a σ or an ``n_st`` of 0: no such
+sensor). The derivatives of the whole slice are zero: it changes only at the samples.
 """
 
 from __future__ import annotations
