@@ -44,7 +44,8 @@ class FlightSoftware:
     delay : the computation delay in control periods, 0 or 1: the command computed at ``t_k`` acts from
         ``t_k + delay·T`` (zero before the first one is out)
     sensor_noise : False: the sensors read the truth exactly (the filter keeps its noise model)
-    seed : the default of ``sensor_seed0`` (each run's noise seed, a whole number in [0, 2⁵³))
+    seed : the default of ``sensor_seed0`` (each run's noise seed, a whole number in [0, 2⁵³)), the same for
+        every run of a batch: give ``sensor_seed0`` one per run for a Monte-Carlo over the noise
 
     The filter models the sensors as they are (the same σ of each). The initial estimate is
     ``q_estimate0`` (default ``q0``) and ``bias_estimate0`` (default 0); the gyro's true bias starts at
