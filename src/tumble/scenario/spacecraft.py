@@ -34,7 +34,8 @@ The tables and keys are the arguments of :class:`tumble.spacecraft.Spacecraft`
 and of its parts (``docs/spacecraft.md`` lists them): actuators, a nutation
 damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment
 (``[spacecraft.magnetic_field]``, ``[spacecraft.residual_dipole]``,
-``gravity_gradient``), and the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`).
+``gravity_gradient``), the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`) and the
+flight software that feeds them an estimate (``[spacecraft.flight_software]``).
 ``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
 external torques ``[[torque]]`` (``torque=`` of :func:`tumble.simulate`, on
 top of the spacecraft's own environment) are the shared tables
@@ -56,7 +57,7 @@ from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError, in_file, keyed
 from tumble.scenario._run import RUN_KEYS, Run
 from tumble.scenario._values import (_Bool, _InertiaOrMoments, _Limit, _Matrix, _Number, _Positive, _Table,
-                                     _Vector)
+                                     _Quaternion, _Vector)
 from tumble.scenario.control import Controller, Regulator
 from tumble.scenario.damper import SphericalDamperTable
 from tumble.scenario.orbit import OrbitTable
@@ -64,6 +65,7 @@ from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
 from tumble.spacecraft import actuators
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
+from tumble.spacecraft.flight_software import FlightSoftware
 from tumble.spacecraft.model import Spacecraft
 from tumble.trajectory import Trajectory
 
@@ -195,6 +197,32 @@ class ResidualDipoleTable(_Table):
         return ResidualDipole(np.array(self.dipole))
 
 
+class FlightSoftwareTable(_Table):
+    """``[spacecraft.flight_software]``: a gyro (``gyro_arw``, rad/√s; ``gyro_rrw``, rad/s^1.5) and attitude
+    sensors — a star tracker (``star_tracker_sigma``, rad: a number or 3; ``star_tracker_every`` samples), a
+    fine Sun sensor (``sun_sensor_sigma``, rad; ``sun_direction``, inertial), a magnetometer
+    (``magnetometer_sigma``, rad) — read through the MEKF at ``control_period``, the law fed the estimate;
+    ``delay`` (0 or 1 period), ``sensor_noise``, ``seed``, and the filter's initial ``attitude_sigma0`` (rad)
+    and ``bias_sigma0`` (rad/s)."""
+
+    gyro_arw: _Number
+    gyro_rrw: _Number
+    star_tracker_sigma: _Positive | _Vector | None = None
+    star_tracker_every: Annotated[int, Field(strict=True)] = 1
+    sun_sensor_sigma: _Positive | None = None
+    sun_direction: _Vector | None = None
+    magnetometer_sigma: _Positive | None = None
+    attitude_sigma0: _Positive = 1e-2
+    bias_sigma0: _Positive = 1e-4
+    delay: Annotated[int, Field(strict=True)] = 1
+    sensor_noise: _Bool = True
+    seed: Annotated[int, Field(strict=True)] = 0
+
+    def build(self) -> FlightSoftware:
+        return FlightSoftware(**{name: np.array(value) if isinstance(value, list) else value
+                                 for name, value in self})
+
+
 class FieldTable(_Table):
     """``model = "dipole"`` (tilted dipole, IGRF-13 2020) or ``uniform = [Bx, By, Bz]`` (T, inertial)."""
 
@@ -246,6 +274,7 @@ class SpacecraftTable(_InertiaOrMoments):
     residual_dipole: ResidualDipoleTable | None = None
     controller: list[Controller] = []
     control_period: _Positive | None = None
+    flight_software: FlightSoftwareTable | None = None
 
     @model_validator(mode="after")
     def _one_description(self):
@@ -264,7 +293,7 @@ class SpacecraftTable(_InertiaOrMoments):
             key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
             for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field",
-                    "residual_dipole"):
+                    "residual_dipole", "flight_software"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
         pyramid = parts.pop("wheel_pyramid")
@@ -293,12 +322,18 @@ class SpacecraftInitial(Initial):
     """``[initial]``: ``omega``, ``q`` or ``euler`` as in every kind, plus ``wheel_speeds`` (rad/s, relative
     to the hub), ``gimbal_angles`` (rad), ``damper_omega`` (the damper sphere's rate relative to inertial,
     rad/s, body axes; default ``omega``) and ``attitude_error_integral`` (∫σ dt of the MRP feedback's
-    integral term, s; default 0). A key the spacecraft has no state for is refused by :func:`tumble.simulate`."""
+    integral term, s; default 0); with flight software ``q_estimate`` (default ``q``), ``bias_estimate`` and
+    ``gyro_bias`` (rad/s, body axes; default 0) and ``sensor_seed`` (its noise seed; default its ``seed``). A
+    key the spacecraft has no state for is refused by :func:`tumble.simulate`."""
 
     wheel_speeds: list[_Number] | None = None
     gimbal_angles: list[_Number] | None = None
     damper_omega: _Vector | None = None
     attitude_error_integral: _Vector | None = None
+    q_estimate: _Quaternion | None = None
+    bias_estimate: _Vector | None = None
+    gyro_bias: _Vector | None = None
+    sensor_seed: Annotated[int, Field(strict=True, ge=0)] | None = None
 
 
 class SpacecraftSolver(Solver):

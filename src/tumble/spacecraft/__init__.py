@@ -22,13 +22,14 @@ from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MR
                                        RateDamping, WheelTorques)
 from tumble.spacecraft.damper import SphericalDamper, simulate_damped
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
+from tumble.spacecraft.flight_software import FlightSoftware
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft, simulate
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.spacecraft.passive import gravity_gradient_stability, gravity_gradient_stability_figure, spin_stability
 
 __all__ = [
-    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "MRPFeedback", "Magnetorquers",
+    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "FlightSoftware", "MRPFeedback", "Magnetorquers",
     "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
     "SaturationWarning", "SingularityWarning", "Spacecraft", "SphericalDamper", "Thruster", "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",

@@ -38,6 +38,7 @@ from tumble.body import RigidBody
 from tumble.kernels import spacecraft as _kernel
 from tumble.kernels.spacecraft import cmgs as _cmgs
 from tumble.kernels.spacecraft import damper as _damper_kernel
+from tumble.kernels.spacecraft import flight_software as _fsw_kernel
 from tumble.kernels.spacecraft import environment as _environment
 from tumble.kernels.spacecraft import laws as _law_kernels
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
@@ -51,6 +52,8 @@ from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, Reactio
 from tumble.spacecraft.control import DIPOLE_LAWS, TORQUE_LAWS, MomentumDumping, MRPFeedback, PythonLaw, WheelTorques
 from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
+from tumble.spacecraft.flight_software import FlightSoftware, check_seed
+from tumble.spacecraft.flight_software import initial_state as _fsw_initial_state
 from tumble.spacecraft.orbit import Orbit
 from tumble.trajectory import Extra, Trajectory
 
@@ -98,6 +101,8 @@ class Spacecraft(Model):
         ``u = law(t, q, omega, wheel_speeds)``, i.e. a :class:`PythonLaw`), one of each dipole law
         (:class:`BDot`, :class:`MomentumDumping`) and one :class:`WheelTorques`
     control_period : None (continuous) or the sample period of a zero-order-hold controller, s
+    flight_software : :class:`~tumble.spacecraft.flight_software.FlightSoftware` or None: gyro, star tracker
+        and MEKF at the control period (needed), the control law fed the estimate instead of the truth
 
     The torque command goes to the wheels if there are any, else to the CMGs,
     else to the thrusters (through the PWPF modulators), else to the
@@ -123,6 +128,7 @@ class Spacecraft(Model):
     residual_dipole: ResidualDipole | None = None
     controller: Any = None  # a law, a sequence of laws or None: the tuple of laws once validated
     control_period: float | None = None
+    flight_software: FlightSoftware | None = None
     #: The whole spacecraft as one rigid body (total inertia J, mass, centre of mass), derived.
     body: RigidBody = field(init=False, repr=False)
 
@@ -160,6 +166,7 @@ class Spacecraft(Model):
             if not math.isfinite(value) or value <= 0.0:
                 raise ValidationError(f"control_period: must be None (continuous) or a number > 0 (s), got {value}")
             set_(self, "control_period", value)
+        self._check_flight_software()
 
     # -- description -------------------------------------------------------------------
 
@@ -178,6 +185,19 @@ class Spacecraft(Model):
         if self.damper is None:
             return total
         return RigidBody(total.inertia + self.damper.inertia * np.eye(3), mass=total.mass, com=total.com)
+
+    def _check_flight_software(self) -> None:
+        _check_type(self.flight_software, FlightSoftware, "flight_software")
+        if self.flight_software is None:
+            return
+        if self.control_period is None:
+            raise ValidationError("flight_software: needs a control_period (its sensors and filter run at it)")
+        if self.flight_software.magnetometer_sigma is not None and self.magnetic_field is None:
+            raise ValidationError("flight_software: a magnetometer needs a magnetic_field")
+        if self._torque_law() is None or any(isinstance(law, WheelTorques) for law in self.controller):
+            raise ValidationError("flight_software: needs a torque law (QuaternionPD, MRPFeedback, RateDamping, "
+                                  "ConstantTorque or a Python law) and no WheelTorques (whose commands it does "
+                                  "not delay)")
 
     def _laws(self) -> tuple:
         laws = () if self.controller is None else (
@@ -258,8 +278,8 @@ class Spacecraft(Model):
             programs.append(_wheels.program(
                 axes, spin, max_torque, max_speed, viscous, coulomb, coulomb_speed,
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
-        programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper, self.residual_dipole)
-                     if part is not None]
+        programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper, self.residual_dipole,
+                                                  self.flight_software) if part is not None]
         thrusters = self._thruster_program()
         if thrusters is not None:  # None: no thrusters
             programs.append(thrusters)
@@ -327,6 +347,17 @@ class Spacecraft(Model):
         if any(isinstance(law, MRPFeedback) and law.Ki is not None for law in self.controller):
             fields.append(StateField("attitude_error_integral0", 3, "initial ∫σ dt of the MRP feedback's "
                                      "integral term, s", default=np.zeros(3)))
+        if self.flight_software is not None:
+            fields += [
+                StateField("q_estimate0", 4, "the flight software's initial attitude estimate, unit quaternion "
+                           "[w, x, y, z], body → inertial (default: q0)", default=lambda values: values["q0"],
+                           quaternion=True),
+                StateField("bias_estimate0", 3, "its initial gyro bias estimate, rad/s, body axes",
+                           default=np.zeros(3)),
+                StateField("gyro_bias0", 3, "the gyro's true initial bias, rad/s, body axes", default=np.zeros(3)),
+                StateField("sensor_seed0", 1, "the seed of the sensors' noise, a whole number in [0, 2**53)",
+                           default=np.array([float(self.flight_software.seed)])),
+            ]
         return tuple(fields)
 
     def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:
@@ -372,6 +403,9 @@ class Spacecraft(Model):
         if "attitude_error_integral0" in values:
             s = where("mrp_integral").s + _law_kernels.INTEGRAL
             y0[:, s:s + 3] = values["attitude_error_integral0"]
+        if self.flight_software is not None:
+            check_seed(values["sensor_seed0"], "sensor_seed0")
+            _fsw_initial_state(self.flight_software, values, y0, where("flight_software").s)
         for y in y0:
             _kernel.initialise(kernel, float(t0), y)
         return y0
@@ -470,6 +504,9 @@ class Spacecraft(Model):
             add("attitude_error_integral",
                 states[..., _law_kernels.integral_slices(integral.n, integral.s)["attitude_error_integral"]], ("xyz",),
                 "s", "integral of the MRP attitude error of the MRP feedback's integral term")
+        if self.flight_software is not None:
+            s = where("flight_software").s
+            self._estimation_outputs(add, states[..., s:s + _fsw_kernel.STATE], q)
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
             "torque of all parts on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper, "
             "residual dipole)")
@@ -482,6 +519,30 @@ class Spacecraft(Model):
         info = {} if self.control_period is None else {"control_period": self.control_period}
         return Outputs(q=q, omega=omega, inertia=self.total_inertia, extras=extras,
                        totals={"energy": energy, "momentum_body": momentum_body}, info=info)
+
+    def _estimation_outputs(self, add, fsw: np.ndarray, q: np.ndarray) -> None:
+        """The flight software's named outputs from its state slices ``fsw`` (…, STATE) and the true ``q``:
+        estimates, knowledge error ``log(q* ⊗ q̂)`` (estimate − truth) with the filter's 3σ, control error
+        ``log(q* ⊗ q_c)`` (target − truth), rad, body axes."""
+        k = _fsw_kernel
+        q_estimate = fsw[..., k.Q_EST:k.Q_EST + 4]
+        sigma = np.sqrt(np.diagonal(fsw[..., k.COVARIANCE:k.COVARIANCE + 36].reshape(*fsw.shape[:-1], 6, 6),
+                                    axis1=-2, axis2=-1))
+        add("q_estimate", q_estimate, ("quaternion",), "1",
+            "the flight software's attitude estimate [w, x, y, z], body → inertial, at the last sample")
+        add("bias_estimate", fsw[..., k.BIAS_EST:k.BIAS_EST + 3], ("xyz",), "rad/s", "gyro bias estimate, body axes")
+        add("omega_estimate", fsw[..., k.OMEGA_EST:k.OMEGA_EST + 3], ("xyz",), "rad/s",
+            "the rate the control law read: gyro rate less the bias estimate, body axes")
+        add("gyro_bias", fsw[..., k.GYRO_BIAS:k.GYRO_BIAS + 3], ("xyz",), "rad/s", "the gyro's true bias, body axes")
+        add("knowledge_error", attitude.to_rotvec(attitude.multiply(attitude.conjugate(q), q_estimate)), ("xyz",),
+            "rad", "estimate − truth: rotation vector of q* ⊗ q_estimate, body axes")
+        add("knowledge_error_3sigma", 3.0 * sigma[..., :3], ("xyz",), "rad",
+            "the filter's 3σ bound of the attitude error, body axes")
+        add("bias_error_3sigma", 3.0 * sigma[..., 3:], ("xyz",), "rad/s", "the filter's 3σ bound of the bias error")
+        target = getattr(self._torque_law(), "target", None)
+        if target is not None:
+            add("control_error", attitude.to_rotvec(attitude.multiply(attitude.conjugate(q), target)), ("xyz",),
+                "rad", "target − truth: rotation vector of q* ⊗ q_target, body axes")
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers or residual

@@ -16,12 +16,12 @@ from numba import njit
 
 from tumble import _quat, torques
 from tumble._vec import cross, matvec_flat
-from tumble.kernels.spacecraft import (_commands, cmgs, damper, environment, laws, magnetorquers, residual_dipole,
-                                      thrusters, wheels)
+from tumble.kernels.spacecraft import (_commands, cmgs, damper, environment, flight_software, laws, magnetorquers,
+                                      residual_dipole, thrusters, wheels)
 from tumble.kernels.spacecraft._base import inline, lane, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_WHEELS, J,
-                                               J_RATE, J_RATE_INV, PARTS, locator)
+                                               J_RATE, J_RATE_INV, PARTS, PERIOD, locator)
 
 #: The actuators (parts that carry momentum or exert torque on the hub), each ``kernel(lane, direct)`` of its
 #: state access (:func:`~tumble.kernels.spacecraft._base.lane`) and the motor torques commanded directly to the
@@ -196,6 +196,8 @@ def assemble(ndim, python):
     torques_on_hub = _sum_torques(actuators)
     sample_parts, discrete = _sample_all(actuators)
     field, gravity, external = _environment(python)
+    has_fsw, where_fsw = locator("flight_software")
+    fsw_step, fsw_delayed = flight_software.kernel(access)
 
     @inline
     def controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
@@ -218,6 +220,10 @@ def assemble(ndim, python):
         if has_hold(model):
             _, n, s, _ = where_hold(model)
             for i in range(HELD_WHEELS + n):
+                put(out, s + i, j, 0.0)
+        if has_fsw(model):  # the flight software's state changes only at the samples
+            _, _, s, _ = where_fsw(model)
+            for i in range(flight_software.STATE):
                 put(out, s + i, j, 0.0)
 
     # Not inlined: one compiled function that the right-hand side and the diagnostics
@@ -261,11 +267,17 @@ def assemble(ndim, python):
         if has_hold(model):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
             w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
+            b1, b2, b3 = field(model, t, qw, qx, qy, qz)
+            if has_fsw(model):  # the laws read the flight software's estimate, not the truth
+                p, _, s, _ = where_fsw(model)
+                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], y, j, b1, b2, b3)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
             h1, h2, h3 = momenta(model, y, j)
-            b1, b2, b3 = field(model, t, qw, qx, qy, qz)
             u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
                                                       H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
+            if has_fsw(model):
+                p, _, s, _ = where_fsw(model)
+                u1, u2, u3, m1, m2, m3 = fsw_delayed(model, p, s, y, j, u1, u2, u3, m1, m2, m3)
             hold(model, t, y, j, u1, u2, u3, m1, m2, m3, source)
         sample_parts(model, t, y, j)
 
