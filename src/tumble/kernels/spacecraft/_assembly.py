@@ -173,8 +173,8 @@ def _environment(python):
 @functools.lru_cache(maxsize=None)
 def assemble(ndim, python):
     """Compile-time assembly for states of ``ndim``: ``(derivative, sample, discrete)``; ``python``: the
-    variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative
-    and the discrete update, which then allocate nothing, are compiled without reference counting: the
+    variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
+    which then allocates nothing, is compiled without reference counting: the
     runtime tests of the parts split the refcount pairs of the model's arrays over branches that Numba's
     pruner cannot join, and counting them made the RK4 step 5.5 times slower).
     ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` of the member in lane ``j`` of the block
@@ -262,7 +262,9 @@ def assemble(ndim, python):
             put3(aux, AUX_ACTUATOR, j, x1, x2, x3)
             put3(aux, AUX_EXTERNAL, j, e1, e2, e3)
 
-    @njit(_nrt=python)
+    # Counted: the flight software's filter allocates its matrices; a sample runs once per sample time
+    # (or step), not per evaluation of the right-hand side.
+    @njit
     def sample(model, t, y, j):
         if has_hold(model):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
