@@ -1,5 +1,7 @@
 """Helpers shared by the tests."""
 
+import subprocess
+
 import numpy as np
 
 from tumble.integrate import METHODS
@@ -24,3 +26,26 @@ def assert_same_run(traj, reference):
     for name in traj.totals:
         np.testing.assert_array_equal(traj.totals[name], reference.totals[name], err_msg=name)
     assert traj.method == reference.method and traj.model == reference.model
+
+
+def stop(*processes):
+    """End processes a test module started: SIGTERM to all, then SIGKILL to any not exited within 5 s."""
+    for process in processes:
+        if process.poll() is None:
+            process.terminate()
+    for process in processes:
+        try:
+            process.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=20)
+
+
+def assert_one_line_error(result, message, code=2):
+    """A CLI result (typer's ``CliRunner``): exit ``code`` (2: bad input), nothing on stdout, one ``error:`` line
+    holding ``message``, no traceback."""
+    assert result.exit_code == code, (result.exit_code, result.stderr, result.exception)
+    assert result.stdout == ""
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], result.stderr
+    assert "Traceback" not in result.stderr

@@ -9,6 +9,7 @@ import os
 import h5py
 import numpy as np
 import pytest
+from helpers import assert_one_line_error
 import xarray as xr
 from typer.testing import CliRunner
 
@@ -24,13 +25,6 @@ def invoke(*args):
     return runner.invoke(app, [str(a) for a in args])
 
 
-def assert_one_line_error(result, message, code=2):
-    """Exit ``code`` (2: bad input), nothing on stdout, one ``error:`` line holding ``message``, no traceback."""
-    assert result.exit_code == code, (result.exit_code, result.stderr, result.exception)
-    assert result.stdout == ""
-    lines = result.stderr.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], result.stderr
-    assert "Traceback" not in result.stderr
 
 
 @pytest.fixture(scope="module")

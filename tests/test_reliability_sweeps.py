@@ -22,6 +22,7 @@ from pathlib import Path
 import cloudpickle
 import numpy as np
 import pytest
+from helpers import stop
 
 import tumble
 from tumble import _callback
@@ -62,17 +63,6 @@ def stop_after(n):
     return progress
 
 
-def stop(*processes):
-    """End processes this module started: SIGTERM to all, then SIGKILL to any not exited within 5 s."""
-    for process in processes:
-        if process.poll() is None:
-            process.terminate()
-    for process in processes:
-        try:
-            process.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=20)
 
 
 @pytest.fixture(scope="module")

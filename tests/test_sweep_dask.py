@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import stop
 
 import tumble
 from tumble.sweep import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
@@ -69,17 +70,6 @@ def local_client(reference):
     cluster.close(timeout=TIMEOUT)
 
 
-def stop(*processes):
-    """End processes this module started: SIGTERM to all, then SIGKILL to any not exited within 5 s."""
-    for process in processes:
-        if process.poll() is None:
-            process.terminate()
-    for process in processes:
-        try:
-            process.wait(timeout=5)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=20)
 
 
 @pytest.fixture(scope="module")
