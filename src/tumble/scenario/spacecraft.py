@@ -32,8 +32,9 @@ orbit in degrees)::
 
 The tables and keys are the arguments of :class:`tumble.spacecraft.Spacecraft`
 and of its parts (``docs/spacecraft.md`` lists them): actuators, a nutation
-damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment,
-and the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`).
+damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment
+(``[spacecraft.magnetic_field]``, ``[spacecraft.residual_dipole]``,
+``gravity_gradient``), and the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`).
 ``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
 external torques ``[[torque]]`` (``torque=`` of :func:`tumble.simulate`, on
 top of the spacecraft's own environment) are the shared tables
@@ -62,7 +63,7 @@ from tumble.scenario.orbit import OrbitTable
 from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
 from tumble.spacecraft import actuators
-from tumble.spacecraft.environment import DipoleField
+from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.model import Spacecraft
 from tumble.trajectory import Trajectory
 
@@ -185,6 +186,15 @@ class MagnetorquerTable(_Table):
         return actuators.Magnetorquers(cast(Any, self.max_dipole))  # a number or (3,): converted there
 
 
+class ResidualDipoleTable(_Table):
+    """``dipole = [mx, my, mz]``: a constant body dipole, A·m² (torque m × B in the magnetic field)."""
+
+    dipole: _Vector
+
+    def build(self) -> ResidualDipole:
+        return ResidualDipole(np.array(self.dipole))
+
+
 class FieldTable(_Table):
     """``model = "dipole"`` (tilted dipole, IGRF-13 2020) or ``uniform = [Bx, By, Bz]`` (T, inertial)."""
 
@@ -233,6 +243,7 @@ class SpacecraftTable(_InertiaOrMoments):
     orbit: OrbitTable | None = None
     magnetic_field: FieldTable | None = None
     gravity_gradient: _Bool = False
+    residual_dipole: ResidualDipoleTable | None = None
     controller: list[Controller] = []
     control_period: _Positive | None = None
 
@@ -252,7 +263,8 @@ class SpacecraftTable(_InertiaOrMoments):
         parts: dict[str, Any] = {  # the keyword arguments of Spacecraft
             key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
             for key in ("wheels", "thrusters", "controller")}
-        for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field"):
+        for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field",
+                    "residual_dipole"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
         pyramid = parts.pop("wheel_pyramid")

@@ -21,7 +21,7 @@ from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, Reactio
 from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MRPFeedback, PythonLaw, QuaternionPD,
                                        RateDamping, WheelTorques)
 from tumble.spacecraft.damper import SphericalDamper, simulate_damped
-from tumble.spacecraft.environment import DipoleField
+from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft, simulate
@@ -31,7 +31,7 @@ from tumble.spacecraft.tle import TLE
 
 __all__ = [
     "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "Environment", "MRPFeedback", "Magnetorquers",
-    "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel",
+    "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
     "SaturationWarning", "SingularityWarning", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE", "Thruster",
     "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",

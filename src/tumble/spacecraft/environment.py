@@ -20,6 +20,9 @@ from the inertial x axis at ``t = 0``. At the magnetic equator ``|B| = B₀
 Determination and Control*, ch. 5 and appendix H; Markley & Crassidis,
 *Fundamentals of Spacecraft Attitude Determination and Control*, ch. 3.)
 
+A residual magnetic dipole ``m`` (A·m², fixed in the body; :class:`ResidualDipole`)
+feels ``τ = m × B`` in the body-axes field ``B`` (Wertz, §17.2).
+
 Default numbers: the dipole (degree-1) terms of IGRF-13 at epoch 2020.0
 (Alken et al., "International Geomagnetic Reference Field: the thirteenth
 generation", Earth Planets Space 73:49, 2021), ``g₁⁰ = −29404.8 nT``,
@@ -41,9 +44,11 @@ from numpy.typing import ArrayLike
 
 from tumble._gravity import gravity_gradient_torque
 from tumble._validate import ValidationError, as_array, require_finite, require_positive
+from tumble.kernels.spacecraft import residual_dipole as _residual_dipole
+from tumble.kernels.spacecraft._base import Program
 from tumble.kernels.spacecraft.environment import dipole_field
 
-__all__ = ["DipoleField", "IGRF2020_DIPOLE", "dipole_field", "gravity_gradient_torque"]
+__all__ = ["DipoleField", "IGRF2020_DIPOLE", "ResidualDipole", "dipole_field", "gravity_gradient_torque"]
 
 #: IGRF-13 degree-1 Gauss coefficients at epoch 2020.0, nT: (g₁⁰, g₁¹, h₁¹) (Alken et al. 2021).
 IGRF2020_DIPOLE = (-29404.8, -1450.9, 4652.5)
@@ -120,3 +125,24 @@ class DipoleField:
 def _fields(t, r, params, out):
     for k in range(t.shape[0]):
         out[k, 0], out[k, 1], out[k, 2] = dipole_field(t[k], r[k, 0], r[k, 1], r[k, 2], params)
+
+
+@dataclass(frozen=True)
+class ResidualDipole:
+    """A residual magnetic dipole fixed in the body: torque ``τ = m × B`` (N·m, body axes) in the spacecraft's
+    ``magnetic_field`` ``B`` (T, body axes); :mod:`tumble.kernels.spacecraft.residual_dipole`.
+
+    dipole : m, (3,) A·m², body axes
+    """
+
+    dipole: np.ndarray
+
+    def __post_init__(self):
+        m = as_array(self.dipole, "dipole")
+        if m.shape != (3,):
+            raise ValidationError(f"dipole: must be 3 numbers (A·m², body axes), got shape {m.shape}")
+        m.setflags(write=False)
+        object.__setattr__(self, "dipole", m)
+
+    def _program(self) -> Program:
+        return _residual_dipole.program(self.dipole)

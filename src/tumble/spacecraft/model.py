@@ -41,6 +41,7 @@ from tumble.kernels.spacecraft import damper as _damper_kernel
 from tumble.kernels.spacecraft import environment as _environment
 from tumble.kernels.spacecraft import laws as _law_kernels
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
+from tumble.kernels.spacecraft import residual_dipole as _residual_dipole
 from tumble.kernels.spacecraft import thrusters as _thrusters
 from tumble.kernels.spacecraft import wheels as _wheels
 from tumble.kernels.spacecraft._base import Program
@@ -49,7 +50,7 @@ from tumble.simulate import simulate as _simulate
 from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, ReactionWheel, Thruster
 from tumble.spacecraft.control import DIPOLE_LAWS, TORQUE_LAWS, MomentumDumping, MRPFeedback, PythonLaw, WheelTorques
 from tumble.spacecraft.damper import SphericalDamper
-from tumble.spacecraft.environment import DipoleField
+from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.orbit import Orbit
 from tumble.trajectory import Extra, Trajectory
 
@@ -90,6 +91,8 @@ class Spacecraft(Model):
     magnetic_field : :class:`~tumble.spacecraft.environment.DipoleField`, a (3,) uniform field in
         inertial axes (T), or None
     gravity_gradient : bool, the gravity-gradient torque of the orbit on the total inertia
+    residual_dipole : :class:`~tumble.spacecraft.environment.ResidualDipole` or None: a constant body dipole,
+        torque ``m × B`` in ``magnetic_field`` (needed)
     controller : a law or a sequence of laws: at most one torque law (:class:`QuaternionPD`,
         :class:`MRPFeedback`, :class:`RateDamping`, :class:`ConstantTorque`, or a Python callable
         ``u = law(t, q, omega, wheel_speeds)``, i.e. a :class:`PythonLaw`), one of each dipole law
@@ -117,6 +120,7 @@ class Spacecraft(Model):
     orbit: Orbit | None = None
     magnetic_field: object = None
     gravity_gradient: bool = False
+    residual_dipole: ResidualDipole | None = None
     controller: Any = None  # a law, a sequence of laws or None: the tuple of laws once validated
     control_period: float | None = None
     #: The whole spacecraft as one rigid body (total inertia J, mass, centre of mass), derived.
@@ -133,6 +137,7 @@ class Spacecraft(Model):
         _check_type(self.magnetorquers, Magnetorquers, "magnetorquers")
         _check_type(self.damper, SphericalDamper, "damper")
         _check_type(self.orbit, Orbit, "orbit")
+        _check_type(self.residual_dipole, ResidualDipole, "residual_dipole")
         set_(self, "body", self._total_body())
         if self.magnetic_field is not None and not isinstance(self.magnetic_field, DipoleField):
             b = as_array(self.magnetic_field, "magnetic_field")
@@ -146,6 +151,8 @@ class Spacecraft(Model):
             raise ValidationError(f"gravity_gradient: must be True or False, got {self.gravity_gradient!r}")
         if self.gravity_gradient and self.orbit is None:
             raise ValidationError("gravity_gradient: needs an orbit")
+        if self.residual_dipole is not None and self.magnetic_field is None:
+            raise ValidationError("residual_dipole: needs a magnetic_field (its torque is m × B)")
         set_(self, "controller", self._laws())
         self._thruster_program()  # validates the thruster layout
         if self.control_period is not None:
@@ -251,7 +258,8 @@ class Spacecraft(Model):
             programs.append(_wheels.program(
                 axes, spin, max_torque, max_speed, viscous, coulomb, coulomb_speed,
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
-        programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper) if part is not None]
+        programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper, self.residual_dipole)
+                     if part is not None]
         thrusters = self._thruster_program()
         if thrusters is not None:  # None: no thrusters
             programs.append(thrusters)
@@ -436,12 +444,16 @@ class Spacecraft(Model):
                 "controller dipole command before the magnetorquer limits, body axes")
             add("dipole", aux[..., _magnetorquers.aux_slices(m.n, m.a)["dipole"]], ("xyz",), "A m2",
                 "magnetorquer dipole (after limits), body axes")
+        if self.residual_dipole is not None:
+            r = where("residual_dipole")
+            add("residual_dipole_torque", aux[..., _residual_dipole.aux_slices(r.n, r.a)["residual_dipole_torque"]],
+                ("xyz",), "N m", "torque of the residual dipole m × B, body axes")
         if self.magnetic_field is not None:
             add("magnetic_field", core(_kernel.AUX_FIELD), ("xyz",), "T", "magnetic field, body axes")
         if self.gravity_gradient:
             add("gravity_gradient_torque", core(_kernel.AUX_GRAVITY), ("xyz",), "N m",
                 "gravity-gradient torque, body axes")
-        if kernel.torque_codes is not None:
+        if kernel.torque_codes.size:
             add("external_torque", core(_kernel.AUX_EXTERNAL), ("xyz",), "N m",
                 "external torque of the torque argument, body axes")
         if self.damper is not None:
@@ -454,7 +466,8 @@ class Spacecraft(Model):
                 states[..., _law_kernels.integral_slices(integral.n, integral.s)["attitude_error_integral"]], ("xyz",),
                 "s", "integral of the MRP attitude error of the MRP feedback's integral term")
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
-            "torque of all actuators on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper)")
+            "torque of all parts on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper, "
+            "residual dipole)")
         momentum_body = core(_kernel.AUX_MOMENTUM)
         energy = core(_kernel.AUX_ENERGY, 1)[..., 0]
         add("total_momentum_inertial", attitude.rotate(q, momentum_body), ("xyz",), "N m s",
@@ -466,11 +479,12 @@ class Spacecraft(Model):
                        totals={"energy": energy, "momentum_body": momentum_body}, info=info)
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
-        """Without external torque (no ``torque=``, gravity gradient, thrusters or magnetorquers): the inertial
-        angular momentum of the whole spacecraft; and, without CMGs (whose ideal gimbal servos do work) or a
-        damper (which dissipates), its energy less the work done on the wheels by motors and bearings."""
+        """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers or residual
+        dipole): the inertial angular momentum of the whole spacecraft; and, without CMGs (whose ideal gimbal
+        servos do work) or a damper (which dissipates), its energy less the work done on the wheels by motors
+        and bearings."""
         if (traj.info.get("torque") != "none" or self.gravity_gradient or self.thrusters
-                or self.magnetorquers is not None):
+                or self.magnetorquers is not None or self.residual_dipole is not None):
             return {}
         out = {"momentum_inertial": traj.momentum_inertial}
         if self.cmgs is None and self.damper is None:

@@ -6,10 +6,13 @@ A spacecraft is assembled from *parts*, each a program of one kind of
 (:mod:`.laws`), a piece of the environment (:mod:`.environment`) or the
 zero-order hold of a sampled controller — made of a parameter block in the one
 flat array ``data``, a slice of the state vector and a slice of the
-diagnostics, all at named offsets. :class:`SpacecraftModel` records which
-kinds are present in its *type* (a field per kind, None when absent), so that
-Numba compiles each combination on its own and a part the spacecraft lacks
-costs nothing.
+diagnostics, all at named offsets. The composition is data: which parts a
+spacecraft has, how many wheels, gyros or thrusters, their parameters, the
+control law and its gains, the environment and the external torque program
+are numbers in :class:`SpacecraftModel`, whose Numba *type* is the same for
+every spacecraft. The right-hand side is compiled once, with every kind of
+part behind a runtime test of its presence, and a new composition compiles
+nothing.
 
 State vector::
 
@@ -42,7 +45,7 @@ Inside: :mod:`._layout` says where things are (the kinds, the hub block, the
 core diagnostics, each part's packed place), :mod:`._base` what every part
 shares (state access, the :class:`~._base.Actuator` interface),
 :mod:`._commands` assembles the controller and :mod:`._assembly` the
-right-hand side, when Numba compiles a model type.
+right-hand side, when Numba compiles the model type (once).
 """
 
 from __future__ import annotations
@@ -56,9 +59,10 @@ from numba.extending import overload
 from tumble import _protocol, torques
 from tumble.kernels.spacecraft._assembly import assemble as _assemble
 from tumble.kernels.spacecraft._base import SAMPLE_TOLERANCE, Program, inline
-from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_CORE, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL,
-                                               AUX_FIELD, AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND,
-                                               HELD_WHEELS, HUB_SIZE, PARTS, PERIOD, START, Slices, pack, unpack)
+from tumble.kernels.spacecraft._layout import (ABSENT, AUX_ACTUATOR, AUX_CORE, AUX_DIPOLE_COMMAND, AUX_ENERGY,
+                                               AUX_EXTERNAL, AUX_FIELD, AUX_GRAVITY, AUX_MOMENTUM,
+                                               AUX_TORQUE_COMMAND, CORE_FIELDS, HELD_WHEELS, HUB_SIZE, PARTS,
+                                               PERIOD, START, Slices, locator, pack, unpack)
 
 __all__ = ["AUX_ACTUATOR", "AUX_DIPOLE_COMMAND", "AUX_ENERGY", "AUX_EXTERNAL", "AUX_FIELD", "AUX_GRAVITY",
            "AUX_MOMENTUM", "AUX_TORQUE_COMMAND", "HELD_WHEELS", "PARTS", "Program", "Slices", "SpacecraftModel",
@@ -72,8 +76,7 @@ _STORE = np.array([False, True])
 _PYTHON = ("python_law", "wheel_python")
 
 
-class SpacecraftModel(collections.namedtuple(
-        "SpacecraftModel", ("data", "route", "size", "aux_size", "torque_params", "torque_codes") + PARTS)):
+class SpacecraftModel(collections.namedtuple("SpacecraftModel", CORE_FIELDS + PARTS)):
     """Compiled parameters of a spacecraft (shared by every member of a batch).
 
     data        : float64 parameters: the hub block (``J``, ``J_RATE``, ``J_RATE_INV``,
@@ -82,12 +85,13 @@ class SpacecraftModel(collections.namedtuple(
     size        : length of the state vector
     aux_size    : length of the diagnostics of one sample
     torque_params, torque_codes : the program of ``torque=`` (:func:`tumble.torques.compile_program`
-                  in body axes, params (1, n)), or None
+                  in body axes, params (1, n)); no terms without one
 
-    then one field per kind of :data:`PARTS`: None when the spacecraft has no such part, else where the part
-    is, ``(p, n, s, a)`` (:class:`Slices`) packed into one int64 (:func:`pack`). So the set of parts is in the
-    Numba type, and the layout travels as scalars (the parallel drivers take no tuples; an array of offsets
-    would be read from memory at every evaluation, 8 % of the RK4 step of four wheels and a PD law).
+    then one int64 field per kind of :data:`PARTS`: :data:`ABSENT` (−1) when the spacecraft has no such part,
+    else where the part is, ``(p, n, s, a)`` (:class:`Slices`) packed into one int64 (:func:`pack`). Every
+    field has the same type for every spacecraft, so the Numba type is one and a composition is data; the
+    layout travels as scalars (the parallel drivers take no tuples; an array of offsets would be read from
+    memory at every evaluation).
     """
 
     __slots__ = ()
@@ -100,7 +104,7 @@ class SpacecraftModel(collections.namedtuple(
     @property
     def calls_python(self) -> bool:
         """True when a control law or the torque program calls a Python function (the batch then runs on one core)."""
-        return any(getattr(self, kind) is not None for kind in _PYTHON) or torques.calls_python(self.torque_codes)
+        return any(getattr(self, kind) != ABSENT for kind in _PYTHON) or torques.calls_python(self.torque_codes)
 
 
 def assemble(inertia, rate_inertia, period: float, t0: float, programs, route: str | None,
@@ -121,28 +125,25 @@ def assemble(inertia, rate_inertia, period: float, t0: float, programs, route: s
             layout[kind] = pack(Slices(p, part.count, s, a))
             blocks.append(np.ravel(part.params))
             p, s, a = p + part.params.size, s + part.state, a + part.aux
-    codes, params = None, None
-    if torque is not None:
-        codes, block = torques.compile_program(torque, np.eye(3), offset=0)
-        params = np.ascontiguousarray(block[None, :])
+    codes, block = torques.compile_program(torque, np.eye(3), offset=0)
     return SpacecraftModel(
         data=np.ascontiguousarray(np.concatenate([np.asarray(b, dtype=np.float64) for b in blocks])),
-        route=-1 if route is None else PARTS.index(route), size=s, aux_size=a, torque_params=params,
-        torque_codes=codes, **{kind: layout.get(kind) for kind in PARTS})
+        route=-1 if route is None else PARTS.index(route), size=s, aux_size=a,
+        torque_params=np.ascontiguousarray(block[None, :]), torque_codes=codes,
+        **{kind: layout.get(kind, ABSENT) for kind in PARTS})
 
 
 def slices(model: SpacecraftModel, kind: str) -> Slices | None:
     """Where the part of ``kind`` is in ``model`` (:class:`Slices`), or None when it has none."""
     value = getattr(model, kind)
-    return None if value is None else unpack(value)
-
+    return None if value == ABSENT else unpack(value)
 
 
 # Not inline="always": Numba's overload inliner (0.68) loses the loop accumulators of the parts
 # (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
 @_protocol.implements(_protocol.rhs, SpacecraftModel)
 def _spacecraft_rhs(model, b0, t, Y, OUT):
-    derivative, _, _ = _assemble(model, Y.ndim)
+    derivative, _, _ = _assemble(Y.ndim)
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
             derivative(model, t, Y, 0, OUT, Y, _STORE[0])
@@ -155,27 +156,24 @@ def _spacecraft_rhs(model, b0, t, Y, OUT):
 
 @_protocol.implements(_protocol.project, SpacecraftModel)
 def _spacecraft_project(model, b0, t, Y):
-    _, sample, discrete = _assemble(model, Y.ndim)
+    _, sample, discrete = _assemble(Y.ndim)
+    has_hold, _ = locator("hold")
     if Y.ndim == 1:
         normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
     else:
         normalize, lanes = _protocol.normalize_quaternions, inline(lambda Y: Y.shape[1])
-    if discrete == "hold":
-        def impl(model, b0, t, Y):
-            normalize(Y)
+
+    def impl(model, b0, t, Y):
+        normalize(Y)
+        if has_hold(model):  # a zero-order hold samples at t₀ + k·period
             period, start = model.data[PERIOD], model.data[START]
             k = round((t - start) / period)
             if abs(t - start - k * period) <= SAMPLE_TOLERANCE * period:
                 for j in range(lanes(Y)):
                     sample(model, t, Y, j)
-    elif discrete == "step":
-        def impl(model, b0, t, Y):
-            normalize(Y)
+        elif discrete(model):  # parts with discrete states update after every step
             for j in range(lanes(Y)):
                 sample(model, t, Y, j)
-    else:
-        def impl(model, b0, t, Y):
-            normalize(Y)
     return impl
 
 
@@ -195,7 +193,7 @@ def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload 
 
 @overload(_evaluate, jit_options={"cache": True})
 def _evaluate_overload(model, t, y, aux):
-    derivative, _, _ = _assemble(model, 1)
+    derivative, _, _ = _assemble(1)
 
     def impl(model, t, y, aux):
         out = np.empty(y.shape[1])
@@ -211,7 +209,7 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sample, _ = _assemble(model, 1)
+    _, sample, _ = _assemble(1)
     return lambda model, t, y: sample(model, t, y, 0)
 
 

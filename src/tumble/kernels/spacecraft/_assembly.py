@@ -1,233 +1,245 @@
-"""Compile-time assembly of the spacecraft's right-hand side and discrete updates from the parts present.
+"""Compile-time assembly of the spacecraft's right-hand side and discrete updates over every kind of part.
 
-:func:`assemble` runs when Numba compiles a spacecraft model type (cached per type and state ``ndim``): it
-sums the actuators' compiled functions (:class:`~tumble.kernels.spacecraft._base.Actuator`) over the parts
-present, adds the environment and the controller (:mod:`._commands`), and returns the inlined
-``derivative`` and ``sample`` that the protocol overloads of :mod:`tumble.kernels.spacecraft` call.
+:func:`assemble` runs once per state ``ndim`` when Numba compiles the spacecraft model type: it chains the
+actuators' compiled functions (:class:`~tumble.kernels.spacecraft._base.Actuator`) over every kind of part,
+each behind its runtime presence test (:func:`~tumble.kernels.spacecraft._layout.locator`), adds the
+environment and the controller (:mod:`._commands`), and returns the ``derivative`` and ``sample`` that the
+protocol overloads of :mod:`tumble.kernels.spacecraft` call. Which parts a spacecraft has is data: a new
+composition runs the same compiled code.
 """
 
 from __future__ import annotations
 
 import functools
 
-from numba import njit, types
+from numba import njit
 
 from tumble import _quat, torques
 from tumble._vec import cross, matvec_flat
-from tumble.kernels.spacecraft import _commands, cmgs, damper, environment, laws, magnetorquers, thrusters, wheels
+from tumble.kernels.spacecraft import (_commands, cmgs, damper, environment, laws, magnetorquers, residual_dipole,
+                                      thrusters, wheels)
 from tumble.kernels.spacecraft._base import inline, lane, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_WHEELS, J,
-                                               J_RATE, J_RATE_INV, PARTS, loader, locator, present)
+                                               J_RATE, J_RATE_INV, PARTS, locator)
 
-#: The actuators (parts that carry momentum or exert torque) and their compiled functions, for a state access
-#: (:func:`~tumble.kernels.spacecraft._base.lane`) and the motor torques commanded directly to the wheels (a
-#: function of the wheel-torque law, :func:`tumble.kernels.spacecraft._commands.controller`).
+#: The actuators (parts that carry momentum or exert torque on the hub), each ``kernel(lane, direct)`` of its
+#: state access (:func:`~tumble.kernels.spacecraft._base.lane`) and the motor torques commanded directly to the
+#: wheels (:func:`tumble.kernels.spacecraft._commands.make_direct`), in the order their torques are summed.
 ACTUATORS = {
     "wheels": wheels.kernel,
     "cmgs": lambda lane, direct: cmgs.kernel(lane),
     "thrusters": lambda lane, direct: thrusters.kernel(lane),
     "magnetorquers": lambda lane, direct: magnetorquers.kernel(lane),
     "damper": lambda lane, direct: damper.kernel(lane),
+    "residual_dipole": lambda lane, direct: residual_dipole.kernel(lane),
 }
 
-# Absent pieces: compiled to nothing (Numba's inliner takes no *args, so one per signature).
-_no_momenta = inline(lambda model, L, y, j: (0.0, 0.0, 0.0))
-_no_energy = inline(lambda model, L, y, j: 0.0)
-_no_torques = inline(lambda model, L, t, y, j, out, aux, store, w1, w2, w3, cmd: (0.0, 0.0, 0.0))
-_no_samples = inline(lambda model, L, t, y, j: None)
-_no_field = inline(lambda model, L, t, qw, qx, qy, qz: (0.0, 0.0, 0.0))
-_no_external = inline(lambda model, L, t, qw, qx, qy, qz, w1, w2, w3: (0.0, 0.0, 0.0))
-_no_law_rates = inline(lambda model, L, t, y, j, out, qw, qx, qy, qz: None)
-_no_hold_rates = inline(lambda model, L, out, j: None)
+# The empty sums (Numba's inliner takes no *args, so one per signature).
+_no_momenta = inline(lambda model, y, j: (0.0, 0.0, 0.0))
+_no_energy = inline(lambda model, y, j: 0.0)
+_no_torques = inline(lambda model, t, y, j, out, aux, store, w1, w2, w3, cmd: (0.0, 0.0, 0.0))
+_no_samples = inline(lambda model, t, y, j: None)
+_none_discrete = inline(lambda model: False)
 
 
 def _sum_momenta(parts):
-    """``Σ h_k`` (N·m·s) of the actuators ``parts`` [(kind index, where, Actuator)]."""
+    """``Σ h_k`` (N·m·s) of the actuators ``parts`` [(kind index, (has, where), Actuator)] present."""
     total = _no_momenta
-    for _, where, part in parts:
-        total = _add_momentum(total, where, part.momentum)
+    for _, (has, where), part in parts:
+        total = _add_momentum(total, has, where, part.momentum)
     return total
 
 
-def _add_momentum(previous, where, momentum):
+def _add_momentum(previous, has, where, momentum):
     @inline
-    def total(model, L, y, j):
-        a1, a2, a3 = previous(model, L, y, j)
-        p, n, s, _ = where(L)
-        b1, b2, b3 = momentum(model, p, n, s, y, j)
-        return a1 + b1, a2 + b2, a3 + b3
+    def total(model, y, j):
+        a1, a2, a3 = previous(model, y, j)
+        if has(model):
+            p, n, s, _ = where(model)
+            b1, b2, b3 = momentum(model, p, n, s, y, j)
+            a1, a2, a3 = a1 + b1, a2 + b2, a3 + b3
+        return a1, a2, a3
 
     return total
 
 
 def _sum_energies(parts):
     total = _no_energy
-    for _, where, part in parts:
-        total = _add_energy(total, where, part.energy)
+    for _, (has, where), part in parts:
+        total = _add_energy(total, has, where, part.energy)
     return total
 
 
-def _add_energy(previous, where, energy):
+def _add_energy(previous, has, where, energy):
     @inline
-    def total(model, L, y, j):
-        p, n, s, _ = where(L)
-        return previous(model, L, y, j) + energy(model, p, n, s, y, j)
+    def total(model, y, j):
+        e = previous(model, y, j)
+        if has(model):
+            p, n, s, _ = where(model)
+            e += energy(model, p, n, s, y, j)
+        return e
 
     return total
 
 
 def _sum_torques(parts):
-    """``Σ τ_k`` (N·m) of the actuators, each writing its state derivatives and diagnostics."""
+    """``Σ τ_k`` (N·m) of the actuators present, each writing its state derivatives and diagnostics."""
     total = _no_torques
-    for k, where, part in parts:
-        total = _add_torque(total, k, where, part.act)
+    for k, (has, where), part in parts:
+        total = _add_torque(total, k, has, where, part.act)
     return total
 
 
-def _add_torque(previous, k, where, act):
+def _add_torque(previous, k, has, where, act):
     @inline
-    def total(model, L, t, y, j, out, aux, store, w1, w2, w3, cmd):
-        a1, a2, a3 = previous(model, L, t, y, j, out, aux, store, w1, w2, w3, cmd)
-        p, n, s, a = where(L)
-        b1, b2, b3 = act(model, p, n, s, a, model.route == k, t, y, j, out, aux, store, w1, w2, w3, cmd)
-        return a1 + b1, a2 + b2, a3 + b3
+    def total(model, t, y, j, out, aux, store, w1, w2, w3, cmd):
+        a1, a2, a3 = previous(model, t, y, j, out, aux, store, w1, w2, w3, cmd)
+        if has(model):
+            p, n, s, a = where(model)
+            b1, b2, b3 = act(model, p, n, s, a, model.route == k, t, y, j, out, aux, store, w1, w2, w3, cmd)
+            a1, a2, a3 = a1 + b1, a2 + b2, a3 + b3
+        return a1, a2, a3
 
     return total
 
 
 def _sample_all(parts):
-    """The discrete updates of the actuators that have some, or None."""
-    total = None
-    for _, where, part in parts:
+    """``(sample, discrete)``: the discrete updates of the actuators present that have some, and
+    ``discrete(model)``, True when the spacecraft carries one of them."""
+    total, discrete = _no_samples, _none_discrete
+    for _, (has, where), part in parts:
         if part.sample is not no_sample:
-            total = _add_sample(_no_samples if total is None else total, where, part.sample)
-    return total
+            total, discrete = _add_sample(total, has, where, part.sample), _or_present(discrete, has)
+    return total, discrete
 
 
-def _add_sample(previous, where, sample):
+def _add_sample(previous, has, where, sample):
     @inline
-    def total(model, L, t, y, j):
-        previous(model, L, t, y, j)
-        p, n, s, _ = where(L)
-        sample(model, p, n, s, t, y, j)
+    def total(model, t, y, j):
+        previous(model, t, y, j)
+        if has(model):
+            p, n, s, _ = where(model)
+            sample(model, p, n, s, t, y, j)
 
     return total
 
 
-def _environment(model, has):
-    """``field(model, L, t, q) -> B`` (T, body axes), ``gravity(model, L, t, q) -> τ_gg`` and
-    ``external(model, L, t, q, ω) -> τ`` (the torque program), N·m, body axes."""
-    if has["dipole_field"] or has["uniform_field"]:
-        kind = "dipole_field" if has["dipole_field"] else "uniform_field"
-        body_field = environment.dipole_body if has["dipole_field"] else environment.uniform_body
-        where_field = locator(has, kind)
+def _or_present(previous, has):
+    return inline(lambda model: previous(model) or has(model))
 
-        @inline
-        def field(model, L, t, qw, qx, qy, qz):
-            p, _, _, _ = where_field(L)
-            return body_field(model, p, t, qw, qx, qy, qz)
-    else:
-        field = _no_field
 
-    if has["gravity_gradient"]:
-        where_gg = locator(has, "gravity_gradient")
+def _environment():
+    """``field(model, t, q) -> B`` (T, body axes), ``gravity(model, t, q) -> τ_gg`` and
+    ``external(model, t, q, ω) -> τ`` (the torque program), N·m, body axes."""
+    has_dipole, where_dipole = locator("dipole_field")
+    has_uniform, where_uniform = locator("uniform_field")
+    has_gravity, where_gravity = locator("gravity_gradient")
 
-        @inline
-        def gravity(model, L, t, qw, qx, qy, qz):
-            p, _, _, _ = where_gg(L)
-            return environment.gravity_gradient(model, p, J, t, qw, qx, qy, qz)
-    else:
-        gravity = _no_field
+    @inline
+    def field(model, t, qw, qx, qy, qz):
+        b1 = b2 = b3 = 0.0
+        if has_dipole(model):
+            p, _, _, _ = where_dipole(model)
+            b1, b2, b3 = environment.dipole_body(model, p, t, qw, qx, qy, qz)
+        elif has_uniform(model):
+            p, _, _, _ = where_uniform(model)
+            b1, b2, b3 = environment.uniform_body(model, p, t, qw, qx, qy, qz)
+        return b1, b2, b3
 
-    if isinstance(model.types[model.fields.index("torque_codes")], types.NoneType):
-        external = _no_external
-    else:
-        @inline
-        def external(model, L, t, qw, qx, qy, qz, w1, w2, w3):
-            return torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.torque_params, 0, model.torque_codes)
+    @inline
+    def gravity(model, t, qw, qx, qy, qz):
+        g1 = g2 = g3 = 0.0
+        if has_gravity(model):
+            p, _, _, _ = where_gravity(model)
+            g1, g2, g3 = environment.gravity_gradient(model, p, J, t, qw, qx, qy, qz)
+        return g1, g2, g3
+
+    @inline
+    def external(model, t, qw, qx, qy, qz, w1, w2, w3):
+        e1 = e2 = e3 = 0.0
+        if model.torque_codes.shape[0] > 0:
+            e1, e2, e3 = torques.evaluate(t, qw, qx, qy, qz, w1, w2, w3, model.torque_params, 0,
+                                          model.torque_codes)
+        return e1, e2, e3
 
     return field, gravity, external
 
 
 @functools.lru_cache(maxsize=None)
-def assemble(model, ndim):
-    """Compile-time assembly for the Numba type ``model`` of a SpacecraftModel and states of ``ndim``:
-    ``(derivative, sample, discrete)``. ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` of
-    the member in lane ``j`` of the block ``y`` (or of the state vector ``y``, ``ndim`` 1) into ``out`` and,
-    when ``store``, its diagnostics into ``aux``; ``sample(model, t, y, j)`` applies the discrete updates of
-    a sample time (the held commands, the PWPF triggers); ``discrete``: what :func:`tumble._protocol.project`
-    must do besides normalising the quaternion (``"hold"``: sample at the sample times; ``"step"``: after
-    every step; None). Cached, so that the right-hand side, the projection and the diagnostics share it."""
-    has = present(model)
-    load = loader(model)
+def assemble(ndim):
+    """Compile-time assembly for states of ``ndim``: ``(derivative, sample, discrete)``.
+    ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` of the member in lane ``j`` of the block
+    ``y`` (or of the state vector ``y``, ``ndim`` 1) into ``out`` and, when ``store``, its diagnostics into
+    ``aux``; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
+    PWPF triggers); ``discrete(model)`` is True when a part present updates after every step (without a
+    zero-order hold, which samples at its own times). Cached, so that the right-hand side, the projection and
+    the diagnostics share it."""
     access = lane(ndim)
     at, put, put3 = access
-    law_commands, law_direct = _commands.controller(has, access)
-    if has["hold"]:
-        commands, direct, hold = _commands.zero_order_hold(has, access, law_direct)
-        where_hold = locator(has, "hold")
-    else:
-        commands, direct = law_commands, law_direct
-    actuators = [(PARTS.index(kind), locator(has, kind), ACTUATORS[kind](access, direct))
-                 for kind in ACTUATORS if has[kind]]
+    direct = _commands.make_direct(access)
+    commands = _commands.controller(access)
+    held, hold = _commands.zero_order_hold(access, direct)
+    has_hold, where_hold = locator("hold")
+    has_integral, where_integral = locator("mrp_integral")
+    _, where_mrp = locator("mrp")
+    actuators = [(PARTS.index(kind), locator(kind), ACTUATORS[kind](access, direct)) for kind in ACTUATORS]
     momenta, energies = _sum_momenta(actuators), _sum_energies(actuators)
-    torques_on_hub, sample_parts = _sum_torques(actuators), _sample_all(actuators)
-    discrete = None if sample_parts is None else "step"
-    sample_parts = _no_samples if sample_parts is None else sample_parts
-    field, gravity, external = _environment(model, has)
+    torques_on_hub = _sum_torques(actuators)
+    sample_parts, discrete = _sample_all(actuators)
+    field, gravity, external = _environment()
 
-    if has["mrp_integral"]:
-        where_mrp, where_int = locator(has, "mrp"), locator(has, "mrp_integral")
+    @inline
+    def controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
+        """The commands in force: held from the last sample time, or the laws' now."""
+        if has_hold(model):
+            return held(model, y, j)
+        return commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3)
 
-        @inline
-        def law_rates(model, L, t, y, j, out, qw, qx, qy, qz):
-            """d/dt ∫σ dt = σ, continuous also under a zero-order hold."""
-            p, _, _, _ = where_mrp(L)
-            _, _, s, _ = where_int(L)
+    @inline
+    def law_rates(model, t, y, j, out, qw, qx, qy, qz):
+        """d/dt ∫σ dt = σ, continuous also under a zero-order hold."""
+        if has_integral(model):
+            p, _, _, _ = where_mrp(model)
+            _, _, s, _ = where_integral(model)
             s1, s2, s3 = laws.attitude_error(model, p, qw, qx, qy, qz)
             put3(out, s + laws.INTEGRAL, j, s1, s2, s3)
-    else:
-        law_rates = _no_law_rates
 
-    if has["hold"]:
-        @inline
-        def hold_rates(model, L, out, j):
-            _, n, s, _ = where_hold(L)
+    @inline
+    def hold_rates(model, out, j):
+        if has_hold(model):
+            _, n, s, _ = where_hold(model)
             for i in range(HELD_WHEELS + n):
                 put(out, s + i, j, 0.0)
-    else:
-        hold_rates = _no_hold_rates
 
     # Not inlined: one compiled function that the right-hand side and the diagnostics
-    # (:func:`tumble.kernels.spacecraft.evaluate`) share, so that a model type compiles it once.
+    # (:func:`tumble.kernels.spacecraft.evaluate`) share, so that the model type compiles it once.
     @njit
     def derivative(model, t, y, j, out, aux, store):
         d = model.data
-        L = load(model)
         qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
         w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
         H1, H2, H3 = matvec_flat(d, J_RATE, w1, w2, w3)
-        h1, h2, h3 = momenta(model, L, y, j)
+        h1, h2, h3 = momenta(model, y, j)
         H1, H2, H3 = H1 + h1, H2 + h2, H3 + h3
-        b1, b2, b3 = field(model, L, t, qw, qx, qy, qz)
-        u1, u2, u3, m1, m2, m3, source = commands(model, L, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3,
-                                                  b1, b2, b3)
-        x1, x2, x3 = torques_on_hub(model, L, t, y, j, out, aux, store, w1, w2, w3,
+        b1, b2, b3 = field(model, t, qw, qx, qy, qz)
+        u1, u2, u3, m1, m2, m3, source = controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
+                                                             H1, H2, H3, b1, b2, b3)
+        x1, x2, x3 = torques_on_hub(model, t, y, j, out, aux, store, w1, w2, w3,
                                     (u1, u2, u3, m1, m2, m3, b1, b2, b3, source))
-        g1, g2, g3 = gravity(model, L, t, qw, qx, qy, qz)
-        e1, e2, e3 = external(model, L, t, qw, qx, qy, qz, w1, w2, w3)
+        g1, g2, g3 = gravity(model, t, qw, qx, qy, qz)
+        e1, e2, e3 = external(model, t, qw, qx, qy, qz, w1, w2, w3)
         k1, k2, k3 = cross(w1, w2, w3, H1, H2, H3)
         a1, a2, a3 = matvec_flat(d, J_RATE_INV, x1 + g1 + e1 - k1, x2 + g2 + e2 - k2, x3 + g3 + e3 - k3)
         r = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
         put(out, 0, j, 0.5 * r[0])
         put3(out, 1, j, 0.5 * r[1], 0.5 * r[2], 0.5 * r[3])
         put3(out, 4, j, a1, a2, a3)
-        law_rates(model, L, t, y, j, out, qw, qx, qy, qz)
-        hold_rates(model, L, out, j)
+        law_rates(model, t, y, j, out, qw, qx, qy, qz)
+        hold_rates(model, out, j)
         if store:
             c1, c2, c3 = matvec_flat(d, J_RATE, w1, w2, w3)
-            put(aux, AUX_ENERGY, j, 0.5 * (w1 * c1 + w2 * c2 + w3 * c3) + energies(model, L, y, j))
+            put(aux, AUX_ENERGY, j, 0.5 * (w1 * c1 + w2 * c2 + w3 * c3) + energies(model, y, j))
             put3(aux, AUX_MOMENTUM, j, H1, H2, H3)
             put3(aux, AUX_TORQUE_COMMAND, j, u1, u2, u3)
             put3(aux, AUX_DIPOLE_COMMAND, j, m1, m2, m3)
@@ -236,23 +248,17 @@ def assemble(model, ndim):
             put3(aux, AUX_ACTUATOR, j, x1, x2, x3)
             put3(aux, AUX_EXTERNAL, j, e1, e2, e3)
 
-    if has["hold"]:
-        @inline
-        def sample(model, t, y, j):
-            L = load(model)
+    @inline
+    def sample(model, t, y, j):
+        if has_hold(model):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
             w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
-            h1, h2, h3 = momenta(model, L, y, j)
-            b1, b2, b3 = field(model, L, t, qw, qx, qy, qz)
-            u1, u2, u3, m1, m2, m3, source = law_commands(model, L, t, y, j, qw, qx, qy, qz, w1, w2, w3,
-                                                          H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
-            hold(model, L, t, y, j, u1, u2, u3, m1, m2, m3, source)
-            sample_parts(model, L, t, y, j)
+            h1, h2, h3 = momenta(model, y, j)
+            b1, b2, b3 = field(model, t, qw, qx, qy, qz)
+            u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
+                                                      H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
+            hold(model, t, y, j, u1, u2, u3, m1, m2, m3, source)
+        sample_parts(model, t, y, j)
 
-        discrete = "hold"
-    else:
-        @inline
-        def sample(model, t, y, j):
-            sample_parts(model, load(model), t, y, j)
     return derivative, sample, discrete

@@ -1,11 +1,11 @@
 """Where things are in the compiled spacecraft: the kinds of part, the hub block, the core diagnostics, and
-each part's place ``(p, n, s, a)`` packed into one field of the model (see :mod:`tumble.kernels.spacecraft`)."""
+each part's place ``(p, n, s, a)`` packed into one int64 field of the model (:data:`ABSENT` when the spacecraft
+has no such part; see :mod:`tumble.kernels.spacecraft`)."""
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
-
-from numba import types
 
 from tumble._validate import ValidationError
 from tumble.kernels.spacecraft._base import inline
@@ -13,7 +13,13 @@ from tumble.kernels.spacecraft._base import inline
 #: The kinds of part, in the order of their state slices.
 PARTS = ("hold", "wheels", "cmgs", "thrusters", "magnetorquers", "damper", "pd", "mrp", "mrp_integral",
          "python_law", "bdot", "dumping", "wheel_table", "wheel_python", "dipole_field", "uniform_field",
-         "gravity_gradient")
+         "gravity_gradient", "residual_dipole")
+
+#: The fields of ``SpacecraftModel`` before the parts' (one int64 per kind of :data:`PARTS` follows them).
+CORE_FIELDS = ("data", "route", "size", "aux_size", "torque_params", "torque_codes")
+
+#: The field of a kind the spacecraft lacks.
+ABSENT = -1
 
 # The hub's block at the start of data:
 J = 0              # J (9), total inertia about the centre of mass, kg·m², row-major
@@ -67,39 +73,22 @@ def unpack(value: int) -> Slices:
     return Slices(*((value >> shift) & ((1 << bits) - 1) for shift, bits in _BITS))
 
 
-def present(model) -> dict[str, bool]:
-    """The kinds present in the Numba type ``model`` of a SpacecraftModel (their fields not None)."""
-    return {kind: not isinstance(model.types[model.fields.index(kind)], types.NoneType) for kind in PARTS}
-
-
-def locator(has: dict, kind: str):
-    """A compiled ``where(L) -> (p, n, s, a)`` of the part ``kind`` in the layout ``L`` of :func:`loader`."""
-    k = 4 * sum(has[other] for other in PARTS[:PARTS.index(kind)])
-
-    @inline
-    def where(L):
-        return L[k], L[k + 1], L[k + 2], L[k + 3]
-
-    return where
-
-
-def loader(model):
-    """A compiled ``load(model) -> L``: ``(p, n, s, a)`` of every part present in the Numba type ``model``,
-    unpacked into one flat tuple (once per evaluation; :func:`locator` then indexes it with constants)."""
-    load = inline(lambda model: ())
-    for kind, here in present(model).items():
-        if here:
-            load = _load_part(load, model.fields.index(kind))
-    return load
-
-
-def _load_part(previous, field):
+@functools.lru_cache(maxsize=None)
+def locator(kind: str):
+    """Compiled ``(has, where)`` of the part ``kind``: ``has(model)`` is True when the spacecraft carries it,
+    ``where(model) -> (p, n, s, a)`` unpacks its place (meaningful only when it does). Runtime reads of one
+    int64 field: the composition is data, not part of the model's Numba type."""
+    field = len(CORE_FIELDS) + PARTS.index(kind)
     (_, b0), (s1, b1), (s2, b2), (s3, b3) = _BITS
     m0, m1, m2, m3 = (1 << b0) - 1, (1 << b1) - 1, (1 << b2) - 1, (1 << b3) - 1
 
     @inline
-    def load(model):
-        v = model[field]
-        return previous(model) + (v & m0, (v >> s1) & m1, (v >> s2) & m2, (v >> s3) & m3)
+    def has(model):
+        return model[field] >= 0
 
-    return load
+    @inline
+    def where(model):
+        v = model[field]
+        return v & m0, (v >> s1) & m1, (v >> s2) & m2, (v >> s3) & m3
+
+    return has, where

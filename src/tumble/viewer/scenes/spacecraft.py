@@ -12,6 +12,7 @@ Drawn from the :class:`tumble.spacecraft.Spacecraft` (its parts) and its traject
 * CMG ``i``: its rotor disk on the spin axis ``s_i(δ) = cos δ s0_i + sin δ (g_i × s0_i)``, axes
   ``Rot(g_i, δ) Z(s0_i)``, and its gimbal axis ``g_i`` as a line, just outside the hub along ``g_i``;
 * thruster ``i``: a plume from its position against its direction while ``thruster_firing`` is 1;
+* a residual dipole ``m``: a line from the centre of mass along ``m/|m|`` (body axes);
 * with an orbit: the nadir ``−r/|r|`` and the orbit normal ``r × v/|r × v|`` (inertial axes).
 """
 
@@ -37,6 +38,7 @@ __all__ = ["scene", "spin_angles"]
 _DISK = (0.22, 0.07)     # wheel and rotor disk radius and thickness, × the hub's half-diagonal
 _OUTSIDE = 1.05          # a part without a position sits at this × the half-diagonal along its axis
 _PLUME = 0.5             # plume length, × the half-diagonal
+_DIPOLE = 1.3            # residual-dipole line length, × the half-diagonal
 
 
 def spin_angles(t: np.ndarray, speed: np.ndarray) -> np.ndarray:
@@ -101,6 +103,12 @@ def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: 
             plume[~firing[:, i]] = np.nan
             scene.lines.append(Lines(f"thruster {i + 1} firing", plume, "#ff7f0e", width=9.0))
         scene.notes.append("thrusters: a plume (against the thrust) while the thruster fires")
+    if craft.residual_dipole is not None and np.any(craft.residual_dipole.dipole):
+        m = craft.residual_dipole.dipole / np.linalg.norm(craft.residual_dipole.dipole)
+        ends = np.array([np.zeros(3), _DIPOLE * half * m])
+        scene.lines.append(Lines("residual dipole", np.einsum("fij,pj->fpi", R, ends), "#9467bd", width=5.0,
+                                 markers=True))
+        scene.notes.append("residual dipole: its direction m/|m| from the centre of mass, fixed in the body")
     if craft.orbit is not None:
         r, v = craft.orbit.state(traj.t[idx])
         normal = np.cross(r, v)
