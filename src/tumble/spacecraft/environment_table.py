@@ -45,7 +45,9 @@ from datetime import datetime, timedelta
 
 import numpy as np
 
-from tumble._validate import ValidationError, readonly, require_non_negative, require_positive
+from tumble._validate import ValidationError, as_array, readonly, require_non_negative, require_positive
+from tumble.kernels.spacecraft import environment_table as _table
+from tumble.kernels.spacecraft._base import Program
 from tumble.kernels.spacecraft.environment_table import COLUMNS, WIDTH
 from tumble.spacecraft import _ephemeris
 from tumble.spacecraft.eclipse import SHADOW_MODELS, shadow_fraction
@@ -154,6 +156,30 @@ class Environment:
             raise ValidationError(f"name: must be one of {', '.join(COLUMNS)}, got {name!r}")
         first, width = COLUMNS[name]
         return self.data[:, first] if width == 1 else self.data[:, first:first + width]
+
+    @property
+    def step(self) -> float:
+        """The sample step h, s."""
+        return float(self.t[1] - self.t[0])
+
+    def at(self, t: np.ndarray | float) -> np.ndarray:
+        """The table interpolated at the times ``t`` (s from the epoch, within ``[0, t[-1]]``): (…, 21) rows, by
+        the compiled reader the spacecraft's parts use (:mod:`tumble.kernels.spacecraft.environment_table`:
+        cubic Hermite position and velocity, the rest linear, directions normalised)."""
+        times = as_array(t, "t")
+        self.check_times(times.ravel())
+        out = np.empty((times.size, WIDTH))
+        _table.read(self._program().params, np.ascontiguousarray(times.ravel()), out)
+        return out.reshape((*times.shape, WIDTH))
+
+    def check_times(self, t: np.ndarray) -> None:
+        """Refuse times outside the table, naming ``t``."""
+        if t.size and (t.min() < 0.0 or t.max() > self.t[-1] * (1.0 + 1e-12)):
+            raise ValidationError(f"t: must lie within the environment table, [0, {self.t[-1]}] s from its epoch, "
+                                  f"got [{t.min()}, {t.max()}]")
+
+    def _program(self) -> Program:
+        return _table.program(self.step, self.data)
 
     position = property(lambda self: self.column("position"), doc="r (n, 3), m, GCRS")
     velocity = property(lambda self: self.column("velocity"), doc="v (n, 3), m/s, GCRS")
