@@ -220,3 +220,81 @@ def test_bad_compositions_are_refused(env):
         Spacecraft(inertia=INERTIA, environment=env, magnetic_field=[0.0, 0.0, 1e-5])
     with pytest.raises(tumble.ValidationError, match=r"^drag\.facets: must be a non-empty sequence of Facet"):
         Drag([])
+
+
+# -- integrated -------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.slow  # compiles the spacecraft's dop853 driver on a cold cache (minutes on 2 shared cores)
+def test_disturbances_change_momentum_and_energy_by_exactly_their_impulse_and_work(env):
+    """dop853: the inertial momentum of hub and spinning wheels changes by ∫ R(q) τ dt of the facet torques, its
+    energy (less the wheels' motor work, none here) by ∫ ω·τ dt; nothing else changes them."""
+    faces = box_facets([1.0, 2.0, 1.5], centre_of_mass=[0.05, -0.03, 0.08], specular=0.2, diffuse=0.3,
+                       absorbed=0.5, lift_coefficient=0.3)
+    craft = Spacecraft(inertia=INERTIA, wheels=tumble.spacecraft.pyramid_wheels(0.02), environment=env,
+                       solar_pressure=SolarPressure(faces), drag=Drag(faces))
+    t = np.linspace(0.0, 600.0, 1201)
+    run = tumble.simulate(craft, omega0=[0.01, -0.02, 0.015], wheel_speeds0=[50.0, -30.0, 20.0, 10.0], t=t,
+                          method="dop853", rtol=1e-12, atol=1e-14)
+    torque = run.solar_pressure_torque + run.drag_torque
+    impulse = _simpson(attitude.rotate(run.q, torque), t)
+    work = _simpson(np.einsum("ki,ki->k", run.omega, torque)[:, None], t)[0]
+    change = run.total_momentum_inertial[-1] - run.total_momentum_inertial[0]
+    assert np.linalg.norm(impulse) > 1e-3 * np.linalg.norm(run.total_momentum_inertial[0])   # a real push
+    assert np.linalg.norm(change - impulse) < 1e-8 * np.linalg.norm(impulse)
+    assert abs(run.total_energy[-1] - run.total_energy[0] - work) < 1e-8 * abs(work)
+    assert np.abs(run.wheel_work).max() == 0.0
+
+
+def _simpson(f, t):
+    """∫ f dt over the uniform grid ``t`` (odd length), Simpson's rule: (n, k) → (k,)."""
+    h = t[1] - t[0]
+    return h / 3.0 * (f[0] + f[-1] + 4.0 * f[1:-1:2].sum(axis=0) + 2.0 * f[2:-1:2].sum(axis=0))
+
+
+# -- scenario files and the viewer --------------------------------------------------------------------------
+
+
+def test_the_example_scenario_builds_the_environment_parts():
+    from tumble.scenario import load_scenario
+
+    scenario = load_scenario(tumble.examples.path("spacecraft/leo_disturbances.toml"))
+    craft = scenario.model
+    assert craft.environment.epoch == datetime(2026, 3, 20, 12, 0, tzinfo=timezone.utc)
+    assert craft.environment.t[-1] >= scenario.time.stop and craft.gravity_gradient
+    assert len(craft.solar_pressure.facets) == len(craft.drag.facets) == 6
+    top = craft.solar_pressure.facets[4]                       # the +z face: 0.2 m × 0.1 m at z = 0.17 − 0.02
+    assert (top.area, top.specular, top.diffuse) == (pytest.approx(0.02), 0.3, 0.1)
+    np.testing.assert_allclose(top.centre, [0.0, 0.0, 0.15], atol=1e-15)
+
+
+@pytest.mark.parametrize(("old", "new", "message"), [
+    ("specular = 0.3", "specular = 1.3", r"spacecraft\.solar_pressure\.specular: must be <= 1"),
+    ("absorbed = 0.6", "absorbed = 0.8", r"spacecraft\.solar_pressure: absorbed \+ specular \+ diffuse: must be at most 1"),
+    ("orbit = {", 'tle = ["a", "b"]\norbit = {', r"spacecraft\.environment: give exactly one of orbit .* or tle"),
+    ("epoch = 2026-03-20T12:00:00Z", "epoch = 2063-03-20T12:00:00Z", r"spacecraft\.environment\.epoch: the run must"),
+])
+def test_bad_environment_tables_are_refused_naming_the_key(old, new, message):
+    from tumble.scenario import ScenarioError, parse_scenario
+
+    text = tumble.examples.path("spacecraft/leo_disturbances.toml").read_text(encoding="utf-8")
+    assert old in text
+    with pytest.raises(ScenarioError, match=message):
+        parse_scenario(text.replace(old, new, 1)).build()
+
+
+def test_viewer_draws_the_sun_hidden_in_the_umbra_and_the_facet_normals():
+    from tumble import viewer
+
+    orbit = Orbit.circular(500e3, 0.0)
+    dark = Environment.sample(orbit, EPOCH, duration=orbit.period, step=10.0, shadow="cylindrical")
+    craft = Spacecraft(inertia=INERTIA, environment=dark, solar_pressure=SolarPressure(box_facets([1.0] * 3)))
+    run = tumble.simulate(craft, omega0=[0.0, 0.0, 0.0], t=dark.t, method="rk4", dt=10.0)
+    scene = viewer.scene(run, model=craft, frames=len(dark.t))
+    lines = {line.name: line.points for line in scene.lines}
+    sun = lines["Sun"][:, 1]
+    lit = dark.shadow == 1.0
+    assert np.isnan(sun[~lit]).all() and (~lit).sum() > 100
+    np.testing.assert_allclose(sun[lit] / np.linalg.norm(sun[lit], axis=1)[:, None], dark.sun_direction[lit],
+                               atol=1e-15)
+    assert sum(line.name == "facet normals" for line in scene.lines) == 6

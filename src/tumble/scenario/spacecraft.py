@@ -34,7 +34,9 @@ The tables and keys are the arguments of :class:`tumble.spacecraft.Spacecraft`
 and of its parts (``docs/spacecraft.md`` lists them): actuators, a nutation
 damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment
 (``[spacecraft.magnetic_field]``, ``[spacecraft.residual_dipole]``,
-``gravity_gradient``), and the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`).
+``gravity_gradient``, and the environment sampled along an orbit with its
+facet parts: ``[spacecraft.environment]``, ``[spacecraft.solar_pressure]``,
+``[spacecraft.drag]``, :mod:`tumble.scenario.environment`), and the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`).
 ``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
 external torques ``[[torque]]`` (``torque=`` of :func:`tumble.simulate`, on
 top of the spacecraft's own environment) are the shared tables
@@ -59,6 +61,7 @@ from tumble.scenario._values import (_Bool, _InertiaOrMoments, _Limit, _Matrix, 
                                      _Vector)
 from tumble.scenario.control import Controller, Regulator
 from tumble.scenario.damper import SphericalDamperTable
+from tumble.scenario.environment import DragTable, EnvironmentTable, SolarPressureTable
 from tumble.scenario.orbit import OrbitTable
 from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
@@ -244,6 +247,9 @@ class SpacecraftTable(_InertiaOrMoments):
     magnetic_field: FieldTable | None = None
     gravity_gradient: _Bool = False
     residual_dipole: ResidualDipoleTable | None = None
+    environment: EnvironmentTable | None = None
+    solar_pressure: SolarPressureTable | None = None
+    drag: DragTable | None = None
     controller: list[Controller] = []
     control_period: _Positive | None = None
 
@@ -264,7 +270,7 @@ class SpacecraftTable(_InertiaOrMoments):
             key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
             for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field",
-                    "residual_dipole"):
+                    "residual_dipole", "environment", "solar_pressure", "drag"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
         pyramid = parts.pop("wheel_pyramid")

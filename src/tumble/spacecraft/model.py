@@ -506,7 +506,7 @@ class Spacecraft(Model):
                 "s", "integral of the MRP attitude error of the MRP feedback's integral term")
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
             "torque of all parts on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper, "
-            "residual dipole)")
+            "residual dipole, solar pressure, drag)")
         momentum_body = core(_kernel.AUX_MOMENTUM)
         energy = core(_kernel.AUX_ENERGY, 1)[..., 0]
         add("total_momentum_inertial", attitude.rotate(q, momentum_body), ("xyz",), "N m s",
@@ -518,12 +518,13 @@ class Spacecraft(Model):
                        totals={"energy": energy, "momentum_body": momentum_body}, info=info)
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
-        """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers or residual
-        dipole): the inertial angular momentum of the whole spacecraft; and, without CMGs (whose ideal gimbal
+        """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers, residual
+        dipole, solar pressure or drag): the inertial angular momentum of the whole spacecraft; and, without CMGs (whose ideal gimbal
         servos do work) or a damper (which dissipates), its energy less the work done on the wheels by motors
         and bearings."""
         if (traj.info.get("torque") != "none" or self.gravity_gradient or self.thrusters
-                or self.magnetorquers is not None or self.residual_dipole is not None):
+                or self.magnetorquers is not None or self.residual_dipole is not None
+                or self.solar_pressure is not None or self.drag is not None):
             return {}
         out = {"momentum_inertial": traj.momentum_inertial}
         if self.cmgs is None and self.damper is None:
