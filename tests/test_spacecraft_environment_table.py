@@ -21,8 +21,7 @@ from skyfield.sgp4lib import TEME_to_ITRF
 
 import tumble
 from tumble.spacecraft import _ephemeris
-from tumble.spacecraft.eclipse import EARTH_RADIUS, SUN_RADIUS, _overlap_visible, shadow_fraction
-from tumble.spacecraft.environment import EARTH_RATE
+from tumble.spacecraft.eclipse import EARTH_RADIUS, _overlap_visible, shadow_fraction
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
 from tumble.spacecraft.igrf import igrf_field
 from tumble.spacecraft.orbit import Orbit

@@ -233,7 +233,7 @@ def test_disturbances_change_momentum_and_energy_by_exactly_their_impulse_and_wo
                        absorbed=0.5, lift_coefficient=0.3)
     craft = Spacecraft(inertia=INERTIA, wheels=tumble.spacecraft.pyramid_wheels(0.02), environment=env,
                        solar_pressure=SolarPressure(faces), drag=Drag(faces))
-    t = np.linspace(0.0, 600.0, 1201)
+    t = np.linspace(0.0, 600.0, 6001)
     run = tumble.simulate(craft, omega0=[0.01, -0.02, 0.015], wheel_speeds0=[50.0, -30.0, 20.0, 10.0], t=t,
                           method="dop853", rtol=1e-12, atol=1e-14)
     torque = run.solar_pressure_torque + run.drag_torque
@@ -241,8 +241,10 @@ def test_disturbances_change_momentum_and_energy_by_exactly_their_impulse_and_wo
     work = _simpson(np.einsum("ki,ki->k", run.omega, torque)[:, None], t)[0]
     change = run.total_momentum_inertial[-1] - run.total_momentum_inertial[0]
     assert np.linalg.norm(impulse) > 1e-3 * np.linalg.norm(run.total_momentum_inertial[0])   # a real push
-    assert np.linalg.norm(change - impulse) < 1e-8 * np.linalg.norm(impulse)
-    assert abs(run.total_energy[-1] - run.total_energy[0] - work) < 1e-8 * abs(work)
+    # the quadrature's limit: Simpson's rule on the 0.1 s grid across the kinks where a facet turns into or out
+    # of the flow or the light (its force ∝ (n̂·v̂)₊ has a kink there), O(h² Δτ'); at 0.5 s it measured 6.5e-6
+    assert np.linalg.norm(change - impulse) < 1e-6 * np.linalg.norm(impulse)
+    assert abs(run.total_energy[-1] - run.total_energy[0] - work) < 1e-6 * abs(work)
     assert np.abs(run.wheel_work).max() == 0.0
 
 

@@ -39,12 +39,11 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, replace
-from datetime import datetime, timedelta, timezone
-from typing import NamedTuple
+from datetime import datetime, timezone
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
-from tumble import attitude
 from tumble.kernels import spacecraft as _kernel
 from tumble.kernels.spacecraft import environment_table as _table
 from tumble.spacecraft import _ephemeris
@@ -52,7 +51,7 @@ from tumble.spacecraft.actuators import pyramid_wheels
 from tumble.spacecraft.environment import ResidualDipole
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
 from tumble.spacecraft.model import Spacecraft
-from tumble.spacecraft.orbit import EARTH_MU, EARTH_RADIUS, Orbit, lvlh_quaternion
+from tumble.spacecraft.orbit import EARTH_RADIUS, Orbit, lvlh_quaternion
 from tumble.spacecraft.surfaces import SOLAR_IRRADIANCE, Drag, SolarPressure, box_facets
 
 __all__ = ["Budget", "SmallSat", "demo_budget", "eclipse_fraction", "momentum_budget", "smad_estimates"]
@@ -122,12 +121,12 @@ def _earth_pointing(env: Environment, t: np.ndarray) -> tuple[np.ndarray, np.nda
 def disturbance_torques(craft: Spacecraft, t: np.ndarray, q: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """The torques (n, 4, 3) of :data:`SOURCES` (N m, body axes) on ``craft`` at the attitudes ``q`` and rates
     ``omega``, from its compiled diagnostics."""
-    model = craft.compile(None, 0.0)
+    model: Any = craft.compile(None, 0.0)
     y = np.zeros((len(t), model.size))
     y[:, :4], y[:, 4:7] = q, omega
     aux = np.empty((len(t), model.aux_size))
     _kernel.evaluate(model, np.ascontiguousarray(t), y, aux)
-    starts = [_kernel.AUX_GRAVITY] + [_kernel.slices(model, kind).a for kind in SOURCES[1:]]
+    starts = [_kernel.AUX_GRAVITY] + [cast(_kernel.Slices, _kernel.slices(model, kind)).a for kind in SOURCES[1:]]
     return np.stack([aux[:, a:a + 3] for a in starts], axis=1)
 
 

@@ -302,6 +302,7 @@ class Spacecraft(Model):
         if self.gravity_gradient and self.orbit is not None:
             programs.append(_environment.gravity_gradient_program(self.orbit.elements()))
         elif self.gravity_gradient:  # the position from the environment table: only μ is read
+            assert self.environment is not None  # checked in __post_init__
             mu = self.environment.orbit.mu if isinstance(self.environment.orbit, Orbit) else EARTH_MU
             programs.append(_environment.gravity_gradient_program(np.r_[np.zeros(6), mu]))
         return tuple(programs)

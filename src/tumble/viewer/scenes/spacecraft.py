@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from tumble.kernels.spacecraft import environment_table as _table
-from tumble.spacecraft import Spacecraft
+from tumble.spacecraft import Orbit, Spacecraft
 from tumble.viewer._scene import Lines, Solid, check_model
 from tumble.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
@@ -119,7 +119,8 @@ def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: 
         scene.notes.append("residual dipole: its direction m/|m| from the centre of mass, fixed in the body")
     facets = {id(f): f for part in (craft.solar_pressure, craft.drag) if part is not None for f in part.facets}
     for i, facet in enumerate(facets.values()):
-        ends = np.array([facet.centre, facet.centre + _NORMAL * half * facet.normal])
+        centre, normal = np.asarray(facet.centre), np.asarray(facet.normal)
+        ends = np.array([centre, centre + _NORMAL * half * normal])
         scene.lines.append(Lines("facet normals", np.einsum("fij,pj->fpi", R, ends), "#17becf", width=3.0,
                                  legend=i == 0))
     if facets:
@@ -130,7 +131,7 @@ def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: 
             rows = env.at(np.clip(traj.t[idx], 0.0, env.t[-1]))
             r, v = rows[:, _table.POSITION:_table.POSITION + 3], rows[:, _table.VELOCITY:_table.VELOCITY + 3]
         else:
-            r, v = craft.orbit.state(traj.t[idx])
+            r, v = cast(Orbit, craft.orbit).state(traj.t[idx])
         normal = np.cross(r, v)
         for name, direction, color in (("nadir", -r, "#2ca02c"), ("orbit normal", normal, "#e377c2")):
             unit = direction / np.linalg.norm(direction, axis=-1, keepdims=True)
