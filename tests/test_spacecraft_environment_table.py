@@ -195,7 +195,8 @@ def test_field_column_is_igrf_in_the_itrs_turned_to_gcrs(iss_env):
     b_itrs = np.einsum("kij,kj->ki", rot, iss_env.magnetic_field)
     for k in (0, 25, 60):
         x, y, z = r_itrs[k] / 1e3
-        rad, colat, lon = math.sqrt(x * x + y * y + z * z), math.degrees(math.acos(z / math.sqrt(x * x + y * y + z * z))), math.degrees(math.atan2(y, x))
+        rad = math.sqrt(x * x + y * y + z * z)
+        colat, lon = math.degrees(math.acos(z / rad)), math.degrees(math.atan2(y, x))
         when = iss_env.epoch.replace(tzinfo=None) + timedelta(seconds=float(iss_env.t[k]))
         br = ppigrf.igrf_gc(rad, colat, lon, when)[0].item() * 1e-9
         assert b_itrs[k] @ r_itrs[k] / np.linalg.norm(r_itrs[k]) == pytest.approx(br, rel=1e-9)

@@ -177,7 +177,8 @@ def test_residual_dipole_and_magnetorquers_read_the_igrf_field_of_the_table(env)
     field = _body(q, env.magnetic_field[5])
     assert np.linalg.norm(aux[_kernel.AUX_FIELD:_kernel.AUX_FIELD + 3] - field) < 1e-15 * np.linalg.norm(field)
     a = _kernel.slices(model, "residual_dipole").a
-    assert np.linalg.norm(aux[a:a + 3] - np.cross(dipole, field)) < 1e-15 * np.linalg.norm(dipole) * np.linalg.norm(field)
+    torque = np.cross(dipole, field)
+    assert np.linalg.norm(aux[a:a + 3] - torque) < 1e-15 * np.linalg.norm(dipole) * np.linalg.norm(field)
 
 
 def test_gravity_gradient_reads_the_tables_position(env):
@@ -275,7 +276,8 @@ def test_the_example_scenario_builds_the_environment_parts():
 
 @pytest.mark.parametrize(("old", "new", "message"), [
     ("specular = 0.3", "specular = 1.3", r"spacecraft\.solar_pressure\.specular: must be <= 1"),
-    ("absorbed = 0.6", "absorbed = 0.8", r"spacecraft\.solar_pressure: absorbed \+ specular \+ diffuse: must be at most 1"),
+    ("absorbed = 0.6", "absorbed = 0.8",
+     r"spacecraft\.solar_pressure: absorbed \+ specular \+ diffuse: must be at most 1"),
     ("orbit = {", 'tle = ["a", "b"]\norbit = {', r"spacecraft\.environment: give exactly one of orbit .* or tle"),
     ("epoch = 2026-03-20T12:00:00Z", "epoch = 2063-03-20T12:00:00Z", r"spacecraft\.environment\.epoch: the run must"),
 ])

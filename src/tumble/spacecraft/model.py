@@ -520,9 +520,9 @@ class Spacecraft(Model):
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers, residual
-        dipole, solar pressure or drag): the inertial angular momentum of the whole spacecraft; and, without CMGs (whose ideal gimbal
-        servos do work) or a damper (which dissipates), its energy less the work done on the wheels by motors
-        and bearings."""
+        dipole, solar pressure or drag): the inertial angular momentum of the whole spacecraft; and, without
+        CMGs (whose ideal gimbal servos do work) or a damper (which dissipates), its energy less the work done
+        on the wheels by motors and bearings."""
         if (traj.info.get("torque") != "none" or self.gravity_gradient or self.thrusters
                 or self.magnetorquers is not None or self.residual_dipole is not None
                 or self.solar_pressure is not None or self.drag is not None):

@@ -4,10 +4,9 @@ and aerodynamic drag, in the sunlight and the air of an :class:`~tumble.spacecra
 Equations: :mod:`tumble.kernels.spacecraft.facets` (forces and torques),
 :mod:`tumble.kernels.spacecraft.solar_pressure` and :mod:`tumble.kernels.spacecraft.drag`.
 
-    >>> import numpy as np
     >>> plate = Facet(area=2.0, normal=[1.0, 0.0, 0.0], centre=[0.1, 0.0, 0.0], specular=0.3, diffuse=0.2,
     ...               absorbed=0.5)
-    >>> SolarPressure([plate]), Drag([plate])       # parts of a Spacecraft(environment=...)
+    >>> parts = {"solar_pressure": SolarPressure([plate]), "drag": Drag([plate])}   # Spacecraft(..., **parts)
 """
 
 from __future__ import annotations
@@ -80,7 +79,8 @@ class Facet:
             set_(self, name, require_non_negative(getattr(self, name), name))
 
 
-def box_facets(size: ArrayLike, *, centre_of_mass: ArrayLike = (0.0, 0.0, 0.0), **coefficients) -> list[Facet]:
+def box_facets(size: ArrayLike, *, centre_of_mass: ArrayLike = (0.0, 0.0, 0.0),
+               **coefficients: float) -> list[Facet]:
     """The six facets of a box of edge lengths ``size`` (3,), m, centred at the body origin and aligned with the
     body axes, their centres of pressure measured from ``centre_of_mass`` (m, body axes); ``coefficients`` are
     :class:`Facet`'s (the same for all six)."""
