@@ -279,3 +279,21 @@ def test_import_tumble_imports_none_of_the_environment_libraries():
             "print(sorted(m for m in ('sgp4', 'skyfield', 'pymsis', 'ppigrf', 'skyfield_data') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_nothing_reaches_the_network():
+    # a fresh process with every socket refused: the ephemeris, the Earth-orientation data, the IGRF
+    # coefficients and NRLMSIS's parameters all load from the installed packages
+    code = (
+        "import socket\n"
+        "def refuse(*args, **kwargs):\n"
+        "    raise OSError('network access refused by the test')\n"
+        "socket.socket.connect = refuse\n"
+        "socket.create_connection = refuse\n"
+        "from tumble.spacecraft import TLE, Environment\n"
+        f"env = Environment.sample(TLE({ISS[0]!r}, {ISS[1]!r}), duration=60.0, step=10.0)\n"
+        "print(env.density.min() > 0.0, abs(env.magnetic_field).max() > 0.0)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["True", "True"]
