@@ -87,6 +87,15 @@ def test_tle_state_is_sgp4s_own(iss_env):
         assert np.abs(v_teme[0] - 1e3 * np.array(v)).max() < 1e-6
 
 
+def test_a_tle_and_its_environment_pickle(iss_env):
+    import pickle
+
+    again = pickle.loads(pickle.dumps(iss_env))
+    assert again.orbit == iss_env.orbit and np.array_equal(again.data, iss_env.data)
+    r, _ = again.orbit.state_teme(again.epoch, again.t[:2])
+    assert np.array_equal(r, TLE(*ISS).state_teme(iss_env.epoch, iss_env.t[:2])[0])
+
+
 def test_tle_gcrs_matches_skyfields_satellite_and_the_classic_teme_to_itrf_chain(iss_env):
     ts, _ = _ephemeris.loaded()
     time = _ephemeris.times(iss_env.epoch, iss_env.t)

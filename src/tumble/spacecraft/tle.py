@@ -71,6 +71,10 @@ class TLE:
             raise ValidationError(f"tle: SGP4 refuses these elements (sgp4 error {satrec.error})")
         object.__setattr__(self, "_satrec", satrec)
 
+    def __reduce__(self):
+        """Pickled as its two lines (sgp4's ``Satrec`` is not picklable): for sweeps on other processes."""
+        return (TLE, (self.line1, self.line2))
+
     @property
     def epoch(self) -> datetime:
         """The elements' epoch, a UTC datetime (rounded to the microsecond)."""
