@@ -146,9 +146,7 @@ def _environment():
         b1 = b2 = b3 = 0.0
         if has_table(model):
             p, _, _, _ = where_table(model)
-            row, s = environment_table.interval(model.data, p, t)
-            b1, b2, b3 = environment_table.linear3(model.data, row, s, environment_table.MAGNETIC_FIELD)
-            b1, b2, b3 = _quat.qrotate_inv(qw, qx, qy, qz, b1, b2, b3)
+            b1, b2, b3 = environment_table.field_body(model.data, p, t, qw, qx, qy, qz)
         elif has_dipole(model):
             p, _, _, _ = where_dipole(model)
             b1, b2, b3 = environment.dipole_body(model, p, t, qw, qx, qy, qz)
@@ -164,8 +162,7 @@ def _environment():
             p, _, _, _ = where_gravity(model)
             if has_table(model):
                 tp, _, _, _ = where_table(model)
-                row, s = environment_table.interval(model.data, tp, t)
-                r1, r2, r3 = environment_table.position(model.data, tp, row, s)
+                r1, r2, r3 = environment_table.position_at(model.data, tp, t)
             else:
                 r1, r2, r3 = environment.position(model.data, p + environment.ORBIT, t)
             g1, g2, g3 = environment.gravity_gradient(model, p, J, r1, r2, r3, qw, qx, qy, qz)

@@ -22,6 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
+from tumble import _quat
 from tumble.kernels.spacecraft._base import Program, inline
 
 #: position of the craft r, m (3)
@@ -130,6 +131,24 @@ def direction(d, row, s, column):
     x, y, z = linear3(d, row, s, column)
     norm = math.sqrt(x * x + y * y + z * z)
     return x / norm, y / norm, z / norm
+
+
+# The parts' entry points: compiled functions of their own (not inlined), so that a spacecraft without an
+# environment carries none of their code in its right-hand side, only the presence test that skips the call.
+
+@njit(cache=True)
+def field_body(d, p, t, qw, qx, qy, qz):
+    """The field ``B`` (T) of the table part at ``d[p:]`` at ``t``, in body axes of the attitude ``q``."""
+    row, s = interval(d, p, t)
+    b1, b2, b3 = linear3(d, row, s, MAGNETIC_FIELD)
+    return _quat.qrotate_inv(qw, qx, qy, qz, b1, b2, b3)
+
+
+@njit(cache=True)
+def position_at(d, p, t):
+    """The position (m, GCRS) of the table part at ``d[p:]`` at ``t``."""
+    row, s = interval(d, p, t)
+    return position(d, p, row, s)
 
 
 @njit(cache=True)

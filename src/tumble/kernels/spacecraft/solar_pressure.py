@@ -13,6 +13,7 @@ turned into body axes by ``q``. Facet forces and torque:
 """
 
 import numpy as np
+from numba import njit
 
 from tumble import _quat
 from tumble.kernels.spacecraft import environment_table as table
@@ -39,6 +40,18 @@ def aux_slices(n: int, a: int) -> dict[str, slice]:
     return {"solar_pressure_torque": slice(a + AUX_TORQUE, a + AUX_TORQUE + 3)}
 
 
+@njit(cache=True)
+def torque(d, p, n, tp, t, qw, qx, qy, qz):
+    """``τ`` (N·m, body axes) of the part at ``d[p:]`` (``n`` facets) in the sunlight of the table part at
+    ``d[tp:]`` at ``t``, attitude ``q`` (a function of its own: see :func:`.environment_table.field_body`)."""
+    row, f = table.interval(d, tp, t)
+    distance = table.linear(d, row, f, table.SUN_DISTANCE)
+    pressure = table.linear(d, row, f, table.SHADOW) * d[p + PRESSURE] * (AU / distance) ** 2
+    s1, s2, s3 = table.direction(d, row, f, table.SUN_DIRECTION)
+    s1, s2, s3 = _quat.qrotate_inv(qw, qx, qy, qz, s1, s2, s3)
+    return facets.radiation_torque(d, p + HEAD, n, pressure, s1, s2, s3)
+
+
 def kernel(lane: Lane) -> Actuator:
     """The :class:`~tumble.kernels.spacecraft._base.Actuator` of the facets in sunlight (an external torque)."""
     at, put3 = lane.at, lane.put3
@@ -46,14 +59,8 @@ def kernel(lane: Lane) -> Actuator:
 
     @inline
     def act(model, p, n, s, a, routed, t, y, j, out, aux, store, w1, w2, w3, cmd):
-        d = model.data
         tp, _, _, _ = where_table(model)
-        row, f = table.interval(d, tp, t)
-        distance = table.linear(d, row, f, table.SUN_DISTANCE)
-        pressure = table.linear(d, row, f, table.SHADOW) * d[p + PRESSURE] * (AU / distance) ** 2
-        s1, s2, s3 = table.direction(d, row, f, table.SUN_DIRECTION)
-        s1, s2, s3 = _quat.qrotate_inv(at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j), s1, s2, s3)
-        t1, t2, t3 = facets.radiation_torque(d, p + HEAD, n, pressure, s1, s2, s3)
+        t1, t2, t3 = torque(model.data, p, n, tp, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
         if store:
             put3(aux, a + AUX_TORQUE, j, t1, t2, t3)
         return t1, t2, t3
