@@ -29,7 +29,7 @@ def invoke(*args):
     "command",
     [[], ["run"], ["demo"], ["demo", "racket"], ["demo", "polhode"], ["demo", "top"], ["info"],
      *[["demo", name] for name in ("diver", "flexible", "slosh", "explorer1", "gravity-gradient", "gyro", "coning",
-                                   "ins")],
+                                   "ins", "budget")],
      ["robot"], ["robot", "torques"]],
     ids=" ".join,
 )

@@ -6,6 +6,8 @@ Counted two ways: Numba's ``numba:compile`` events (fired by every compilation t
 answer) and the signatures of the compiled diagnostics (one per model type, cache hits included).
 """
 
+from datetime import datetime, timezone
+
 import numba
 import numpy as np
 from numba.core import event
@@ -13,8 +15,9 @@ from numba.core import event
 import tumble
 from tumble import torques
 from tumble.kernels import spacecraft as kernel
-from tumble.spacecraft import (CMGCluster, MRPFeedback, QuaternionPD, ResidualDipole, Spacecraft,
-                               pyramid_wheels)
+from tumble.spacecraft import (CMGCluster, Environment, MRPFeedback, Orbit, QuaternionPD, ResidualDipole,
+                               Spacecraft, pyramid_wheels)
+from tumble.spacecraft.surfaces import Drag, SolarPressure, box_facets
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
 T = np.linspace(0.0, 2.0, 3)
@@ -32,19 +35,31 @@ def wheels_cmgs_pd_dipole():
                       controller=QuaternionPD(0.2, 0.8, target=TARGET))
 
 
+def environment_parts():
+    env = Environment.sample(Orbit.circular(400e3, 0.9), datetime(2026, 6, 1, tzinfo=timezone.utc), duration=10.0,
+                             step=5.0)
+    faces = box_facets([1.0, 2.0, 1.5], centre_of_mass=[0.05, 0.0, -0.02], specular=0.2, diffuse=0.3, absorbed=0.5)
+    return Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), environment=env, gravity_gradient=True,
+                      solar_pressure=SolarPressure(faces), drag=Drag(faces),
+                      controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
+
+
 def test_every_composition_has_one_numba_type():
     first = wheels_and_mrp().compile(None, 0.0)
     second = wheels_cmgs_pd_dipole().compile(torques.ConstantBody([1e-3, 0.0, -2e-3]), 0.0)
-    assert numba.typeof(first) == numba.typeof(second)
+    assert numba.typeof(first) == numba.typeof(second) == numba.typeof(environment_parts().compile(None, 0.0))
 
 
 def test_a_new_composition_compiles_nothing():
     tumble.simulate(wheels_and_mrp(), [0.01, -0.02, 0.03], t=T, method="rk4", dt=0.1)
     signatures = len(kernel.evaluate.signatures)
+    in_orbit = environment_parts()            # sampling the environment is not the spacecraft's compilation
     with event.install_recorder("numba:compile") as compiles:
         traj = tumble.simulate(wheels_cmgs_pd_dipole(), [0.01, -0.02, 0.03], t=T, method="rk4", dt=0.1,
                                torque=torques.ConstantBody([1e-3, 0.0, -2e-3]))
+        env_traj = tumble.simulate(in_orbit, [0.01, -0.02, 0.03], t=T, method="rk4", dt=0.1)
     assert [e.data["dispatcher"].py_func.__qualname__ for e in compiles.buffer if e.is_start] == []
     assert len(kernel.evaluate.signatures) == signatures
     np.testing.assert_array_equal(traj.external_torque[-1], [1e-3, 0.0, -2e-3])  # the new parts ran
     assert np.abs(traj.residual_dipole_torque).max() > 0.0
+    assert np.abs(env_traj.solar_pressure_torque).max() > 0.0 and np.abs(env_traj.drag_torque).max() > 0.0

@@ -174,6 +174,30 @@ DEMOS: dict[str, Demo] = {
             ("libration", f"largest roll/pitch/yaw angle {s['max_angle_deg']:.3g} deg"),
         ],
     ),
+    "budget": Demo(
+        "tumble.spacecraft.budget:demo_budget",
+        """A pointing and momentum budget: an Earth-pointing LEO smallsat with four wheels over a day.
+
+        The disturbance torques by source (gravity gradient, solar pressure and drag on its six faces,
+        a residual dipole in IGRF-14) along a 500 km dawn-dusk sun-synchronous orbit, the momentum the
+        wheels must store against the closed-form estimates of SMAD (Larson & Wertz 1999, section 11.1),
+        eclipse seasons over a year, and a Monte-Carlo sweep over facet coefficients and centre-of-mass
+        offset (docs/spacecraft_environment.md). About a minute. Writes budget.png in the directory.
+        """,
+        lambda s: [
+            *[(source.replace("_", " "), f"peak {s['peak_torque'][source]:.3g} N m (SMAD "
+                                         f"{s['estimate_torque'][source]:.3g}), momentum "
+                                         f"{s['peak_momentum'][source]:.3g} N m s (SMAD "
+                                         f"{s['estimate_momentum'][source]:.3g})")
+              for source in s["peak_torque"]],
+            ("wheels", f"peak |h| {s['peak_total_momentum']:.3g} N m s over {s['hours']:g} h, "
+                       f"{s['peak_wheel_momentum']:.3g} N m s on one wheel"),
+            ("eclipses", f"{s['eclipse_days']} days of the year, up to {s['eclipse_max_fraction']:.1%} of an "
+                         f"orbit (beta {s['beta_range_deg'][0]:.1f} to {s['beta_range_deg'][1]:.1f} deg)"),
+            ("Monte Carlo", f"peak |h| over an orbit: median {s['monte_carlo_median']:.3g}, 95th percentile "
+                            f"{s['monte_carlo_p95']:.3g} N m s ({s['monte_carlo_samples']} draws)"),
+        ],
+    ),
     "lorentz": Demo(
         "tumble.lorentz:demo_lorentz",
         """Lorentz-factor inertia of a neutron star (R = 12 km, M = 1.4 Msun, period 1.4 ms).

@@ -34,8 +34,11 @@ The tables and keys are the arguments of :class:`tumble.spacecraft.Spacecraft`
 and of its parts (``docs/spacecraft.md`` lists them): actuators, a nutation
 damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment
 (``[spacecraft.magnetic_field]``, ``[spacecraft.residual_dipole]``,
-``gravity_gradient``), the ``[[spacecraft.controller]]`` laws (:mod:`tumble.scenario.control`) and the
-flight software that feeds them an estimate (``[spacecraft.flight_software]``).
+``gravity_gradient``, and the environment sampled along an orbit with its
+facet parts: ``[spacecraft.environment]``, ``[spacecraft.solar_pressure]``,
+``[spacecraft.drag]``, :mod:`tumble.scenario.environment`), the ``[[spacecraft.controller]]`` laws
+(:mod:`tumble.scenario.control`) and the flight software that feeds them an estimate
+(``[spacecraft.flight_software]``).
 ``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
 external torques ``[[torque]]`` (``torque=`` of :func:`tumble.simulate`, on
 top of the spacecraft's own environment) are the shared tables
@@ -60,6 +63,7 @@ from tumble.scenario._values import (_Bool, _InertiaOrMoments, _Limit, _Matrix, 
                                      _Quaternion, _Vector)
 from tumble.scenario.control import Controller, Regulator
 from tumble.scenario.damper import SphericalDamperTable
+from tumble.scenario.environment import DragTable, EnvironmentTable, SolarPressureTable
 from tumble.scenario.orbit import OrbitTable
 from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
@@ -272,6 +276,9 @@ class SpacecraftTable(_InertiaOrMoments):
     magnetic_field: FieldTable | None = None
     gravity_gradient: _Bool = False
     residual_dipole: ResidualDipoleTable | None = None
+    environment: EnvironmentTable | None = None
+    solar_pressure: SolarPressureTable | None = None
+    drag: DragTable | None = None
     controller: list[Controller] = []
     control_period: _Positive | None = None
     flight_software: FlightSoftwareTable | None = None
@@ -293,7 +300,7 @@ class SpacecraftTable(_InertiaOrMoments):
             key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
             for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field",
-                    "residual_dipole", "flight_software"):
+                    "residual_dipole", "environment", "solar_pressure", "drag", "flight_software"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
         pyramid = parts.pop("wheel_pyramid")

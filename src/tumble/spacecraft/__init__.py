@@ -1,6 +1,6 @@
 """Spacecraft attitude dynamics and control: a rigid hub with reaction wheels, control moment gyros,
 thrusters, magnetorquers and a nutation damper, in a Keplerian orbit with gravity gradient and a dipole
-magnetic field, under feedback control laws (compiled or Python; continuous or sampled with a zero-order
+magnetic field (or the environment sampled along a Kepler or TLE orbit: :class:`Environment`), under feedback control laws (compiled or Python; continuous or sampled with a zero-order
 hold). A :class:`Spacecraft` is a model of :func:`tumble.simulate`.
 
     >>> import numpy as np, tumble
@@ -22,16 +22,20 @@ from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MR
                                        RateDamping, WheelTorques)
 from tumble.spacecraft.damper import SphericalDamper, simulate_damped
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
+from tumble.spacecraft.environment_table import Environment, SpaceWeather
 from tumble.spacecraft.flight_software import FlightSoftware
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft, simulate
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.spacecraft.passive import gravity_gradient_stability, gravity_gradient_stability_figure, spin_stability
+from tumble.spacecraft.tle import TLE
 
 __all__ = [
-    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "FlightSoftware", "MRPFeedback", "Magnetorquers",
+    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "Environment", "FlightSoftware", "MRPFeedback",
+    "Magnetorquers",
     "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
-    "SaturationWarning", "SingularityWarning", "Spacecraft", "SphericalDamper", "Thruster", "WheelTorques",
+    "SaturationWarning", "SingularityWarning", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE", "Thruster",
+    "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",
     "pyramid_wheels", "save_spacecraft_figure", "simulate", "simulate_damped", "spacecraft_figure", "spin_stability",
 ]

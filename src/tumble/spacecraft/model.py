@@ -37,12 +37,14 @@ from tumble._validate import ValidationError, as_array
 from tumble.body import RigidBody
 from tumble.kernels import spacecraft as _kernel
 from tumble.kernels.spacecraft import cmgs as _cmgs
+from tumble.kernels.spacecraft import drag as _drag
 from tumble.kernels.spacecraft import damper as _damper_kernel
 from tumble.kernels.spacecraft import flight_software as _fsw_kernel
 from tumble.kernels.spacecraft import environment as _environment
 from tumble.kernels.spacecraft import laws as _law_kernels
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
 from tumble.kernels.spacecraft import residual_dipole as _residual_dipole
+from tumble.kernels.spacecraft import solar_pressure as _solar_pressure
 from tumble.kernels.spacecraft import thrusters as _thrusters
 from tumble.kernels.spacecraft import wheels as _wheels
 from tumble.kernels.spacecraft._base import Program
@@ -52,9 +54,11 @@ from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, Reactio
 from tumble.spacecraft.control import DIPOLE_LAWS, TORQUE_LAWS, MomentumDumping, MRPFeedback, PythonLaw, WheelTorques
 from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
+from tumble.spacecraft.environment_table import Environment
 from tumble.spacecraft.flight_software import FlightSoftware, check_seed
 from tumble.spacecraft.flight_software import initial_state as _fsw_initial_state
-from tumble.spacecraft.orbit import Orbit
+from tumble.spacecraft.orbit import EARTH_MU, Orbit
+from tumble.spacecraft.surfaces import Drag, SolarPressure
 from tumble.trajectory import Extra, Trajectory
 
 __all__ = ["Spacecraft", "SaturationWarning", "SingularityWarning", "simulate"]
@@ -95,7 +99,12 @@ class Spacecraft(Model):
         inertial axes (T), or None
     gravity_gradient : bool, the gravity-gradient torque of the orbit on the total inertia
     residual_dipole : :class:`~tumble.spacecraft.environment.ResidualDipole` or None: a constant body dipole,
-        torque ``m × B`` in ``magnetic_field`` (needed)
+        torque ``m × B`` in ``magnetic_field`` or the environment's field (needed)
+    environment : :class:`~tumble.spacecraft.environment_table.Environment` or None: the environment sampled
+        along an orbit (Kepler or TLE), whose ``t = 0`` is the simulation's: it replaces ``orbit`` and
+        ``magnetic_field`` (the field is its IGRF-14, the gravity gradient reads its position) and is needed by
+    solar_pressure : :class:`~tumble.spacecraft.surfaces.SolarPressure` or None: radiation pressure on facets
+    drag : :class:`~tumble.spacecraft.surfaces.Drag` or None: aerodynamic drag and lift on facets
     controller : a law or a sequence of laws: at most one torque law (:class:`QuaternionPD`,
         :class:`MRPFeedback`, :class:`RateDamping`, :class:`ConstantTorque`, or a Python callable
         ``u = law(t, q, omega, wheel_speeds)``, i.e. a :class:`PythonLaw`), one of each dipole law
@@ -126,6 +135,9 @@ class Spacecraft(Model):
     magnetic_field: object = None
     gravity_gradient: bool = False
     residual_dipole: ResidualDipole | None = None
+    environment: Environment | None = None
+    solar_pressure: SolarPressure | None = None
+    drag: Drag | None = None
     controller: Any = None  # a law, a sequence of laws or None: the tuple of laws once validated
     control_period: float | None = None
     flight_software: FlightSoftware | None = None
@@ -144,6 +156,17 @@ class Spacecraft(Model):
         _check_type(self.damper, SphericalDamper, "damper")
         _check_type(self.orbit, Orbit, "orbit")
         _check_type(self.residual_dipole, ResidualDipole, "residual_dipole")
+        _check_type(self.environment, Environment, "environment")
+        _check_type(self.solar_pressure, SolarPressure, "solar_pressure")
+        _check_type(self.drag, Drag, "drag")
+        if self.environment is not None:
+            for name in ("orbit", "magnetic_field"):
+                if getattr(self, name) is not None:
+                    raise ValidationError(f"{name}: the environment gives the orbit and the field (IGRF-14); give "
+                                          f"the environment or the {name}, not both")
+        for name in ("solar_pressure", "drag"):
+            if getattr(self, name) is not None and self.environment is None:
+                raise ValidationError(f"{name}: needs an environment (the Sun, the shadow, the air along the orbit)")
         set_(self, "body", self._total_body())
         if self.magnetic_field is not None and not isinstance(self.magnetic_field, DipoleField):
             b = as_array(self.magnetic_field, "magnetic_field")
@@ -155,9 +178,9 @@ class Spacecraft(Model):
             raise ValidationError("magnetic_field: a DipoleField needs an orbit (the field depends on the position)")
         if not isinstance(self.gravity_gradient, (bool, np.bool_)):
             raise ValidationError(f"gravity_gradient: must be True or False, got {self.gravity_gradient!r}")
-        if self.gravity_gradient and self.orbit is None:
-            raise ValidationError("gravity_gradient: needs an orbit")
-        if self.residual_dipole is not None and self.magnetic_field is None:
+        if self.gravity_gradient and self.orbit is None and self.environment is None:
+            raise ValidationError("gravity_gradient: needs an orbit or an environment")
+        if self.residual_dipole is not None and not self._has_field:
             raise ValidationError("residual_dipole: needs a magnetic_field (its torque is m × B)")
         set_(self, "controller", self._laws())
         self._thruster_program()  # validates the thruster layout
@@ -192,12 +215,17 @@ class Spacecraft(Model):
             return
         if self.control_period is None:
             raise ValidationError("flight_software: needs a control_period (its sensors and filter run at it)")
-        if self.flight_software.magnetometer_sigma is not None and self.magnetic_field is None:
+        if self.flight_software.magnetometer_sigma is not None and not self._has_field:
             raise ValidationError("flight_software: a magnetometer needs a magnetic_field")
         if self._torque_law() is None or any(isinstance(law, WheelTorques) for law in self.controller):
             raise ValidationError("flight_software: needs a torque law (QuaternionPD, MRPFeedback, RateDamping, "
                                   "ConstantTorque or a Python law) and no WheelTorques (whose commands it does "
                                   "not delay)")
+
+    @property
+    def _has_field(self) -> bool:
+        """A magnetic field is there: ``magnetic_field`` or the environment's IGRF."""
+        return self.magnetic_field is not None or self.environment is not None
 
     def _laws(self) -> tuple:
         laws = () if self.controller is None else (
@@ -219,14 +247,14 @@ class Spacecraft(Model):
             raise ValidationError(f"controller: {type(torque_laws[0]).__name__} needs an actuator "
                                   "(wheels, cmgs, thrusters or magnetorquers)")
         for law in laws:
-            if isinstance(law, DIPOLE_LAWS) and (self.magnetorquers is None or self.magnetic_field is None):
+            if isinstance(law, DIPOLE_LAWS) and (self.magnetorquers is None or not self._has_field):
                 raise ValidationError(f"controller: {type(law).__name__} needs magnetorquers and a magnetic_field")
             if isinstance(law, (MomentumDumping, WheelTorques)) and not self.wheels:
                 raise ValidationError(f"controller: {type(law).__name__} needs reaction wheels")
             if isinstance(law, WheelTorques) and law.wheels not in (None, len(self.wheels)):
                 raise ValidationError(f"controller: WheelTorques gives {law.wheels} motor torques for "
                                       f"{len(self.wheels)} wheels")
-        if self.route == "magnetorquers" and torque_laws and self.magnetic_field is None:
+        if self.route == "magnetorquers" and torque_laws and not self._has_field:
             raise ValidationError("controller: torque by magnetorquers needs a magnetic_field")
         return laws
 
@@ -279,7 +307,9 @@ class Spacecraft(Model):
                 axes, spin, max_torque, max_speed, viscous, coulomb, coulomb_speed,
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
         programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper, self.residual_dipole,
-                                                  self.flight_software) if part is not None]
+                                                  self.environment, self.solar_pressure, self.drag,
+                                                  self.flight_software)
+                     if part is not None]
         thrusters = self._thruster_program()
         if thrusters is not None:  # None: no thrusters
             programs.append(thrusters)
@@ -290,9 +320,12 @@ class Spacecraft(Model):
             programs.append(_environment.dipole_program(self.orbit.elements(), self.magnetic_field.params()))
         elif self.magnetic_field is not None:
             programs.append(_environment.uniform_program(self.magnetic_field))
-        if self.gravity_gradient:
-            assert self.orbit is not None  # checked in __post_init__
+        if self.gravity_gradient and self.orbit is not None:
             programs.append(_environment.gravity_gradient_program(self.orbit.elements()))
+        elif self.gravity_gradient:  # the position from the environment table: only μ is read
+            assert self.environment is not None  # checked in __post_init__
+            mu = self.environment.orbit.mu if isinstance(self.environment.orbit, Orbit) else EARTH_MU
+            programs.append(_environment.gravity_gradient_program(np.r_[np.zeros(6), mu]))
         return tuple(programs)
 
     def __getstate__(self) -> dict:
@@ -364,6 +397,8 @@ class Spacecraft(Model):
         """A sampled controller needs a fixed-step method (rk4, cf4) whose step divides the control period and
         every output interval, so that steps end on the sample times (where the projection updates the held
         commands). Which methods apply at all is the kernel's to declare (``provides``)."""
+        if self.environment is not None:
+            self.environment.check_times(t)
         period = self.control_period
         if period is None:
             return
@@ -487,7 +522,13 @@ class Spacecraft(Model):
             r = where("residual_dipole")
             add("residual_dipole_torque", aux[..., _residual_dipole.aux_slices(r.n, r.a)["residual_dipole_torque"]],
                 ("xyz",), "N m", "torque of the residual dipole m × B, body axes")
-        if self.magnetic_field is not None:
+        for part, module, name, what in ((self.solar_pressure, _solar_pressure, "solar_pressure_torque",
+                                          "solar radiation pressure torque on the facets"),
+                                         (self.drag, _drag, "drag_torque", "aerodynamic torque on the facets")):
+            if part is not None:
+                w = where(name.removesuffix("_torque"))
+                add(name, aux[..., module.aux_slices(w.n, w.a)[name]], ("xyz",), "N m", f"{what}, body axes")
+        if self._has_field:
             add("magnetic_field", core(_kernel.AUX_FIELD), ("xyz",), "T", "magnetic field, body axes")
         if self.gravity_gradient:
             add("gravity_gradient_torque", core(_kernel.AUX_GRAVITY), ("xyz",), "N m",
@@ -509,7 +550,7 @@ class Spacecraft(Model):
             self._estimation_outputs(add, states[..., s:s + _fsw_kernel.STATE], q)
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
             "torque of all parts on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper, "
-            "residual dipole)")
+            "residual dipole, solar pressure, drag)")
         momentum_body = core(_kernel.AUX_MOMENTUM)
         energy = core(_kernel.AUX_ENERGY, 1)[..., 0]
         add("total_momentum_inertial", attitude.rotate(q, momentum_body), ("xyz",), "N m s",
@@ -545,12 +586,13 @@ class Spacecraft(Model):
                 "rad", "target − truth: rotation vector of q* ⊗ q_target, body axes")
 
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
-        """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers or residual
-        dipole): the inertial angular momentum of the whole spacecraft; and, without CMGs (whose ideal gimbal
-        servos do work) or a damper (which dissipates), its energy less the work done on the wheels by motors
-        and bearings."""
+        """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers, residual
+        dipole, solar pressure or drag): the inertial angular momentum of the whole spacecraft; and, without
+        CMGs (whose ideal gimbal servos do work) or a damper (which dissipates), its energy less the work done
+        on the wheels by motors and bearings."""
         if (traj.info.get("torque") != "none" or self.gravity_gradient or self.thrusters
-                or self.magnetorquers is not None or self.residual_dipole is not None):
+                or self.magnetorquers is not None or self.residual_dipole is not None
+                or self.solar_pressure is not None or self.drag is not None):
             return {}
         out = {"momentum_inertial": traj.momentum_inertial}
         if self.cmgs is None and self.damper is None:

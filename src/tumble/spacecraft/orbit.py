@@ -33,13 +33,14 @@ from numba import njit
 from numpy.typing import ArrayLike
 
 from tumble import _quat, attitude
-from tumble._gravity import eccentric_anomaly, orbit_state
+from tumble._gravity import eccentric_anomaly, kepler_state, orbit_state
 from tumble._validate import ValidationError, as_array, require_finite, require_positive
 
 if TYPE_CHECKING:
     from tumble.trajectory import Trajectory
 
 __all__ = [
+    "EARTH_J2",
     "EARTH_MU",
     "EARTH_RADIUS",
     "LvlhAttitude",
@@ -56,6 +57,8 @@ __all__ = [
 EARTH_MU = 3.986004418e14
 #: Earth's equatorial radius, m (WGS 84 semi-major axis).
 EARTH_RADIUS = 6378137.0
+#: Earth's J₂ = −√5 C̄₂,₀ with C̄₂,₀ = −4.84166774985e-4 (WGS 84, NIMA TR8350.2, 3rd ed., Table 5.1).
+EARTH_J2 = 1.0826298213133048e-3
 
 
 @dataclass(frozen=True)
@@ -120,11 +123,32 @@ class Orbit:
         """Orbital period 2π/n, s."""
         return 2.0 * math.pi / self.mean_motion
 
-    def state(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
-        """Position (m) and velocity (m/s) in inertial axes at the times ``t`` (s, any shape): two (…, 3) arrays."""
+    def j2_rates(self, j2: float = EARTH_J2, radius: float = EARTH_RADIUS) -> tuple[float, float, float]:
+        """``(Ω̇, ω̇, Ṁ)``, rad/s: the secular drift of the node, the periapsis and the mean anomaly under the
+        Earth's oblateness, to first order in J₂ (Vallado, 4th ed., §9.6, eqs. 9-41; the elements taken as
+        mean elements)::
+
+            p = a (1 − e²),   k = (3/2) n J₂ (R/p)²
+            Ω̇ = −k cos i,   ω̇ = (k/2)(5 cos² i − 1),   Ṁ = n + (k/2) √(1 − e²) (3 cos² i − 1)
+        """
+        n, e, ci = self.mean_motion, self.eccentricity, math.cos(self.inclination)
+        k = 1.5 * n * j2 * (radius / (self.semi_major_axis * (1.0 - e * e))) ** 2
+        return -k * ci, 0.5 * k * (5.0 * ci * ci - 1.0), n + 0.5 * k * math.sqrt(1.0 - e * e) * (3.0 * ci * ci - 1.0)
+
+    def state(self, t: ArrayLike, *, j2: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """Position (m) and velocity (m/s) in inertial axes at the times ``t`` (s, any shape): two (…, 3) arrays.
+
+        With ``j2=True`` the node, the periapsis and the mean anomaly drift at :meth:`j2_rates` (the Earth's
+        J₂ and equatorial radius) and the velocity is the time derivative of that position::
+
+            v = (Ṁ/n) v_Kepler + Ω̇ ẑ × r + ω̇ ĥ × r        (ĥ: the unit orbit normal)
+        """
         t = as_array(t, "t")
         out = np.empty((t.size, 6))
-        _states(self.elements(), t.ravel(), out)
+        if j2:
+            _drifting_states(self.elements(), np.array(self.j2_rates()), t.ravel(), out)
+        else:
+            _states(self.elements(), t.ravel(), out)
         out = out.reshape((*t.shape, 6))
         return out[..., :3], out[..., 3:]
 
@@ -133,6 +157,23 @@ class Orbit:
 def _states(el, t, out):
     for k in range(t.shape[0]):
         out[k, 0], out[k, 1], out[k, 2], out[k, 3], out[k, 4], out[k, 5] = orbit_state(el, t[k])
+
+
+@njit(cache=True)
+def _drifting_states(el, rates, t, out):
+    """Kepler states with Ω, ω and M drifting at ``rates = (Ω̇, ω̇, Ṁ)``; see :meth:`Orbit.state`."""
+    a, e, inc, raan, argp, m0, mu = el[0], el[1], el[2], el[3], el[4], el[5], el[6]
+    n = math.sqrt(mu / a**3)
+    for k in range(t.shape[0]):
+        node = raan + rates[0] * t[k]
+        rx, ry, rz, vx, vy, vz = kepler_state(a, e, inc, node, argp + rates[1] * t[k], m0 + (rates[2] - n) * t[k],
+                                              mu, t[k])
+        hx, hy, hz = math.sin(inc) * math.sin(node), -math.sin(inc) * math.cos(node), math.cos(inc)
+        scale = rates[2] / n
+        out[k, 0], out[k, 1], out[k, 2] = rx, ry, rz
+        out[k, 3] = scale * vx - rates[0] * ry + rates[1] * (hy * rz - hz * ry)
+        out[k, 4] = scale * vy + rates[0] * rx + rates[1] * (hz * rx - hx * rz)
+        out[k, 5] = scale * vz + rates[1] * (hx * ry - hy * rx)
 
 
 @njit(cache=True)

@@ -16,8 +16,9 @@ from numba import njit
 
 from tumble import _quat, torques
 from tumble._vec import cross, matvec_flat
-from tumble.kernels.spacecraft import (_commands, cmgs, damper, environment, flight_software, laws, magnetorquers,
-                                      residual_dipole, thrusters, wheels)
+from tumble.kernels.spacecraft import (_commands, cmgs, damper, drag, environment, environment_table,
+                                      flight_software, laws, magnetorquers, residual_dipole, solar_pressure,
+                                      thrusters, wheels)
 from tumble.kernels.spacecraft._base import inline, lane, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_WHEELS, J,
@@ -33,6 +34,8 @@ ACTUATORS = {
     "magnetorquers": lambda lane, direct: magnetorquers.kernel(lane),
     "damper": lambda lane, direct: damper.kernel(lane),
     "residual_dipole": lambda lane, direct: residual_dipole.kernel(lane),
+    "solar_pressure": lambda lane, direct: solar_pressure.kernel(lane),
+    "drag": lambda lane, direct: drag.kernel(lane),
 }
 
 # The empty sums (Numba's inliner takes no *args, so one per signature).
@@ -132,16 +135,21 @@ def _or_present(previous, has):
 def _environment(python):
     """``field(model, t, q) -> B`` (T, body axes), ``gravity(model, t, q) -> τ_gg`` and
     ``external(model, t, q, ω) -> τ`` (the torque program, its Python terms only in the variant that calls
-    Python, ``python``), N·m, body axes."""
+    Python, ``python``), N·m, body axes. With an environment table the field is its IGRF column and the
+    gravity gradient reads its position; without, the dipole or uniform field and the Kepler orbit."""
     program = torques.evaluate if python else torques.evaluate_compiled
     has_dipole, where_dipole = locator("dipole_field")
     has_uniform, where_uniform = locator("uniform_field")
     has_gravity, where_gravity = locator("gravity_gradient")
+    has_table, where_table = locator("environment_table")
 
     @inline
     def field(model, t, qw, qx, qy, qz):
         b1 = b2 = b3 = 0.0
-        if has_dipole(model):
+        if has_table(model):
+            p, _, _, _ = where_table(model)
+            b1, b2, b3 = environment_table.field_body(model.data, p, t, qw, qx, qy, qz)
+        elif has_dipole(model):
             p, _, _, _ = where_dipole(model)
             b1, b2, b3 = environment.dipole_body(model, p, t, qw, qx, qy, qz)
         elif has_uniform(model):
@@ -154,7 +162,12 @@ def _environment(python):
         g1 = g2 = g3 = 0.0
         if has_gravity(model):
             p, _, _, _ = where_gravity(model)
-            g1, g2, g3 = environment.gravity_gradient(model, p, J, t, qw, qx, qy, qz)
+            if has_table(model):
+                tp, _, _, _ = where_table(model)
+                r1, r2, r3 = environment_table.position_at(model.data, tp, t)
+            else:
+                r1, r2, r3 = environment.position(model.data, p + environment.ORBIT, t)
+            g1, g2, g3 = environment.gravity_gradient(model, p, J, r1, r2, r3, qw, qx, qy, qz)
         return g1, g2, g3
 
     @inline

@@ -13,7 +13,7 @@ from tumble.kernels.spacecraft._base import inline
 #: The kinds of part, in the order of their state slices.
 PARTS = ("hold", "wheels", "cmgs", "thrusters", "magnetorquers", "damper", "pd", "mrp", "mrp_integral",
          "python_law", "bdot", "dumping", "wheel_table", "wheel_python", "dipole_field", "uniform_field",
-         "gravity_gradient", "residual_dipole",
+         "gravity_gradient", "residual_dipole", "environment_table", "solar_pressure", "drag",
          "flight_software")
 
 #: The fields of ``SpacecraftModel`` before the parts' (one int64 per kind of :data:`PARTS` follows them).

@@ -8,7 +8,8 @@ Both follow a Kepler orbit propagated in closed form with the attitude
   body axes, T;
 * ``"uniform_field"``: a field fixed in inertial axes, rotated into body axes, T;
 * ``"gravity_gradient"``: ``τ = 3μ/|r|⁵ r_B × (J r_B)`` with the total inertia ``J``
-  (Hughes, *Spacecraft Attitude Dynamics*, ch. 8), N·m, body axes.
+  (Hughes, *Spacecraft Attitude Dynamics*, ch. 8), N·m, body axes; with an environment table
+  (:mod:`.environment_table`) ``r`` is the table's position and only ``μ`` of the elements is read.
 """
 
 from __future__ import annotations
@@ -84,10 +85,11 @@ def uniform_body(model, p, t, qw, qx, qy, qz):
 
 
 @inline
-def gravity_gradient(model, p, j_offset, t, qw, qx, qy, qz):
-    """The gravity-gradient torque on the total inertia ``J = d[j_offset:j_offset + 9]`` (row-major)."""
+def gravity_gradient(model, p, j_offset, r1, r2, r3, qw, qx, qy, qz):
+    """The gravity-gradient torque on the total inertia ``J = d[j_offset:j_offset + 9]`` (row-major) at the
+    position ``r`` (m, inertial axes; the orbit's or the environment table's), with ``μ`` of the part's
+    elements."""
     d = model.data
-    r1, r2, r3 = position(d, p + ORBIT, t)
     r1, r2, r3 = _quat.qrotate_inv(qw, qx, qy, qz, r1, r2, r3)
     o = j_offset  # row-major: J₁₁ at o, J₂₂ at o + 4, J₃₃ at o + 8, J₁₂ at o + 1, J₁₃ at o + 2, J₂₃ at o + 5
     return gravity_gradient_torque(d[p + ORBIT + 6], r1, r2, r3, d[o], d[o + 4], d[o + 8], d[o + 1], d[o + 2],

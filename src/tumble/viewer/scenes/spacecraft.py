@@ -13,7 +13,12 @@ Drawn from the :class:`tumble.spacecraft.Spacecraft` (its parts) and its traject
   ``Rot(g_i, δ) Z(s0_i)``, and its gimbal axis ``g_i`` as a line, just outside the hub along ``g_i``;
 * thruster ``i``: a plume from its position against its direction while ``thruster_firing`` is 1;
 * a residual dipole ``m``: a line from the centre of mass along ``m/|m|`` (body axes);
-* with an orbit: the nadir ``−r/|r|`` and the orbit normal ``r × v/|r × v|`` (inertial axes).
+* with an orbit (or an environment): the nadir ``−r/|r|`` and the orbit normal ``r × v/|r × v|`` (inertial
+  axes);
+* with an environment: the direction of the Sun ``ŝ`` (inertial axes), hidden while the craft is in the
+  umbra (``ν = 0``) and drawn shorter in the penumbra (length ∝ ν);
+* the facets of the solar pressure and drag parts: each a short line along its normal from its centre of
+  pressure (body axes).
 """
 
 from __future__ import annotations
@@ -22,7 +27,8 @@ from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
-from tumble.spacecraft import Spacecraft
+from tumble.kernels.spacecraft import environment_table as _table
+from tumble.spacecraft import Orbit, Spacecraft
 from tumble.viewer._scene import Lines, Solid, check_model
 from tumble.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
 from tumble.viewer.scenes._attitude import attitude_scene, rotations
@@ -39,6 +45,8 @@ _DISK = (0.22, 0.07)     # wheel and rotor disk radius and thickness, × the hub
 _OUTSIDE = 1.05          # a part without a position sits at this × the half-diagonal along its axis
 _PLUME = 0.5             # plume length, × the half-diagonal
 _DIPOLE = 1.3            # residual-dipole line length, × the half-diagonal
+_SUN = 1.9               # Sun-direction line length in full sunlight, × the half-diagonal
+_NORMAL = 0.35           # facet-normal line length, × the half-diagonal
 
 
 def spin_angles(t: np.ndarray, speed: np.ndarray) -> np.ndarray:
@@ -109,14 +117,34 @@ def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: 
         scene.lines.append(Lines("residual dipole", np.einsum("fij,pj->fpi", R, ends), "#9467bd", width=5.0,
                                  markers=True))
         scene.notes.append("residual dipole: its direction m/|m| from the centre of mass, fixed in the body")
-    if craft.orbit is not None:
-        r, v = craft.orbit.state(traj.t[idx])
+    facets = {id(f): f for part in (craft.solar_pressure, craft.drag) if part is not None for f in part.facets}
+    for i, facet in enumerate(facets.values()):
+        centre, normal = np.asarray(facet.centre), np.asarray(facet.normal)
+        ends = np.array([centre, centre + _NORMAL * half * normal])
+        scene.lines.append(Lines("facet normals", np.einsum("fij,pj->fpi", R, ends), "#17becf", width=3.0,
+                                 legend=i == 0))
+    if facets:
+        scene.notes.append("facets: a line along each facet's normal from its centre of pressure")
+    env = craft.environment
+    if craft.orbit is not None or env is not None:
+        if env is not None:
+            rows = env.at(np.clip(traj.t[idx], 0.0, env.t[-1]))
+            r, v = rows[:, _table.POSITION:_table.POSITION + 3], rows[:, _table.VELOCITY:_table.VELOCITY + 3]
+        else:
+            r, v = cast(Orbit, craft.orbit).state(traj.t[idx])
         normal = np.cross(r, v)
         for name, direction, color in (("nadir", -r, "#2ca02c"), ("orbit normal", normal, "#e377c2")):
             unit = direction / np.linalg.norm(direction, axis=-1, keepdims=True)
             scene.lines.append(Lines(name, np.stack([np.zeros_like(unit), 1.6 * half * unit], axis=1), color,
                                      width=3.0, markers=True))
         scene.notes.append("nadir −r/|r| and orbit normal r × v/|r × v| of the orbit, inertial axes")
+    if env is not None:
+        sun, lit = rows[:, _table.SUN_DIRECTION:_table.SUN_DIRECTION + 3], rows[:, _table.SHADOW]
+        line = np.stack([np.zeros_like(sun), _SUN * half * lit[:, None] * sun], axis=1)
+        line[lit == 0.0] = np.nan
+        scene.lines.append(Lines("Sun", line, "#ffbf00", width=5.0, markers=True))
+        scene.notes.append("Sun: its direction, inertial axes, as long as the fraction of the solar disc seen "
+                           "(hidden in the Earth's umbra)")
     for solid in scene.solids[1:]:
         reach = np.linalg.norm(solid.position, axis=-1).max() + np.linalg.norm(solid.mesh.vertices, axis=-1).max()
         scene.extent = max(scene.extent, 1.1 * float(reach))
