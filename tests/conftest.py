@@ -1,7 +1,13 @@
 """Shared fixtures of the dynamics, torque and simulation tests."""
 
+import os
+
 import numpy as np
 import pytest
+
+# The one-line notice of a compile that holds a run up (tumble._compiling) is tested in tests/test_compiling.py,
+# which removes this; elsewhere the tests read the exact output of commands, which a cold cache must not change.
+os.environ.setdefault("TUMBLE_QUIET", "1")
 
 
 @pytest.fixture

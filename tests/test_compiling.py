@@ -46,7 +46,8 @@ def test_a_long_compile_is_announced_once_on_stderr_naming_the_function_and_the_
                      "RigidBody (a compiled function of yours, first called in this process)..."]
 
 
-def test_a_compile_shorter_than_the_delay_says_nothing(capsys):
+def test_a_compile_shorter_than_the_delay_says_nothing(capsys, monkeypatch):
+    monkeypatch.delenv("TUMBLE_QUIET", raising=False)
     with _compiling.notice("the rk4 path of RigidBody", delay=60.0):
         njit(lambda x: x + 1.0)(1.0)
     assert capsys.readouterr().err == ""
@@ -64,7 +65,8 @@ def test_the_notice_is_silenced_by_tumble_quiet_or_the_loggers_level(capsys, cap
     assert capsys.readouterr().err == "" and not caplog.records
 
 
-def test_the_notice_is_a_log_record_where_logging_enables_it(capsys, caplog):
+def test_the_notice_is_a_log_record_where_logging_enables_it(capsys, caplog, monkeypatch):
+    monkeypatch.delenv("TUMBLE_QUIET", raising=False)
     caplog.set_level(logging.INFO, logger="tumble")
     with _compiling.notice("a run", delay=0.05):
         _compile_two_laws()
