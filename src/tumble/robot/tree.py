@@ -285,7 +285,7 @@ class RobotTree(ChainMotion):
                 f"mass={self.mass:.6g} kg)")
 
 
-def _rebuild(cls: type, links, parents, gravity, name, frames, mimic) -> RobotTree:
+def _rebuild(cls: type[RobotTree], links, parents, gravity, name, frames, mimic) -> RobotTree:
     """A tree of class ``cls`` (a subclass too: its own constructor takes other arguments) built by
     :class:`RobotTree`'s constructor, for :meth:`RobotTree.__reduce__`."""
     tree = cls.__new__(cls)

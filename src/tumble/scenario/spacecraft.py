@@ -223,8 +223,8 @@ class FlightSoftwareTable(_Table):
     seed: Annotated[int, Field(strict=True)] = 0
 
     def build(self) -> FlightSoftware:
-        return FlightSoftware(**{name: np.array(value) if isinstance(value, list) else value
-                                 for name, value in self})
+        values: dict[str, Any] = {name: np.array(value) if isinstance(value, list) else value for name, value in self}
+        return FlightSoftware(**values)
 
 
 class FieldTable(_Table):
