@@ -20,21 +20,27 @@ from tumble import _compiling
 SRC = str(Path(tumble.__file__).resolve().parents[1])
 
 
-@intrinsic
-def _slow_to_type(typingctx, x):
-    """``x``, whose typing takes 0.3 s: a compile that outlasts the tests' 0.05 s delay whatever the load."""
-    time.sleep(0.3)
+def _slow_to_type():
+    """A new intrinsic ``x -> x`` whose typing takes 0.3 s: a compile that outlasts the tests' 0.05 s delay
+    whatever the load (a new one each time: Numba keeps an intrinsic's typing once done)."""
 
-    def codegen(context, builder, signature, args):
-        return args[0]
+    @intrinsic
+    def slow(typingctx, x):
+        time.sleep(0.3)
 
-    return x(x), codegen
+        def codegen(context, builder, signature, args):
+            return args[0]
+
+        return x(x), codegen
+
+    return slow
 
 
 def _compile_two_laws() -> None:
     """Compile two new functions of the test module, each slower than the delay."""
-    njit(lambda x: _slow_to_type(x) + 1.0)(1.0)
-    njit(lambda x: _slow_to_type(x) * 2.0)(1.0)
+    first, second = _slow_to_type(), _slow_to_type()
+    njit(lambda x: first(x) + 1.0)(1.0)
+    njit(lambda x: second(x) * 2.0)(1.0)
 
 
 def test_a_long_compile_is_announced_once_on_stderr_naming_the_function_and_the_purpose(capsys, monkeypatch):
