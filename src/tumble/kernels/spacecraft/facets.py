@@ -29,7 +29,8 @@ import math
 import numpy as np
 
 from tumble._vec import cross
-from tumble.kernels.spacecraft._base import inline
+from tumble.kernels.spacecraft._base import Actuator, Lane, inline
+from tumble.kernels.spacecraft._layout import locator
 
 AREA = 0           # A, m²
 NORMAL = 1         # n̂ (3), body axes
@@ -90,3 +91,25 @@ def air_torque(d, o, n, density, v1, v2, v3):
                                drag * u1 + lift * l1, drag * u2 + lift * l2, drag * u3 + lift * l3)
             t1, t2, t3 = t1 + x1, t2 + x2, t3 + x3
     return t1, t2, t3
+
+
+#: The diagnostics of a facet part: its torque τ (3), N·m, body axes.
+AUX_TORQUE = 0
+
+
+def actuator(lane: Lane, torque) -> Actuator:
+    """The :class:`~tumble.kernels.spacecraft._base.Actuator` of a facet part (an external torque, no state):
+    ``torque(d, p, n, tp, t, q) -> τ`` (N·m, body axes) of its ``n`` facets at ``d[p:]`` in the environment of
+    the table part at ``d[tp:]``, stored as its diagnostics (:data:`AUX_TORQUE`)."""
+    at, put3 = lane.at, lane.put3
+    _, where_table = locator("environment_table")
+
+    @inline
+    def act(model, p, n, s, a, routed, t, y, j, out, aux, store, w1, w2, w3, cmd):
+        tp, _, _, _ = where_table(model)
+        t1, t2, t3 = torque(model.data, p, n, tp, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
+        if store:
+            put3(aux, a + AUX_TORQUE, j, t1, t2, t3)
+        return t1, t2, t3
+
+    return Actuator(act)

@@ -18,8 +18,7 @@ from numba import njit
 from tumble import _quat
 from tumble.kernels.spacecraft import environment_table as table
 from tumble.kernels.spacecraft import facets
-from tumble.kernels.spacecraft._base import Actuator, Lane, Program, inline
-from tumble.kernels.spacecraft._layout import locator
+from tumble.kernels.spacecraft._base import Actuator, Lane, Program
 
 #: The astronomical unit, m (IAU 2012 Resolution B2).
 AU = 149597870700.0
@@ -28,7 +27,7 @@ LIGHT_SPEED = 299792458.0
 
 PRESSURE = 0     # Φ/c at 1 au, N/m²
 HEAD = 1         # then the facets (count × facets.STRIDE)
-AUX_TORQUE = 0   # τ (3), N·m, body axes
+AUX_TORQUE = facets.AUX_TORQUE   # τ (3), N·m, body axes
 
 
 def program(irradiance: float, facet_block: np.ndarray, count: int) -> Program:
@@ -54,15 +53,4 @@ def torque(d, p, n, tp, t, qw, qx, qy, qz):
 
 def kernel(lane: Lane) -> Actuator:
     """The :class:`~tumble.kernels.spacecraft._base.Actuator` of the facets in sunlight (an external torque)."""
-    at, put3 = lane.at, lane.put3
-    _, where_table = locator("environment_table")
-
-    @inline
-    def act(model, p, n, s, a, routed, t, y, j, out, aux, store, w1, w2, w3, cmd):
-        tp, _, _, _ = where_table(model)
-        t1, t2, t3 = torque(model.data, p, n, tp, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
-        if store:
-            put3(aux, a + AUX_TORQUE, j, t1, t2, t3)
-        return t1, t2, t3
-
-    return Actuator(act)
+    return facets.actuator(lane, torque)
