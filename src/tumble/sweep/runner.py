@@ -56,13 +56,20 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
     mapped and its pages faulted afresh, and a sweep of chunks of 1e4 rigid bodies ran 12–15 % slower
     (docs/sweeps.md). With glibc's defaults a chunk reuses the memory the previous one freed, and a worker
     holds about one chunk's memory between tasks (379–405 MiB against Dask's 218 MiB, after five sweeps of
-    chunks of 1e4 bodies). For Dask's setting, start a cluster and pass its client."""
+    chunks of 1e4 bodies). For Dask's setting, start a cluster and pass its client.
+
+    The workers log errors only (``silence_logs=logging.ERROR``): the warnings of Dask's worker state machine,
+    such as a cancelled chunk's ``CancelledError`` when a sweep is interrupted, are its own bookkeeping, and an
+    interrupted ``tumble sweep`` says one line."""
+    import logging
+
     from distributed import LocalCluster
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
     with _glibc_malloc_defaults(), _interrupts_ignored():
         return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                            dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"})
+                            dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"},
+                            silence_logs=logging.ERROR)
 
 
 @contextmanager
