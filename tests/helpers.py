@@ -1,6 +1,9 @@
 """Helpers shared by the tests."""
 
+import contextlib
 import subprocess
+import sys
+import time
 
 import numpy as np
 
@@ -49,3 +52,33 @@ def assert_one_line_error(result, message, code=2):
     lines = result.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: ") and message in lines[0], result.stderr
     assert "Traceback" not in result.stderr
+
+
+@contextlib.contextmanager
+def dask_processes(path, workers, env, timeout):
+    """A ``dask scheduler`` process writing its address to ``path`` and one ``dask worker`` process per entry
+    ``(name, threads)`` of ``workers``, every server on 127.0.0.1; yields ``path`` once every worker has joined,
+    and stops them all after (the workers first: a worker whose scheduler is gone retries it before it exits)."""
+    import distributed
+
+    cli = [sys.executable, "-m"]
+    commands = [["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
+                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(path)]]
+    commands += [["distributed.cli.dask_worker", "--scheduler-file", str(path), "--host", "127.0.0.1", "--nthreads",
+                  str(threads), "--nworkers", "1", "--name", name, "--dashboard-address", "127.0.0.1:0"]
+                 for name, threads in workers]  # a worker waits for the scheduler's file
+    processes = []
+    try:
+        for command in commands:
+            processes.append(subprocess.Popen(cli + command, env=env, stdout=subprocess.DEVNULL,
+                                              stderr=subprocess.DEVNULL))
+        deadline = time.monotonic() + timeout
+        while not path.exists():
+            assert time.monotonic() < deadline, "the scheduler did not start"
+            time.sleep(0.1)
+        with distributed.Client(scheduler_file=str(path), timeout=timeout) as client:
+            client.wait_for_workers(len(workers), timeout=timeout)
+        yield path
+    finally:
+        stop(*processes[1:])
+        stop(*processes[:1])

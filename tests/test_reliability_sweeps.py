@@ -22,7 +22,7 @@ from pathlib import Path
 import cloudpickle
 import numpy as np
 import pytest
-from helpers import stop
+from helpers import dask_processes, stop
 
 import tumble
 from tumble import _callback
@@ -68,27 +68,8 @@ def stop_after(n):
 @pytest.fixture(scope="module")
 def scheduler_file(tmp_path_factory):
     """``dask scheduler`` and one ``dask worker`` process of 2 threads on 127.0.0.1, started and stopped here."""
-    path = tmp_path_factory.mktemp("dask") / "scheduler.json"
-    cli = [sys.executable, "-m"]
-    commands = [["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(path)],
-                ["distributed.cli.dask_worker", "--scheduler-file", str(path), "--host", "127.0.0.1", "--nthreads",
-                 "2", "--nworkers", "1", "--dashboard-address", "127.0.0.1:0"]]
-    processes = []
-    try:
-        for command in commands:
-            processes.append(subprocess.Popen(cli + command, env=ENV, stdout=subprocess.DEVNULL,
-                                              stderr=subprocess.DEVNULL))
-        deadline = time.monotonic() + TIMEOUT
-        while not path.exists():
-            assert time.monotonic() < deadline, "the scheduler did not start"
-            time.sleep(0.1)
-        with distributed.Client(scheduler_file=str(path), timeout=TIMEOUT) as client:
-            client.wait_for_workers(1, timeout=TIMEOUT)
+    with dask_processes(tmp_path_factory.mktemp("dask") / "scheduler.json", [("w1", 2)], ENV, TIMEOUT) as path:
         yield path
-    finally:  # the worker first: a worker whose scheduler is gone retries it before it exits
-        stop(*processes[1:])
-        stop(*processes[:1])
 
 
 # -- 1. two sweeps on one scheduler never share a task ------------------------------------

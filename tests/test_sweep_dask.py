@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import stop
+from helpers import dask_processes, stop
 
 import tumble
 from tumble.sweep import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
@@ -75,28 +75,9 @@ def local_client(reference):
 @pytest.fixture(scope="module")
 def scheduler_file(reference, tmp_path_factory):
     """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1, started and stopped here."""
-    path = tmp_path_factory.mktemp("dask") / "scheduler.json"
-    cli = [sys.executable, "-m"]
-    commands = [["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
-                 "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(path)]]
-    commands += [["distributed.cli.dask_worker", "--scheduler-file", str(path), "--host", "127.0.0.1", "--nthreads",
-                  "1", "--nworkers", "1", "--name", name, "--dashboard-address", "127.0.0.1:0"]
-                 for name in ("w1", "w2")]  # a worker waits for the scheduler's file
-    processes = []
-    try:
-        for command in commands:
-            processes.append(subprocess.Popen(cli + command, env=ENV, stdout=subprocess.DEVNULL,
-                                              stderr=subprocess.DEVNULL))
-        deadline = time.monotonic() + TIMEOUT
-        while not path.exists():
-            assert time.monotonic() < deadline, "the scheduler did not start"
-            time.sleep(0.1)
-        with distributed.Client(scheduler_file=str(path), timeout=TIMEOUT) as client:
-            client.wait_for_workers(2, timeout=TIMEOUT)
+    with dask_processes(tmp_path_factory.mktemp("dask") / "scheduler.json", [("w1", 1), ("w2", 1)], ENV,
+                        TIMEOUT) as path:
         yield path
-    finally:  # the workers first: a worker whose scheduler is gone retries it before it exits (5 s and more)
-        stop(*processes[1:])
-        stop(*processes[:1])
 
 
 def test_local_cluster_of_two_processes_equals_the_run_in_this_process(local_client, reference):
