@@ -115,6 +115,16 @@ def _directions_at(value, name: str, t: np.ndarray, times: np.ndarray) -> np.nda
     return np.stack([np.interp(times, t, v[:, j]) for j in range(3)], axis=-1)
 
 
+def _body_vectors(t, q, rate: float, latency: float, value, name: str, unit: bool):
+    """The sample times of a sensor of ``rate`` (Hz) and ``latency`` (s) on the truth ``(t, q)``, and the
+    inertial vector ``value`` ((3,) or one per truth time; a unit direction when ``unit``) seen in body axes at
+    them, ``R(q(t_k − latency))ᵀ v_N(t_k − latency)``: ``(t_k, v_B)``."""
+    t, q = _truth(t, q)
+    out_t = sample_times(t, rate, latency)
+    v = _directions_at(value, name, t, out_t - latency)
+    return out_t, attitude.rotate_inverse(attitude_at(t, q, out_t - latency), _unit_rows(v, name) if unit else v)
+
+
 def _unit_rows(v: np.ndarray, name: str) -> np.ndarray:
     n = np.linalg.norm(v, axis=-1, keepdims=True)
     if np.any(n == 0.0):
@@ -208,10 +218,7 @@ class CoarseSunSensor:
     def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
                sun: ArrayLike, seed: Seed = None) -> Measurements:
         """Head outputs (M, J); ``sun``: direction to the Sun, inertial axes, (3,) or one per truth time."""
-        t, q = _truth(t, q)
-        out_t = sample_times(t, self.rate, self.latency)
-        s_b = attitude.rotate_inverse(attitude_at(t, q, out_t - self.latency),
-                                      _unit_rows(_directions_at(sun, "sun", t, out_t - self.latency), "sun"))
+        out_t, s_b = _body_vectors(t, q, self.rate, self.latency, sun, "sun", unit=True)
         rng = np.random.default_rng(seed)
         value = np.maximum(s_b @ self.normals.T, 0.0) + self.sigma * rng.standard_normal((out_t.size,
                                                                                           len(self.normals)))
@@ -240,10 +247,7 @@ class FineSunSensor:
     def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
                sun: ArrayLike, seed: Seed = None) -> Measurements:
         """Measured Sun directions (M, 3), unit, NaN outside the field of view."""
-        t, q = _truth(t, q)
-        out_t = sample_times(t, self.rate, self.latency)
-        s_b = attitude.rotate_inverse(attitude_at(t, q, out_t - self.latency),
-                                      _unit_rows(_directions_at(sun, "sun", t, out_t - self.latency), "sun"))
+        out_t, s_b = _body_vectors(t, q, self.rate, self.latency, sun, "sun", unit=True)
         rng = np.random.default_rng(seed)
         v = self.sigma * rng.standard_normal((out_t.size, 3))
         v -= np.sum(v * s_b, axis=-1, keepdims=True) * s_b      # v ⊥ ŝ: a small rotation of ŝ
@@ -278,10 +282,7 @@ class Magnetometer:
     def sample(self, t: Trajectory | ArrayLike, q: ArrayLike | None = None, *,
                field_inertial: ArrayLike, seed: Seed = None) -> Measurements:
         """Measured field (M, 3), T; ``field_inertial``: the field in inertial axes, (3,) or one per truth time."""
-        t, q = _truth(t, q)
-        out_t = sample_times(t, self.rate, self.latency)
-        b_body = attitude.rotate_inverse(attitude_at(t, q, out_t - self.latency),
-                                         _directions_at(field_inertial, "field_inertial", t, out_t - self.latency))
+        out_t, b_body = _body_vectors(t, q, self.rate, self.latency, field_inertial, "field_inertial", unit=False)
         rng = np.random.default_rng(seed)
         value = b_body @ (np.eye(3) + self.errors).T + self.bias + self.sigma * rng.standard_normal(b_body.shape)
         return Measurements(t=out_t, value=value)
