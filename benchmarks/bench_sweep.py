@@ -46,8 +46,8 @@ import psutil
 
 import tumble
 from tumble.ensemble import moments
-from tumble.sweep import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
-from tumble.sweep.plan import make_plan
+from tumble.sweeps import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
+from tumble.sweeps.plan import make_plan
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
 T = np.linspace(0.0, 10.0, 101)
@@ -170,7 +170,7 @@ def main():
     rates = {}
     for n in (1, 2):
         start = time.perf_counter()
-        cluster = tumble.sweep.local_cluster(n)
+        cluster = tumble.sweeps.local_cluster(n)
         client = Client(cluster)
         started = time.perf_counter() - start
         tumble.sweep(BODY, **{**sweep, "samples": 2 * n, "chunk": 1}, client=client)  # workers load the kernel

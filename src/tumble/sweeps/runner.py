@@ -32,8 +32,8 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from tumble._validate import ValidationError
-from tumble.sweep.plan import Plan
-from tumble.sweep.store import SweepStore
+from tumble.sweeps.plan import Plan
+from tumble.sweeps.store import SweepStore
 
 if TYPE_CHECKING:
     from distributed import Client, LocalCluster
