@@ -116,7 +116,7 @@ def main():
     parser.add_argument("--tiny", type=int, default=200, help="one-sample chunks for the overhead per chunk")
     parser.add_argument("--big", type=int, default=100_000, help="bodies of the simulate_to_store run (0: skip it)")
     parser.add_argument("--big-inertia", type=float, nargs=3, default=[1.0, 2.0, 3.0], metavar="I",
-                        help="principal moments of the simulate_to_store run's body, kg m2 (1 1 2, a symmetric top: ω_z and "
+                        help="principal moments of the stored run's body, kg m2 (1 1 2, a symmetric top: ω_z and "
                         "the z momentum stay constant and compress, 60 GiB on disk at 1e6 bodies against 77 GiB)")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--dt", type=float, default=0.01, help="rk4 step, s (0.001: 10 000 steps a sample, an "

@@ -269,9 +269,11 @@ def simulate(
                       DeprecationWarning, stacklevel=2)
         from tumble.sweeps.stream import simulate_to_store
 
-        return simulate_to_store(model, store=store, t=times, method=method, dt=dt, rtol=rtol,  # type: ignore[return-value]
-                                 atol=atol, max_steps=max_steps, torque=torque, device=device, progress=progress,
-                                 **initial_state)  # the deprecated path's Dataset, typed as the supported result
+        state: dict[str, Any] = initial_state  # initial states by name, as simulate_to_store takes them
+        # the deprecated path's Dataset, typed as the supported result
+        return simulate_to_store(model, store=store, t=times, method=method,  # type: ignore[return-value]
+                                 dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque, device=device,
+                                 progress=progress, **state)
     m, options = _solver_options(model, method, dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if device not in ("cpu", "cuda"):
         raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")

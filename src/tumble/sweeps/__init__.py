@@ -68,7 +68,8 @@ if TYPE_CHECKING:
     from tumble.simulate import Model
     from tumble.torques import TorqueLike
 
-__all__ = ["sweep", "sweep_scenario", "open_sweep", "simulate_to_store", "local_cluster", "StoreMismatchError", "Dispersion", "Normal",
+__all__ = ["sweep", "sweep_scenario", "open_sweep", "simulate_to_store", "local_cluster", "StoreMismatchError",
+           "Dispersion", "Normal",
            "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
            "Component", "Max", "Final", "SettlingTime", "CrossingTime"]

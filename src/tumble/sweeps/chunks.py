@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError
 from tumble.simulate import Model, simulate
@@ -83,7 +84,7 @@ def batch_members(model: Model, initial_state: Mapping[str, Any]) -> int:
     return n_first
 
 
-def simulate_chunks(model: Model, chunks: Chunks, *, t: np.ndarray, initial_state: Mapping[str, Any],
+def simulate_chunks(model: Model, chunks: Chunks, *, t: ArrayLike, initial_state: Mapping[str, Any],
                     **options: Any) -> Iterator[tuple[int, int, Trajectory]]:
     """``(lo, hi, trajectory)`` of each chunk in turn: ``simulate(model.members(lo, hi), t=t, **options,
     **initial_state)`` with the rows ``lo:hi`` of the batched (two-dimensional) initial states, a shared value
