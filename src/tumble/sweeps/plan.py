@@ -105,16 +105,9 @@ class Plan:
 
     @property
     def chunks(self) -> Chunks:
-        """The samples cut into chunks of :attr:`chunk` (:mod:`tumble.sweeps.chunks`)."""
+        """The samples cut into chunks of :attr:`chunk` (:mod:`tumble.sweeps.chunks`): chunk ``k`` is a Dask
+        task."""
         return Chunks(self.samples, self.chunk)
-
-    @property
-    def n_chunks(self) -> int:
-        return len(self.chunks)
-
-    def bounds(self, k: int) -> tuple[int, int]:
-        """The samples ``[lo, hi)`` of chunk ``k``."""
-        return self.chunks.bounds(k)
 
     def inputs(self, lo: int, hi: int) -> dict[str, np.ndarray]:
         """The dispersed inputs of samples ``lo`` to ``hi − 1`` (name → (m, *shape)), each a function of
@@ -133,7 +126,7 @@ class Plan:
 
     def run(self, k: int) -> ChunkResult:
         """Simulate chunk ``k`` and reduce it (what a Dask task does)."""
-        lo, hi = self.bounds(k)
+        lo, hi = self.chunks.bounds(k)
         inputs = self.inputs(lo, hi)
         traj = self.simulate(inputs)
         m = hi - lo

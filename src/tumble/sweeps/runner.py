@@ -138,7 +138,7 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
     from distributed import Client, as_completed
 
     missing = store.missing()
-    total = plan.n_chunks
+    total = len(plan.chunks)
     if progress is not None:
         progress(total - len(missing), total)
     if not missing:

@@ -148,7 +148,7 @@ class SweepStore:
         self._memory: xarray.Dataset | None = None  # the store when path is None, once made
         self._writable: zarr.Group | None = None  # the group open for writing once the store exists, and its arrays
         self._arrays: dict[str, zarr.Array] = {}
-        self._done = np.zeros(plan.n_chunks, dtype=bool)
+        self._done = np.zeros(len(plan.chunks), dtype=bool)
         if self.path is not None and os.path.exists(self.path):
             self._check()
 
@@ -254,7 +254,7 @@ class SweepStore:
         for name, v in first.trajectories.items():
             variables[name] = (("sample", "time", *(f"{name}_dim{k}" for k in range(v.ndim - 2))),
                                (s, *v.shape[1:]), np.dtype(np.float64))
-        variables["done"] = ("chunk",), (plan.n_chunks,), np.dtype(bool)
+        variables["done"] = ("chunk",), (len(plan.chunks),), np.dtype(bool)
         coords = {"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})}
         # as Zarr's JSON gives them back: lists for tuples
         attrs = json.loads(json.dumps({SETTINGS_ATTR: plan.settings(), DIGEST_ATTR: self._digest(),
