@@ -45,7 +45,7 @@ import numpy as np
 import psutil
 
 import tumble
-from tumble.ensemble import moments
+from tumble.sweeps.moments import moments
 from tumble.sweeps import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
 from tumble.sweeps.plan import make_plan
 
