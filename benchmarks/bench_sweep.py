@@ -45,8 +45,8 @@ import numpy as np
 import psutil
 
 import tumble
-from tumble.sweeps.moments import moments
 from tumble.sweeps import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
+from tumble.sweeps.moments import moments
 from tumble.sweeps.plan import make_plan
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
