@@ -1,5 +1,5 @@
 """Sweep throughput on Dask against the plain in-process batch, the Dask overhead per chunk, and the peak memory
-of a big ``simulate(..., store=)`` run.
+of a big ``tumble.sweeps.simulate_to_store`` run.
 
     python benchmarks/bench_sweep.py [--samples 40000] [--chunk 10000] [--big 100000] [--repeats 5] [--dt 0.01]
 
@@ -20,7 +20,7 @@ series (ω_z, with its per-time statistics and percentiles). Figures:
   (no per-time series, whose exact percentiles need every sample at the end);
 * the overhead per chunk: a sweep of ``--tiny`` one-sample chunks of one step
   on 2 workers, minus the same sweep in this process, per chunk;
-* the peak RSS of ``simulate(..., store=)`` of ``--big`` bodies × 1000 output
+* the peak RSS of ``tumble.sweeps.simulate_to_store`` of ``--big`` bodies × 1000 output
   times in a child process (its ``VmHWM``: a child's ``ru_maxrss`` starts from
   its parent's peak at the fork, here that of the sweeps above), and its wall time.
 
@@ -45,9 +45,9 @@ import numpy as np
 import psutil
 
 import tumble
-from tumble.ensemble import moments
-from tumble.sweep import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
-from tumble.sweep.plan import make_plan
+from tumble.sweeps import PERCENTILES, Component, Final, Normal, NutationAngle, UniformAttitude
+from tumble.sweeps.moments import moments
+from tumble.sweeps.plan import make_plan
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
 T = np.linspace(0.0, 10.0, 101)
@@ -61,8 +61,8 @@ import numpy as np, sys, time, tumble
 n, path, inertia = int(sys.argv[1]), sys.argv[2], [float(x) for x in sys.argv[3:6]]
 omega0 = np.random.default_rng(0).normal([0.0, 0.0, 1.0], 0.05, size=(n, 3))
 start = time.perf_counter()
-ds = tumble.simulate(tumble.RigidBody(np.diag(inertia)), omega0, t=np.linspace(0.0, 10.0, 1000),
-                     method="rk4", dt=0.01, store=path)
+ds = tumble.sweeps.simulate_to_store(tumble.RigidBody(np.diag(inertia)), omega0, store=path,
+                                     t=np.linspace(0.0, 10.0, 1000), method="rk4", dt=0.01)
 # this process's own peak (VmHWM, KiB); ru_maxrss would be at least the parent's at the fork that started it
 peak = next(int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmHWM:"))
 print(time.perf_counter() - start, peak, dict(ds.sizes))
@@ -114,9 +114,9 @@ def main():
     parser.add_argument("--samples", type=int, default=40_000)
     parser.add_argument("--chunk", type=int, default=10_000)
     parser.add_argument("--tiny", type=int, default=200, help="one-sample chunks for the overhead per chunk")
-    parser.add_argument("--big", type=int, default=100_000, help="bodies of the store= run (0: skip it)")
+    parser.add_argument("--big", type=int, default=100_000, help="bodies of the simulate_to_store run (0: skip it)")
     parser.add_argument("--big-inertia", type=float, nargs=3, default=[1.0, 2.0, 3.0], metavar="I",
-                        help="principal moments of the store= run's body, kg m2 (1 1 2, a symmetric top: ω_z and "
+                        help="principal moments of the stored run's body, kg m2 (1 1 2, a symmetric top: ω_z and "
                         "the z momentum stay constant and compress, 60 GiB on disk at 1e6 bodies against 77 GiB)")
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--dt", type=float, default=0.01, help="rk4 step, s (0.001: 10 000 steps a sample, an "
@@ -170,7 +170,7 @@ def main():
     rates = {}
     for n in (1, 2):
         start = time.perf_counter()
-        cluster = tumble.sweep.local_cluster(n)
+        cluster = tumble.sweeps.local_cluster(n)
         client = Client(cluster)
         started = time.perf_counter() - start
         tumble.sweep(BODY, **{**sweep, "samples": 2 * n, "chunk": 1}, client=client)  # workers load the kernel
@@ -203,7 +203,7 @@ def main():
         finally:
             shutil.rmtree(directory, ignore_errors=True)
         wall, rss_kib, sizes = float(out[0]), int(out[1]), out[2].strip()
-        print(f"\nsimulate(store=) of {args.big} bodies x 1000 output times (rk4, 1000 steps, I = "
+        print(f"\nsimulate_to_store of {args.big} bodies x 1000 output times (rk4, 1000 steps, I = "
               f"diag({', '.join(f'{x:g}' for x in args.big_inertia)})): {wall:.1f} s, "
               f"peak RSS {rss_kib / 2**20:.2f} GiB, store {size / 2**30:.2f} GiB on disk, sizes {sizes}")
         print(f"  (in memory the same run would need at least "

@@ -324,8 +324,8 @@ def test_a_block_that_starts_a_cluster_is_run_as_a_script_and_needs_the_guard(tm
     # exec inside pytest could not show the missing guard: spawned workers import the script, not pytest
     unguarded = "import tumble\nds = tumble.sweep(body, dispersions, samples=10, t=t)\n"
     assert starts_a_cluster(unguarded) and not starts_a_cluster(unguarded.replace("t=t", "t=t, workers=0"))
-    assert starts_a_cluster("cluster = tumble.sweep.local_cluster(2)\n")
-    assert not starts_a_cluster("tumble.sweep.Normal(0, 1)")
+    assert starts_a_cluster("cluster = tumble.sweeps.local_cluster(2)\n")
+    assert not starts_a_cluster("tumble.sweeps.Normal(0, 1)")
     with pytest.raises(AssertionError, match='needs `if __name__ == "__main__":`'):
         run_script(unguarded, "block at line 1", ROOT / "README.md", tmp_path)
     run_script('import math\nif __name__ == "__main__":\n    print(math.pi)  # 3.14159\n', "block at line 1",

@@ -58,7 +58,7 @@ def test_custom_quantity_and_progress_over_chunks():
 @pytest.mark.parametrize("kwargs, message", [
     (dict(omega0=[1.0, 2.0, 3.0]), r"omega0: must have shape \(N, 3\)"),
     (dict(chunk=0), "chunk: must be >= 1"),
-    (dict(q0=np.ones((4, 4))), r"q0: must have shape \(4,\) or \(23, 4\)"),
+    (dict(q0=np.ones((4, 4))), r"^q0: a batch of 4 does not match the 23 of omega0"),
     (dict(quantities={"bad": lambda traj: traj.t}), r"quantities\['bad'\]: must return an array"),
     (dict(quantities={}), "quantities: give at least one"),
 ])

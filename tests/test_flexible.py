@@ -214,16 +214,6 @@ def test_totals_are_the_energy_and_momentum_of_hub_and_modes():
     assert batch.energy.shape == (t.size, 2) and batch.momentum_body.shape == (t.size, 2, 3)
 
 
-def test_deprecated_simulate_warns_and_forwards():
-    fbody = coupled()
-    t = np.linspace(0.0, 1.0, 3)
-    with pytest.warns(DeprecationWarning, match="tumble.simulate"):
-        old = flexible.simulate(fbody, OMEGA0, t=t, eta0=[0.05, 0.0], **TIGHT)
-    new = tumble.simulate(fbody, OMEGA0, t=t, eta0=[0.05, 0.0], **TIGHT)
-    np.testing.assert_array_equal(old.q, new.q)
-    np.testing.assert_array_equal(old.modal_rate, new.modal_rate)
-
-
 def test_documented_example_runs():
     # docs/flexible.md: every Python block runs as a script and prints what it claims
     text = (Path(__file__).resolve().parents[1] / "docs" / "flexible.md").read_text(encoding="utf-8")

@@ -131,11 +131,3 @@ def test_energy_and_vertical_momentum_of_rotor_and_gimbals_are_conserved():
     rubbed = GimbaledGyro(outer_friction=1e-3, **ROTOR, **GIMBALS)
     assert rubbed.invariants(tumble.simulate(rubbed, t=t[:3], spin=100.0)) == {}
 
-
-def test_deprecated_simulate_warns_and_forwards():
-    gyro = GimbaledGyro(inner_torque=0.0196, **ROTOR, **GIMBALS)
-    t = np.linspace(0.0, 0.1, 3)
-    with pytest.warns(DeprecationWarning, match="tumble.simulate"):
-        old = gyro.simulate(t, spin=100.0, phi_dot0=0.5)
-    new = tumble.simulate(gyro, t=t, spin=100.0, phi_dot0=0.5, **TIGHT)
-    np.testing.assert_array_equal(old.theta, new.theta)

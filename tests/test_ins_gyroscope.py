@@ -139,14 +139,6 @@ def test_a_batch_of_initial_precession_rates_equals_one_by_one():
         np.testing.assert_array_equal(batch.q[:, i], one.q)
 
 
-def test_deprecated_simulate_warns_and_forwards():
-    gyro = Gyroscope(spin=100.0, **ROTOR)
-    t = np.linspace(0.0, 0.1, 3)
-    with pytest.warns(DeprecationWarning, match="precession_rate0"):
-        old = gyro.simulate(t, released=False)
-    np.testing.assert_array_equal(old.omega, steady(gyro, t).omega)
-
-
 def test_documented_example_runs(capsys):
     # the gyroscope block of docs/ins.md runs as a script and prints what it claims
     text = (Path(__file__).resolve().parents[1] / "docs" / "ins.md").read_text(encoding="utf-8")

@@ -26,8 +26,8 @@ from helpers import dask_processes, stop
 
 import tumble
 from tumble import _callback
-from tumble.sweep import Component, CrossingTime, Final, Normal, NutationAngle, StoreMismatchError
-from tumble.sweep.store import writing
+from tumble.sweeps import Component, CrossingTime, Final, Normal, NutationAngle, StoreMismatchError
+from tumble.sweeps.store import writing
 
 distributed = pytest.importorskip("distributed")
 
@@ -117,12 +117,12 @@ def test_a_sweep_resumed_after_its_torque_table_changed_is_refused_and_unchanged
     whole = tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.0), workers=0, **args)
     with pytest.raises(KeyboardInterrupt):
         tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.0), workers=0, store=store, progress=stop_after(2), **args)
-    done = tumble.sweep.open_sweep(store).done.values.tolist()
+    done = tumble.sweeps.open_sweep(store).done.values.tolist()
     assert done == [True, True, False, False, False]
     with pytest.raises(StoreMismatchError, match=r"^store: .*mc\.zarr was written by another sweep: the settings "
                                                  r"agree but not the content .* delete the store"):
         tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.5), workers=0, store=store, **args)
-    assert tumble.sweep.open_sweep(store).done.values.tolist() == done  # left alone
+    assert tumble.sweeps.open_sweep(store).done.values.tolist() == done  # left alone
     resumed = tumble.sweep(BODY, DISPERSIONS, torque=tabulated(1.0), workers=0, store=store, **args)
     assert resumed.attrs["chunks_computed"] == 3
     assert_same(resumed, whole)
@@ -155,7 +155,7 @@ def test_a_scenario_whose_undispersed_table_changed_has_another_digest(tmp_path)
     # recorded settings name the file and the keys only, the digest holds every table of it (here the
     # damper's sphere inertia, which nothing else records)
     from tumble.scenario.sweep import sweep_arguments
-    from tumble.sweep.plan import make_plan
+    from tumble.sweeps.plan import make_plan
 
     path = tmp_path / "explorer1.toml"
     plans = []
@@ -232,7 +232,7 @@ def test_a_complete_store_that_lost_a_chunk_file_computes_that_chunk_again(tmp_p
     again = tumble.sweep(BODY, DISPERSIONS, store=store, **args)
     assert again.attrs["chunks_computed"] == 0  # chunks of NaN (the fill value) are files too
     os.remove(store / "omega_z" / "c" / "3")  # chunk 3 of an outcome, samples 15 to 19
-    damaged = tumble.sweep.open_sweep(store)
+    damaged = tumble.sweeps.open_sweep(store)
     assert np.isnan(damaged.omega_z.values[15:20]).all() and damaged.done.values.all()  # what resuming once read
     resumed = tumble.sweep(BODY, DISPERSIONS, store=store, **args)
     assert resumed.attrs["chunks_computed"] == 1
@@ -259,8 +259,8 @@ def test_other_percentiles_on_a_complete_store_replace_its_statistics(tmp_path):
 KILLED = textwrap.dedent("""
     import numpy as np, tumble
     # 2000 bodies x 4001 output times: chunks of 131 bodies, one written at a time
-    tumble.simulate(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), np.tile([0.1, 0.0, 1.0], (2000, 1)),
-                    t=np.linspace(0.0, 40.0, 4001), method="rk4", dt=0.01, store={store!r})
+    tumble.sweeps.simulate_to_store(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), np.tile([0.1, 0.0, 1.0], (2000, 1)),
+                                    store={store!r}, t=np.linspace(0.0, 40.0, 4001), method="rk4", dt=0.01)
 """)
 
 
@@ -281,7 +281,7 @@ def test_a_store_killed_mid_run_leaves_a_temporary_that_the_next_run_removes(tmp
         stop(process)
         process.stderr.close()
     assert not store.exists() and len(list(tmp_path.glob(".run.zarr.*.tmp"))) == 1
-    tumble.simulate(BODY, np.tile([0.1, 0.0, 1.0], (3, 1)), t=T, method="rk4", dt=0.01, store=store)
+    tumble.sweeps.simulate_to_store(BODY, np.tile([0.1, 0.0, 1.0], (3, 1)), store=store, t=T, method="rk4", dt=0.01)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.zarr"]
 
 
@@ -396,9 +396,9 @@ def test_ctrl_c_during_tumble_sweep_is_one_line_and_exit_130_and_the_store_resum
                                    "resumes the sweep"]
     written = _done(store)
     assert 1 <= written < 16
-    resumed = tumble.sweep.sweep_scenario(scenario, store=store, workers=0)
+    resumed = tumble.sweeps.sweep_scenario(scenario, store=store, workers=0)
     assert resumed.attrs["chunks_computed"] == 16 - written
-    assert_same(resumed, tumble.sweep.sweep_scenario(scenario, workers=0))
+    assert_same(resumed, tumble.sweeps.sweep_scenario(scenario, workers=0))
 
 
 def _done(store):
@@ -443,7 +443,7 @@ def test_a_sweep_whose_index_and_outcomes_outgrow_memory_is_refused_at_once(tmp_
 
 
 def test_a_sweep_of_more_chunks_than_its_window_holds_a_window_of_tasks_at_a_time(scheduler_file):
-    # 40 chunks of one sample, a window of 32 (tumble.sweep.runner.IN_FLIGHT): each completed chunk submits one
+    # 40 chunks of one sample, a window of 32 (tumble.sweeps.runner.IN_FLIGHT): each completed chunk submits one
     args = dict(dispersions=DISPERSIONS, samples=40, seed=1, chunk=1, **RUN)
     reference = tumble.sweep(BODY, workers=0, **args)
     held = []
@@ -464,7 +464,7 @@ DIGESTS = textwrap.dedent("""
     warnings.simplefilter("ignore")
     import tumble
     from tumble.scenario.sweep import sweep_arguments
-    from tumble.sweep.plan import make_plan
+    from tumble.sweeps.plan import make_plan
 
     for path in sys.argv[1:]:
         a = sweep_arguments(tumble.scenario.load(path))

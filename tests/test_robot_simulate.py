@@ -218,16 +218,6 @@ def test_gravity_is_the_chains(puma):
                                rtol=1e-13, atol=1e-15)
 
 
-@pytest.mark.slow  # shares the compiled rk4 of the chain model
-def test_robot_simulate_is_a_deprecated_alias(puma):
-    """robot.simulate(chain, q0, qd0, ..., gravity=g) warns and forwards to tumble.simulate(chain.with_gravity(g))."""
-    with pytest.warns(DeprecationWarning, match=r"tumble.robot.simulate is deprecated: use tumble.simulate"):
-        old = robot.simulate(puma, Q0, QD0, t=T, dt=0.01, gravity=(0.0, 0.0, -1.62))
-    new = tumble.simulate(puma.with_gravity((0.0, 0.0, -1.62)), q0=Q0, qd0=QD0, t=T, method="rk4", dt=0.01)
-    np.testing.assert_array_equal(old.joint_position, new.joint_position)
-    assert old.info == new.info
-
-
 @pytest.mark.slow  # compiles dop853 for the chain model (shared with the power-balance test)
 def test_demo_writes_its_files_and_keeps_the_energy(tmp_path):
     """The Panda falling for 2 s: energy E ≈ 94 J kept to a measured 6e-12 J (tolerance 1e-10 J, see above)."""

@@ -163,16 +163,6 @@ def test_totals_are_the_energy_and_momentum_of_hub_and_slosh_mass():
     assert batch.energy.shape == (t.size, 2) and batch.momentum_body.shape == (t.size, 2, 3)
 
 
-def test_deprecated_simulate_warns_and_forwards():
-    sbody = sloshing()
-    t = np.linspace(0.0, 1.0, 3)
-    with pytest.warns(DeprecationWarning, match="tumble.simulate"):
-        old = slosh.simulate(sbody, OMEGA0, t=t, direction0=[1.0, 1.0, 0.0], **TIGHT)
-    new = tumble.simulate(sbody, OMEGA0, t=t, direction0=[1.0, 1.0, 0.0], **TIGHT)
-    np.testing.assert_array_equal(old.q, new.q)
-    np.testing.assert_array_equal(old.pendulum_rate, new.pendulum_rate)
-
-
 def test_documented_example_runs():
     # docs/slosh.md: its Python block runs as a script (a short run of the demo spinner)
     text = (Path(__file__).resolve().parents[1] / "docs" / "slosh.md").read_text(encoding="utf-8")

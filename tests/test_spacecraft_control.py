@@ -323,13 +323,3 @@ def test_initial_state_names_follow_the_parts():
     names = [f.name for f in _mrp_craft(MRPFeedback(K=1.0, P=1.0, Ki=1e-3)).state_fields()]
     assert names == ["omega0", "q0", "wheel_speeds0", "attitude_error_integral0"]
 
-
-@SLOW
-def test_spacecraft_simulate_is_a_deprecated_alias():
-    craft = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), controller=QuaternionPD(0.2))
-    t = np.linspace(0.0, 2.0, 5)
-    with pytest.warns(DeprecationWarning, match="tumble.simulate"):
-        old = tumble.spacecraft.simulate(craft, [0.05, -0.02, 0.03], t=t, dt=0.05)
-    new = tumble.simulate(craft, [0.05, -0.02, 0.03], t=t, method="rk4", dt=0.05)
-    np.testing.assert_array_equal(old.q, new.q)
-    np.testing.assert_array_equal(old.wheel_speed, new.wheel_speed)

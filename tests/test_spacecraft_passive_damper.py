@@ -141,15 +141,6 @@ def test_external_torque_on_a_damped_hub_changes_the_momentum_by_its_impulse():
     assert python.info["torque"] == "Python function <lambda>"
 
 
-@pytest.mark.slow
-def test_simulate_damped_is_a_deprecated_alias():
-    with pytest.warns(DeprecationWarning, match="tumble.simulate"):
-        old = d.simulate_damped(HUB, DAMPER, omega_with_nutation(0.05), t=[0.0, 1.0, 2.0])
-    new = tumble.simulate(CRAFT, omega_with_nutation(0.05), t=[0.0, 1.0, 2.0])
-    np.testing.assert_array_equal(old.q, new.q)
-    np.testing.assert_array_equal(old.extras["damper_omega"].data, new.extras["damper_omega"].data)
-
-
 def test_damper_refuses_bad_input():
     with pytest.raises(tumble.ValidationError, match="damper.inertia"):
         d.SphericalDamper(0.0, 1.0)

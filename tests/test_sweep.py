@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble.sweep import (
+from tumble.sweeps import (
     Final,
     Grid,
     Inertia,
@@ -32,15 +32,16 @@ from tumble.sweep import (
     TruncatedNormal,
     Uniform,
     UniformAttitude,
+    simulate_to_store,
 )
-from tumble.sweep.plan import make_plan
+from tumble.sweeps.plan import make_plan
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
 T = np.linspace(0.0, 2.0, 11)
 RK4 = dict(method="rk4", dt=0.01)
 DISPERSIONS = {"omega0": Normal([0.0, 0.0, 1.0], [0.05, 0.05, 0.1]), "q0": UniformAttitude()}
 OUTCOMES = {"nutation": Final(NutationAngle([0.0, 0.0, 1.0])), "pointing": Max(PointingError(), after=1.0)}
-SERIES = {"omega_z": tumble.sweep.Component("omega", 2)}
+SERIES = {"omega_z": tumble.sweeps.Component("omega", 2)}
 RUN = dict(t=T, **RK4, outcomes=OUTCOMES, statistics=SERIES, workers=0)
 N = 23  # a prime: the chunks below leave remainders
 
@@ -205,9 +206,9 @@ def test_settling_and_crossing_times():
                              inertia=np.eye(3), extras={"x": tumble.trajectory.Extra(
                                  np.array([[3.0, 0.0, 0.0], [0.5, 0.0, 1.0], [2.0, 0.0, 2.0], [0.5, 0.0, 3.0],
                                            [0.1, 0.0, 4.0]]))})
-    x = tumble.sweep.Component("x")
+    x = tumble.sweeps.Component("x")
     np.testing.assert_array_equal(SettlingTime(x, below=1.0)(traj), [3.0, 0.0, np.nan])
-    np.testing.assert_array_equal(tumble.sweep.CrossingTime(x, above=2.0)(traj), [0.0, np.nan, 2.0])
+    np.testing.assert_array_equal(tumble.sweeps.CrossingTime(x, above=2.0)(traj), [0.0, np.nan, 2.0])
     np.testing.assert_array_equal(Max(x, after=1.0)(traj), [2.0, 0.0, 4.0])
 
 
@@ -219,7 +220,7 @@ def test_final_and_max_read_only_the_times_they_need():
         whole = series(traj)
         np.testing.assert_array_equal(Final(series)(traj), whole[-1], err_msg=repr(series))
         np.testing.assert_array_equal(Max(series, after=1.0)(traj), whole[T >= 1.0].max(axis=0), err_msg=repr(series))
-    drift = tumble.sweep.Component("energy_drift")  # not pointwise (relative to t = 0): read over the whole run
+    drift = tumble.sweeps.Component("energy_drift")  # not pointwise (relative to t = 0): read over the whole run
     np.testing.assert_array_equal(Final(drift)(traj), traj.energy_drift[-1])
 
 
@@ -227,7 +228,7 @@ def test_outcome_percentiles_are_over_the_samples_where_the_event_happened():
     # omega_z crosses 1.0 rad/s only in the samples started above it (no torque: omega_z oscillates about its
     # start by the small transverse rates): the others have no crossing time (NaN); the percentiles are
     # those of the samples with a value, and the count says how many
-    crossing = tumble.sweep.CrossingTime(tumble.sweep.Component("omega", 2), above=1.0)
+    crossing = tumble.sweeps.CrossingTime(tumble.sweeps.Component("omega", 2), above=1.0)
     ds = tumble.sweep(BODY, DISPERSIONS, samples=N, seed=5, t=T, **RK4, workers=0,
                       outcomes={"crossing": crossing})
     values = ds.crossing.values
@@ -275,7 +276,7 @@ def test_an_interrupted_sweep_resumes_with_the_missing_chunks_only(tmp_path):
     whole = tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=5, **RUN)
     with pytest.raises(KeyboardInterrupt):
         tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=5, store=store, progress=stop_after(2), **RUN)
-    assert tumble.sweep.open_sweep(store).done.values.tolist() == [True, True, False, False, False]
+    assert tumble.sweeps.open_sweep(store).done.values.tolist() == [True, True, False, False, False]
     resumed = tumble.sweep(BODY, DISPERSIONS, samples=N, seed=1, chunk=5, store=store, **RUN)
     assert resumed.attrs["chunks_computed"] == 3
     for name in whole.data_vars:
@@ -325,7 +326,7 @@ def test_a_store_of_other_settings_is_refused_and_left_alone(tmp_path):
      r"^dispersions: the model's build function .* needs 'gain'"),
     (dict(dispersions={"omega0": Normal([0, 0], 0.1)}), r"^dispersions\['omega0'\]: a value of shape \(3,\)"),
     (dict(dispersions={"inertia": Normal(np.eye(3), 0.1)}),
-     r"^dispersions\['inertia'\]: must be a tumble.sweep.Inertia \(it stays physical\) or a Grid"),
+     r"^dispersions\['inertia'\]: must be a tumble.sweeps.Inertia \(it stays physical\) or a Grid"),
     (dict(dispersions={"inertia": Grid([np.eye(3), np.diag([1.0, 1.0, 3.0])])}),
      r"^dispersions\['inertia'\]\[1\]: principal moments break the triangle inequality"),
     (dict(dispersions={"omega0": Normal([0, 0, 1.0], 0.1)}, samples=0), r"^samples: must be >= 1"),
@@ -356,41 +357,45 @@ def test_bad_dispersions_are_refused_at_construction():
         Grid([])
 
 
-# -- simulate(store=) -----------------------------------------------------------------
+# -- simulate_to_store: a batch streamed to a store in chunks ------------------------------
 
 
-def test_simulate_with_a_store_streams_chunks_that_equal_the_batch(tmp_path):
-    from tumble.sweep.stream import simulate_to_store
-
+def test_a_batch_streamed_to_a_store_in_chunks_equals_the_batch(tmp_path):
     rng = np.random.default_rng(4)
     inertia = np.diag([1.0, 2.0, 3.0]) + np.einsum("n,ij->nij", rng.uniform(0.0, 0.2, N), np.eye(3))
     omega0 = rng.normal(size=(N, 3))
     whole = tumble.simulate(inertia, omega0, t=T, **RK4)
-    ds = simulate_to_store(inertia, tmp_path / "run.zarr", t=T, initial_state={"omega0": omega0}, options=RK4,
-                           chunk=5)
+    ds = simulate_to_store(inertia, omega0, store=tmp_path / "run.zarr", t=T, **RK4, chunk=5)
     assert ds.q.chunks[1] == (5, 5, 5, 5, 3)
     back = tumble.Trajectory.from_xarray(ds.load())
     for name in ("q", "omega", "energy", "momentum_body", "inertia"):
         np.testing.assert_array_equal(getattr(back, name), getattr(whole, name), err_msg=name)
     assert back.info == whole.info  # the solver statistics, summed over the chunks
-    front = tumble.simulate(BODY, omega0, t=T, **RK4, store=tmp_path / "front.zarr")
-    np.testing.assert_array_equal(front.omega.values, tumble.simulate(BODY, omega0, t=T, **RK4).omega)
     with pytest.raises(tumble.ValidationError, match="^store: .* exists"):
-        tumble.simulate(BODY, omega0, t=T, **RK4, store=tmp_path / "front.zarr")
-    assert sorted(os.listdir(tmp_path)) == ["front.zarr", "run.zarr"]  # no temporary store left
+        simulate_to_store(BODY, omega0, store=tmp_path / "run.zarr", t=T, **RK4)
+    assert sorted(os.listdir(tmp_path)) == ["run.zarr"]  # no temporary store left
 
 
-def test_simulate_with_a_store_refuses_an_empty_batch(tmp_path):
+def test_simulate_with_a_store_is_deprecated_and_still_streams(tmp_path):
+    omega0 = np.random.default_rng(5).normal(size=(N, 3))
+    with pytest.warns(DeprecationWarning, match=r"^simulate\(store=\.\.\.\) is deprecated .* use "
+                                                r"tumble\.sweeps\.simulate_to_store\(model, \.\.\., store=\.\.\.\)"):
+        front = tumble.simulate(BODY, omega0, t=T, **RK4, store=tmp_path / "front.zarr")
+    np.testing.assert_array_equal(front.omega.values, tumble.simulate(BODY, omega0, t=T, **RK4).omega)
+
+
+def test_a_store_refuses_an_empty_batch(tmp_path):
     # once zarr's GroupNotFoundError ("No group found in store None"): no chunk had made the store
     with pytest.raises(tumble.ValidationError, match="^store: the batch has no members"):
-        tumble.simulate(BODY, np.zeros((0, 3)), t=T, **RK4, store=tmp_path / "empty.zarr")
+        simulate_to_store(BODY, np.zeros((0, 3)), store=tmp_path / "empty.zarr", t=T, **RK4)
     assert os.listdir(tmp_path) == []
 
 
 def test_a_run_too_big_for_memory_is_refused_before_allocation():
     # 1e6 bodies x 1e5 output times: 1.4e13 bytes, more than any test machine has
     with pytest.raises(tumble.ValidationError, match=r"^store: 1000000 members x 100000 output times need at least "
-                                                     r"14,400,000,000,000 bytes .* pass store="):
+                                                     r"14,400,000,000,000 bytes .* tumble\.sweeps\.simulate_to_store"
+                                                     r"\(\.\.\., store='run\.zarr'\) streams it"):
         tumble.simulate(BODY, np.zeros((1_000_000, 3)), t=np.linspace(0.0, 1.0, 100_000), method="rk4", dt=1e-5)
 
 
@@ -412,8 +417,8 @@ def test_tumble_sweep_of_a_scenario_file_writes_the_store_and_the_figure(tmp_pat
     assert "samples   12 (seed 2026), 1 of 1 chunks of 50 done" in result.output
     assert figure.stat().st_size > 10_000
     # the same sweep from Python: the scenario's model rebuilt per sample with its dispersed inertia
-    ds = tumble.sweep.sweep_scenario(SPINNER, samples=12, workers=0)
-    stored = tumble.sweep.open_sweep(store)
+    ds = tumble.sweeps.sweep_scenario(SPINNER, samples=12, workers=0)
+    stored = tumble.sweeps.open_sweep(store)
     for name in ("body.inertia", "omega0", "q0", "nutation", "nutation_angle"):
         np.testing.assert_array_equal(stored[name].values, ds[name].values, err_msg=name)
     j = ds["body.inertia"].values

@@ -22,7 +22,7 @@ import pytest
 from helpers import dask_processes, stop
 
 import tumble
-from tumble.sweep import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
+from tumble.sweeps import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
 
 distributed = pytest.importorskip("distributed")
 
@@ -32,7 +32,7 @@ BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
 SWEEP = dict(dispersions={"omega0": Normal([0.0, 0.0, 1.0], 0.05), "q0": UniformAttitude()}, samples=192, seed=5,
              chunk=24, t=np.linspace(0.0, 20.0, 21), method="rk4", dt=2.5e-4,
              outcomes={"nutation": Final(NutationAngle([0.0, 0.0, 1.0])), "pointing": Max(PointingError())},
-             statistics={"omega_z": tumble.sweep.Component("omega", 2)})
+             statistics={"omega_z": tumble.sweeps.Component("omega", 2)})
 CHUNKS = 8
 SRC = str(Path(tumble.__file__).parents[1])
 ENV = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", ""), "NUMBA_NUM_THREADS": "1"}
@@ -57,7 +57,7 @@ def local_client(reference):
     saved = os.environ.get("MALLOC_TRIM_THRESHOLD_")
     os.environ["MALLOC_TRIM_THRESHOLD_"] = "65536"
     try:
-        cluster = tumble.sweep.local_cluster(2)
+        cluster = tumble.sweeps.local_cluster(2)
         assert os.environ["MALLOC_TRIM_THRESHOLD_"] == "65536"  # given back
     finally:
         if saved is None:
@@ -169,8 +169,8 @@ THREADS = textwrap.dedent("""
         return _full(traj.q.shape[1], numba.get_num_threads())
 
     if __name__ == "__main__":
-        body, dispersions = tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), {"omega0": tumble.sweep.Normal([0, 0, 1.0], 0.1)}
-        with tumble.sweep.local_cluster(1) as cluster, cluster.get_client() as client:
+        body, dispersions = tumble.RigidBody(np.diag([1.0, 2.0, 3.0])), {"omega0": tumble.sweeps.Normal([0, 0, 1.0], 0.1)}
+        with tumble.sweeps.local_cluster(1) as cluster, cluster.get_client() as client:
             ds = tumble.sweep(body, dispersions, samples=4, chunk=2, t=[0.0, 0.01], method="rk4", dt=0.01,
                               client=client, outcomes={"threads": threads})
         print(numba.config.NUMBA_NUM_THREADS, ds.threads.values.tolist())

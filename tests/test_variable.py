@@ -9,7 +9,7 @@ from scipy.integrate import quad, simpson
 
 import tumble
 from tumble import attitude
-from tumble.variable import VariableBody, shape_power, simulate_variable
+from tumble.variable import VariableBody, shape_power
 
 # dop853 tolerances of every run here (each distinct setting does not cost a compile; a method does)
 RTOL = ATOL = 1e-12
@@ -217,15 +217,6 @@ def test_totals_are_the_rotational_energy_and_the_angular_momentum():
     assert kept.keys() == {"momentum_inertial"}
     assert np.abs(kept["momentum_inertial"] - kept["momentum_inertial"][0]).max() < MOMENTUM_TOL * np.linalg.norm(
         kept["momentum_inertial"][0])
-
-
-def test_deprecated_simulate_variable_warns_and_forwards():
-    body = _swimmer_body(1e-2)
-    t = np.linspace(0.0, PERIOD, 5)
-    with pytest.warns(DeprecationWarning, match="tumble.simulate"):
-        old = simulate_variable(body, [0.3, -1.0, 2.0], t=t, rtol=1e-9, atol=1e-9)
-    new = tumble.simulate(body, [0.3, -1.0, 2.0], t=t, rtol=1e-9, atol=1e-9)
-    np.testing.assert_array_equal(old.q, new.q)
 
 
 def test_documented_example_prints_what_it_claims(capsys):

@@ -33,7 +33,7 @@ __version__ = "0.3.0"
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
 _LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep", "examples", "viewer", "estimation")
+         "robot", "sweep", "sweeps", "examples", "viewer", "estimation")
 
 
 def __getattr__(name):
@@ -68,6 +68,7 @@ __all__ = [
     "slosh",
     "spacecraft",
     "sweep",
+    "sweeps",
     "torques",
     "variable",
     "viewer",

@@ -310,8 +310,8 @@ def sweep_command(
     Running it again on the same store computes only the chunks not yet written. A bad file or a store of
     another sweep is reported on stderr with exit code 2, and nothing is written.
     """
-    from tumble.sweep import sweep_scenario
-    from tumble.sweep.figure import sweep_figure
+    from tumble.sweeps import sweep_scenario
+    from tumble.sweeps.figure import sweep_figure
 
     with _exit_codes():
         spec = scenarios.load(scenario)
@@ -370,7 +370,7 @@ def _sweep_rows(ds) -> list[tuple[str, str]]:
 
 @app.command()
 def info(path: Annotated[Path, typer.Argument(help="NetCDF file written by tumble run / tumble demo, or a Zarr "
-                                                    "store written by tumble sweep or simulate(store=).")]) -> None:
+                                                    "store written by tumble sweep or simulate_to_store.")]) -> None:
     """Print what a trajectory file or a sweep's store holds: times, bodies, method, solver info and drifts.
 
     A trajectory file is validated as it is read (tumble.load): not a regular file, damaged, too large for the
@@ -526,7 +526,7 @@ def _info_store(path: Path) -> None:
             rows = [("store", f"{path}: a sweep, {complete}"), *_sweep_rows(ds)]
         else:
             sizes = ", ".join(f"{name} {size}" for name, size in ds.sizes.items())
-            rows = [("store", f"{path}: a run streamed by simulate(store=)"),
+            rows = [("store", f"{path}: a run streamed by simulate_to_store"),
                     ("model", str(ds.attrs.get("model", "?"))), ("sizes", sizes),
                     ("times", f"{float(ds.time[0]):g} to {float(ds.time[-1]):g} s, {ds.sizes['time']} samples"),
                     ("method", str(ds.attrs.get("method", "?")))]

@@ -53,10 +53,9 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -72,7 +71,7 @@ from tumble.trajectory import Extra, Trajectory, write_atomic
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["Mode", "FlexibleBody", "simulate", "energy", "momentum_body", "slew_torque", "demo_flexible"]
+__all__ = ["Mode", "FlexibleBody", "energy", "momentum_body", "slew_torque", "demo_flexible"]
 
 
 @dataclass(frozen=True)
@@ -226,13 +225,6 @@ class FlexibleBody(Model):
         if not np.any(self.damping_ratios):
             kept["energy"] = traj.energy
         return kept
-
-
-def simulate(fbody: FlexibleBody, omega0: ArrayLike | None = None, **options: Any) -> Trajectory:
-    """Deprecated: ``tumble.simulate(fbody, omega0, **options)``, which it calls (see :class:`FlexibleBody`)."""
-    warnings.warn("tumble.flexible.simulate is deprecated: call tumble.simulate(fbody, omega0, t=..., ...)",
-                  DeprecationWarning, stacklevel=2)
-    return tumble.simulate(fbody, omega0, **options)
 
 
 def _momentum(fbody: FlexibleBody, omega, rate) -> np.ndarray:

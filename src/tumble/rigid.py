@@ -178,6 +178,13 @@ class RigidBodies(RigidMotion):
     def batch_size(self) -> int | None:
         return None if self.inertia.ndim == 2 else self.inertia.shape[0]
 
+    def members(self, lo: int, hi: int) -> RigidBodies:
+        """The bodies ``lo`` to ``hi − 1`` of the batch (a shared body: itself)."""
+        if self.batch_size is None:
+            return self
+        masses = None if self.masses is None else self.masses[lo:hi]
+        return RigidBodies(self.inertia[lo:hi], self.moments[lo:hi], self.axes[lo:hi], masses)
+
     def _principal(self):
         return self.moments, self.axes, self.q_bp
 

@@ -34,7 +34,7 @@ import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple, TypedDict, overload
+from typing import TYPE_CHECKING, Any, NamedTuple, TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -45,8 +45,6 @@ from tumble._vec import norm
 from tumble.trajectory import Extra, Trajectory
 
 if TYPE_CHECKING:
-    import xarray
-
     from tumble.body import RigidBody
     from tumble.torques import TorqueLike
 
@@ -138,6 +136,12 @@ class Model(abc.ABC):
         """Members of a batch carried by the model itself (one inertia per body), or None."""
         return None
 
+    def members(self, lo: int, hi: int) -> Model:
+        """The members ``lo`` to ``hi − 1`` of the model's own batch, a model of the same kind (what the
+        sweeps' chunker runs a chunk on, :mod:`tumble.sweeps.chunks`). A model without a batch of its own is
+        every member's: itself; one with a :attr:`batch_size` overrides this."""
+        return self
+
     @abc.abstractmethod
     def state_fields(self) -> tuple[StateField, ...]:
         """The named parts of the initial state, in the order their defaults may depend on."""
@@ -184,44 +188,6 @@ def as_model(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike) -> Mode
     return RigidBodies.of(model)
 
 
-@overload
-def simulate(
-    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
-    omega0: ArrayLike | None = None,
-    *,
-    t: ArrayLike,
-    method: str = "dop853",
-    dt: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    max_steps: int | None = None,
-    torque: TorqueLike | ArrayLike = None,
-    progress: Callable[[int, int], None] | None = None,
-    device: str = "cpu",
-    store: None = None,
-    **initial_state: ArrayLike | None,
-) -> Trajectory: ...
-
-
-@overload
-def simulate(
-    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
-    omega0: ArrayLike | None = None,
-    *,
-    t: ArrayLike,
-    method: str = "dop853",
-    dt: float | None = None,
-    rtol: float | None = None,
-    atol: float | None = None,
-    max_steps: int | None = None,
-    torque: TorqueLike | ArrayLike = None,
-    progress: Callable[[int, int], None] | None = None,
-    device: str = "cpu",
-    store: str | os.PathLike[str],
-    **initial_state: ArrayLike | None,
-) -> xarray.Dataset: ...
-
-
 def simulate(
     model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
     omega0: ArrayLike | None = None,
@@ -237,7 +203,7 @@ def simulate(
     device: str = "cpu",
     store: str | os.PathLike[str] | None = None,
     **initial_state: ArrayLike | None,
-) -> Trajectory | xarray.Dataset:
+) -> Trajectory:
     """Integrate any model through the output times ``t``: the one front door.
 
     For a rigid body it solves Euler's equations ``I ω̇ + ω × (I ω) = τ``
@@ -274,13 +240,12 @@ def simulate(
     device : {"cpu", "cuda"}
         ``"cuda"``: ``method="rk4"`` batches of rigid bodies on an NVIDIA GPU,
         one thread per body (compiled torque models only; ``docs/gpu.md``).
-    store : path of a Zarr store (a directory that does not exist), optional
-        Run the batch in chunks of members, each written to the store as it
-        completes, and return the run as a lazily opened ``xarray.Dataset``
-        (:mod:`tumble.sweep.stream`): memory bounded by a chunk, not by the
-        batch. Without it, a run whose states and outputs cannot fit in the
-        memory available is refused before they are allocated, with the bytes
-        it needs.
+    store : path of a Zarr store, optional
+        Deprecated (to be removed in 0.4): use
+        :func:`tumble.sweeps.simulate_to_store`, which this then calls and
+        whose ``xarray.Dataset`` it returns. A run whose states and outputs
+        cannot fit in the memory available is refused before they are
+        allocated, with the bytes it needs.
     **initial_state
         The model's initial state by name (:meth:`Model.state_fields`), e.g.
         ``q0`` (unit quaternion ``[w, x, y, z]``, body → inertial, default
@@ -298,12 +263,17 @@ def simulate(
     times = output_times(t)
     if omega0 is not None:
         initial_state["omega0"] = omega0
-    if store is not None:  # streamed in chunks by the layer above, each chunk through this function
-        from tumble.sweep.stream import simulate_to_store
+    if store is not None:
+        warnings.warn("simulate(store=...) is deprecated and will be removed in tumble 0.4: use "
+                      "tumble.sweeps.simulate_to_store(model, ..., store=...), which returns the xarray.Dataset",
+                      DeprecationWarning, stacklevel=2)
+        from tumble.sweeps.stream import simulate_to_store
 
-        return simulate_to_store(model, store, t=times, initial_state=initial_state, progress=progress,
-                                 options=dict(method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
-                                              torque=torque, device=device))
+        state: dict[str, Any] = initial_state  # initial states by name, as simulate_to_store takes them
+        # the deprecated path's Dataset, typed as the supported result
+        return simulate_to_store(model, store=store, t=times, method=method,  # type: ignore[return-value]
+                                 dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque, device=device,
+                                 progress=progress, **state)
     m, options = _solver_options(model, method, dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if device not in ("cpu", "cuda"):
         raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
@@ -365,7 +335,7 @@ _UNCHECKED_BYTES = 2**24
 def _check_memory(n_times: int, y0: np.ndarray) -> None:
     """Refuse a run whose sampled states and outputs (float64, ``n_times × members × (state + 11)`` words)
     exceed the memory available now, before they are allocated: the error says how many bytes and
-    suggests ``store=``. Runs under :data:`_UNCHECKED_BYTES` are not checked."""
+    suggests :func:`tumble.sweeps.simulate_to_store`. Runs under :data:`_UNCHECKED_BYTES` are not checked."""
     members, size = y0.shape
     need = 8 * n_times * members * (size + _OUTPUT_WORDS)
     if need < _UNCHECKED_BYTES:
@@ -375,8 +345,9 @@ def _check_memory(n_times: int, y0: np.ndarray) -> None:
     available = psutil.virtual_memory().available
     if need > available:
         raise ValidationError(f"store: {members} members x {n_times} output times need at least {need:,} bytes "
-                              f"({need / 2**30:.1f} GiB) of memory, more than the {available:,} available; pass "
-                              "store='run.zarr' to stream the run to a Zarr store in chunks")
+                              f"({need / 2**30:.1f} GiB) of memory, more than the {available:,} available; "
+                              "tumble.sweeps.simulate_to_store(..., store='run.zarr') streams it to a Zarr store "
+                              "in chunks")
 
 
 def _describe(torque) -> str:

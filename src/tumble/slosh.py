@@ -59,9 +59,8 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -77,7 +76,7 @@ from tumble.trajectory import Extra, Trajectory, write_atomic
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["Pendulum", "SloshBody", "simulate", "energy", "momentum_body", "nutation_angle",
+__all__ = ["Pendulum", "SloshBody", "energy", "momentum_body", "nutation_angle",
            "in_plane_frequency", "flat_spin_energy", "growth_time_constant", "steady_spin_eigenvalues", "demo_slosh"]
 
 
@@ -197,13 +196,6 @@ class SloshBody(Model):
         if self.pendulum.damping == 0.0:
             kept["energy"] = traj.energy
         return kept
-
-
-def simulate(sbody: SloshBody, omega0: ArrayLike | None = None, **options: Any) -> Trajectory:
-    """Deprecated: ``tumble.simulate(sbody, omega0, **options)``, which it calls (see :class:`SloshBody`)."""
-    warnings.warn("tumble.slosh.simulate is deprecated: call tumble.simulate(sbody, omega0, t=..., direction0=..., "
-                  "...)", DeprecationWarning, stacklevel=2)
-    return tumble.simulate(sbody, omega0, **options)
 
 
 def _totals(sbody: SloshBody, omega, s, nu) -> tuple[np.ndarray, np.ndarray]:

@@ -44,17 +44,12 @@ it is conserved without the outer torquer and friction.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
 
-import tumble
 from tumble import attitude
 from tumble._validate import ValidationError, require_non_negative, require_positive
-from tumble.integrate import METHODS
 from tumble.kernels import gimbal as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory
@@ -202,12 +197,3 @@ class GimbaledGyro(Model):
             if not (self.inner_torque or self.spin_friction):
                 kept["energy"] = traj.energy
         return kept
-
-    def simulate(self, t: ArrayLike, *, spin: float, method: str = "dop853", rtol: float = 1e-12, atol: float = 1e-12,
-                 dt: float | None = None, **initial_state: Any) -> Trajectory:
-        """Deprecated: ``tumble.simulate(gyro, t=t, spin=spin, method=..., ...)``, which it calls."""
-        warnings.warn("GimbaledGyro.simulate is deprecated: call tumble.simulate(gyro, t=..., spin=..., ...)",
-                      DeprecationWarning, stacklevel=2)
-        options: dict[str, Any] = {name: value for name, value in dict(rtol=rtol, atol=atol, dt=dt).items()
-                   if method not in METHODS or name in METHODS[method].options}
-        return tumble.simulate(self, t=t, spin=spin, method=method, **options, **initial_state)

@@ -53,14 +53,11 @@ conserved.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 import numpy as np
-from numpy.typing import ArrayLike
 
-import tumble
 from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError, require_non_negative, require_positive
 from tumble.analytic import AxisMotion, HeavyTop, axis_motion
@@ -219,15 +216,6 @@ class Gyroscope(Model):
             return {}
         return {"energy": traj.energy, "momentum_vertical": traj.momentum_inertial[..., 2],
                 "momentum_axial": traj.momentum_body[..., 2]}
-
-    def simulate(self, t: ArrayLike, *, released: bool = True, rtol: float = 1e-12, atol: float = 1e-12) -> Trajectory:
-        """Deprecated: ``tumble.simulate(gyro, t=t, precession_rate0=..., rtol=rtol, atol=atol)``, which it calls
-        (``released=False``: ``precession_rate0=gyro.steady_precession_rate``)."""
-        warnings.warn("Gyroscope.simulate is deprecated: call tumble.simulate(gyro, t=..., precession_rate0=...) "
-                      "(0: released at rest; gyro.steady_precession_rate: steady precession)",
-                      DeprecationWarning, stacklevel=2)
-        return tumble.simulate(self, t=t, precession_rate0=0.0 if released else self.steady_precession_rate,
-                               rtol=rtol, atol=atol)
 
     def axis(self, trajectory: Trajectory) -> AxisMotion:
         """Azimuth φ, tilt θ, their rates and the spin of the axis along a simulation (``analytic.axis_motion``)."""

@@ -18,10 +18,6 @@ See ``docs/robot.md`` for the conventions (frames, DH variants, units).
 
 from __future__ import annotations
 
-import warnings
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
-
 from tumble.robot.chain import SerialChain, load
 from tumble.robot.dynamics import (
     coriolis,
@@ -46,40 +42,10 @@ from tumble.robot.space import space_manipulator
 from tumble.robot.tree import RobotTree
 from tumble.robot.urdf import UrdfRepairWarning
 
-if TYPE_CHECKING:
-    import numpy as np
-    from numpy.typing import ArrayLike
-
-    from tumble.trajectory import Trajectory
-
 __all__ = [
     "Link", "Frame", "RobotTree", "SerialChain", "load", "space_manipulator", "UrdfRepairWarning",
     "frame_poses", "frame_pose", "frame_jacobian", "center_of_mass", "centroidal_momentum_matrix",
     "centroidal_momentum",
     "rnea", "gravity_torques", "coriolis", "mass_matrix", "forward_dynamics",
     "link_poses", "kinetic_energy", "potential_energy",
-    "simulate",
 ]
-
-
-def simulate(chain: RobotTree, q0: ArrayLike, qd0: ArrayLike, *, t: ArrayLike,
-             torque: ArrayLike | Callable[[float, np.ndarray, np.ndarray], ArrayLike] | None = None,
-             method: str = "rk4", dt: float | None = None, rtol: float = 1e-10, atol: float = 1e-12,
-             gravity: ArrayLike | None = None, max_steps: int | None = None) -> Trajectory:
-    """Deprecated: use ``tumble.simulate(chain, q0=q0, qd0=qd0, t=t, ...)``, which this forwards to.
-
-    ``gravity`` (m/s², base frame) runs ``chain.with_gravity(gravity)``; of
-    ``dt``, ``rtol``, ``atol`` and ``max_steps`` only those ``method`` reads
-    are passed on. Returns a :class:`tumble.Trajectory`.
-    """
-    import tumble
-    from tumble.integrate import METHODS
-
-    warnings.warn("tumble.robot.simulate is deprecated: use tumble.simulate(chain, q0=..., qd0=..., t=...)",
-                  DeprecationWarning, stacklevel=2)
-    if gravity is not None:
-        chain = chain.with_gravity(gravity)
-    given: dict[str, Any] = {"dt": dt, "rtol": rtol, "atol": atol, "max_steps": max_steps}
-    reads = METHODS[method].options if method in METHODS else ()
-    return tumble.simulate(chain, q0=q0, qd0=qd0, t=t, torque=torque, method=method,
-                           **{name: given[name] for name in reads})

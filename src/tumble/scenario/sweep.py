@@ -28,7 +28,7 @@ solver and the torques are shared by every sample, so ``time``, ``solver``
 and ``torque`` keys are refused. Each dispersion is one of ``normal = {mean,
 std}``, ``uniform = {low, high}``, ``truncated_normal = {mean, std, low,
 high}``, ``grid = [values]``, ``uniform_attitude = true``, ``inertia =
-{moments, std, angle, truncation}`` (:class:`tumble.sweep.Inertia`) and
+{moments, std, angle, truncation}`` (:class:`tumble.sweeps.Inertia`) and
 ``misalignment = {axes, angle}`` (rad). An outcome or a series names a series
 (``pointing_error`` with a ``target`` quaternion, ``nutation_angle`` with a
 body ``axis``, ``component`` with a ``name`` and ``index``); an outcome adds
@@ -49,9 +49,9 @@ from tumble._validate import ValidationError, as_array
 from tumble.scenario._errors import ScenarioError, in_file
 from tumble.scenario._run import Run
 from tumble.scenario._values import _Bool, _Number, _Table, _Text
-from tumble.sweep import dispersions as _d
-from tumble.sweep import outcomes as _o
-from tumble.sweep.plan import store_name_problem
+from tumble.sweeps import dispersions as _d
+from tumble.sweeps import outcomes as _o
+from tumble.sweeps.plan import store_name_problem
 
 if TYPE_CHECKING:
     import numpy as np
@@ -68,7 +68,7 @@ _SHARED = ("time", "solver", "torque")
 
 
 class DispersionTable(_Table):
-    """One dispersed key: exactly one of the forms of :mod:`tumble.sweep.dispersions`."""
+    """One dispersed key: exactly one of the forms of :mod:`tumble.sweeps.dispersions`."""
 
     normal: dict | None = None
     uniform: dict | None = None
@@ -101,7 +101,7 @@ class DispersionTable(_Table):
 
 
 class SeriesTable(_Table):
-    """A series (:mod:`tumble.sweep.outcomes`), and for an outcome how it is reduced."""
+    """A series (:mod:`tumble.sweeps.outcomes`), and for an outcome how it is reduced."""
 
     series: Literal["pointing_error", "nutation_angle", "component"]
     target: list[_Number] | None = None

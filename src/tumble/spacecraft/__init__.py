@@ -20,12 +20,12 @@ gravity-gradient regions, nutation damper): ``docs/passive_stability.md``.
 from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, ReactionWheel, Thruster, pyramid_wheels
 from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MRPFeedback, PythonLaw, QuaternionPD,
                                        RateDamping, WheelTorques)
-from tumble.spacecraft.damper import SphericalDamper, simulate_damped
+from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
 from tumble.spacecraft.flight_software import FlightSoftware
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
-from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft, simulate
+from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.spacecraft.passive import gravity_gradient_stability, gravity_gradient_stability_figure, spin_stability
 from tumble.spacecraft.tle import TLE
@@ -37,5 +37,5 @@ __all__ = [
     "SaturationWarning", "SingularityWarning", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE", "Thruster",
     "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",
-    "pyramid_wheels", "save_spacecraft_figure", "simulate", "simulate_damped", "spacecraft_figure", "spin_stability",
+    "pyramid_wheels", "save_spacecraft_figure", "spacecraft_figure", "spin_stability",
 ]

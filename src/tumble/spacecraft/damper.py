@@ -43,30 +43,21 @@ axis, ``I_s < I_t``, the Explorer 1 case); ``τ < 0``: it decays (major axis).
 from __future__ import annotations
 
 import math
-import warnings
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.body import RigidBody
 from tumble.kernels.spacecraft import damper as _kernel
 from tumble.kernels.spacecraft._base import Program
-from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
-
-if TYPE_CHECKING:
-    from tumble.torques import TorqueLike
 
 __all__ = [
     "SphericalDamper",
     "energy_sink_time_constant",
     "measured_time_constant",
     "nutation_angle",
-    "simulate_damped",
 ]
 
 
@@ -97,28 +88,6 @@ class SphericalDamper:
 
     def _program(self) -> Program:
         return _kernel.program(self.inertia, self.damping)
-
-
-def simulate_damped(body: RigidBody, damper: SphericalDamper, omega0: ArrayLike, *, t: ArrayLike,
-                    q0: ArrayLike | None = None, damper_omega0: ArrayLike | None = None, method: str = "dop853",
-                    rtol: float | None = None, atol: float | None = None, dt: float | None = None,
-                    torque: TorqueLike = None, max_steps: int | None = None,
-                    progress: Callable[[int, int], None] | None = None) -> Trajectory:
-    """Deprecated: ``tumble.simulate(Spacecraft(hub=body, damper=damper), omega0, ...)`` (the same run).
-
-    ``body`` is the hub without the sphere; the result is the trajectory of
-    the spacecraft (hub and sphere: ``traj.energy``, ``traj.momentum_inertial``).
-    """
-    warnings.warn("tumble.spacecraft.simulate_damped is deprecated: use tumble.simulate(Spacecraft(hub=body, "
-                  "damper=damper), omega0, damper_omega0=..., ...)", DeprecationWarning, stacklevel=2)
-    from tumble.spacecraft.model import Spacecraft  # the spacecraft builds on this module
-
-    if not isinstance(body, RigidBody):
-        raise ValidationError(f"body: must be a RigidBody (the hub, without the damper), got {type(body).__name__}")
-    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("damper_omega0", damper_omega0))
-                               if value is not None}
-    return simulate(Spacecraft(hub=body, damper=damper), omega0, t=t, method=method, rtol=rtol, atol=atol, dt=dt,
-                    max_steps=max_steps, torque=torque, progress=progress, **initial)
 
 
 def nutation_angle(traj: Trajectory, axis: ArrayLike) -> np.ndarray:

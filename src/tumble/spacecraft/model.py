@@ -49,7 +49,6 @@ from tumble.kernels.spacecraft import thrusters as _thrusters
 from tumble.kernels.spacecraft import wheels as _wheels
 from tumble.kernels.spacecraft._base import Program
 from tumble.simulate import Model, Outputs, StateField
-from tumble.simulate import simulate as _simulate
 from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, ReactionWheel, Thruster
 from tumble.spacecraft.control import DIPOLE_LAWS, TORQUE_LAWS, MomentumDumping, MRPFeedback, PythonLaw, WheelTorques
 from tumble.spacecraft.damper import SphericalDamper
@@ -61,7 +60,7 @@ from tumble.spacecraft.orbit import EARTH_MU, Orbit
 from tumble.spacecraft.surfaces import Drag, SolarPressure
 from tumble.trajectory import Extra, Trajectory
 
-__all__ = ["Spacecraft", "SaturationWarning", "SingularityWarning", "simulate"]
+__all__ = ["Spacecraft", "SaturationWarning", "SingularityWarning"]
 
 # A whole number of steps per control period or output interval to this relative tolerance.
 _WHOLE = 1e-9
@@ -612,18 +611,3 @@ def _check_items(values, cls, name):
     for i, value in enumerate(values):
         if not isinstance(value, cls):
             raise ValidationError(f"{name}[{i}]: must be a {cls.__name__}, got {type(value).__name__}")
-
-
-def simulate(spacecraft: Spacecraft, omega0: ArrayLike, *, t: ArrayLike, q0: ArrayLike | None = None,
-             wheel_speeds0: ArrayLike | None = None, gimbal_angles0: ArrayLike | None = None, method: str = "rk4",
-             dt: float | None = None, rtol: float | None = None, atol: float | None = None,
-             max_steps: int | None = None, progress: Callable[[int, int], None] | None = None) -> Trajectory:
-    """Deprecated: ``tumble.simulate(spacecraft, omega0, t=..., method="rk4", dt=..., ...)`` (the same run)."""
-    warnings.warn("tumble.spacecraft.simulate is deprecated: use tumble.simulate(spacecraft, omega0, t=..., "
-                  "method='rk4', dt=..., ...)", DeprecationWarning, stacklevel=2)
-    if not isinstance(spacecraft, Spacecraft):
-        raise ValidationError(f"spacecraft: must be a Spacecraft, got {type(spacecraft).__name__}")
-    initial: dict[str, Any] = {name: value for name, value in (("q0", q0), ("wheel_speeds0", wheel_speeds0),
-                                                ("gimbal_angles0", gimbal_angles0)) if value is not None}
-    return _simulate(spacecraft, omega0, t=t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
-                     progress=progress, **initial)

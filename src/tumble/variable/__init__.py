@@ -19,7 +19,5 @@ segment model of a human body, the twisting somersault;
 
 from tumble.variable.body import VariableBody, angular_velocity, shape_power
 from tumble.variable.human import Human, Motion, MovingHuman, Segment
-from tumble.variable.simulate import simulate_variable
 
-__all__ = ["Human", "Motion", "MovingHuman", "Segment", "VariableBody", "angular_velocity", "shape_power",
-           "simulate_variable"]
+__all__ = ["Human", "Motion", "MovingHuman", "Segment", "VariableBody", "angular_velocity", "shape_power"]

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 
 import tumble
-from tumble.sweep import Grid, sweep
+from tumble.sweeps import Grid, sweep
 
 if TYPE_CHECKING:
     import xarray

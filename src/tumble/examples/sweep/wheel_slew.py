@@ -6,9 +6,9 @@ rad/s slew-rate limit, controller sampled at 2 Hz) slews 60° about z. Each
 sample disperses
 
 * the inertia: principal moments N(m, (2 %)²) truncated at 3σ, principal axes
-  turned by a small rotation of 1° per axis (:class:`tumble.sweep.Inertia`);
+  turned by a small rotation of 1° per axis (:class:`tumble.sweeps.Inertia`);
 * each wheel's spin axis: tilted by a Rayleigh angle of scale 0.5°
-  (:class:`tumble.sweep.Misalignment`); the spacecraft model allocates the
+  (:class:`tumble.sweeps.Misalignment`); the spacecraft model allocates the
   command with the wheels' actual axes (it has no separate estimate of them),
   so the misalignment acts through the wheels' momentum directions;
 * the initial body rate: N(0, (1 mrad/s)²) per axis;
@@ -32,13 +32,13 @@ import numpy as np
 import tumble
 from tumble.spacecraft import QuaternionPD, ReactionWheel, Spacecraft
 from tumble.spacecraft.actuators import pyramid_wheels
-from tumble.sweep import Final, Inertia, Misalignment, Normal, PointingError, sweep
+from tumble.sweeps import Final, Inertia, Misalignment, Normal, PointingError, sweep
 
 if TYPE_CHECKING:
     import xarray
     from numpy.typing import ArrayLike
 
-    from tumble.sweep import Dispersion
+    from tumble.sweeps import Dispersion
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])  # kg m², total, body axes
 NOMINAL = pyramid_wheels(0.02, max_torque=0.05, max_speed=600.0, viscous=1e-5)
@@ -79,7 +79,7 @@ def main(samples: int = 1000, figure: str | os.PathLike[str] | None = None) -> x
           f"95th percentile {math.degrees(p[95.0]):.4g}, 99th percentile {math.degrees(p[99.0]):.4g}, "
           f"max {math.degrees(error.max()):.4g}")
     if figure:
-        from tumble.sweep.figure import sweep_figure
+        from tumble.sweeps.figure import sweep_figure
 
         fig = sweep_figure(ds, title="60° slew, 4 wheels: dispersed inertia, wheel axes, initial rates",
                            units={"final_pointing_error": "rad", "pointing_error": "rad"})

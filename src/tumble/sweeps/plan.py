@@ -4,7 +4,7 @@ A :class:`Plan` is a plain, picklable value: the model (or a function that
 builds one from dispersed parameters), the dispersions, the seed, the output
 times and solver options, and the outcome and series functions. A Dask task
 calls :meth:`Plan.run` on a chunk ``[lo, hi)`` of samples; it draws the
-samples' inputs from their own part of the random stream (:func:`tumble.sweep.dispersions.sample_uniforms`),
+samples' inputs from their own part of the random stream (:func:`tumble.sweeps.dispersions.sample_uniforms`),
 simulates the chunk as **one batch** where the model allows it, and reduces
 the batched trajectory to per-sample outcomes and series. Nothing in a chunk's
 result depends on the chunk's bounds: sample ``i`` is a function of ``(seed,
@@ -42,8 +42,9 @@ from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.rigid import RigidBodies
 from tumble.simulate import Model, as_model, simulate
-from tumble.sweep.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_uniforms
-from tumble.sweep.outcomes import describe
+from tumble.sweeps.chunks import Chunks
+from tumble.sweeps.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_uniforms
+from tumble.sweeps.outcomes import describe
 from tumble.trajectory import Extra, Trajectory
 
 if TYPE_CHECKING:
@@ -68,16 +69,16 @@ class ChunkResult:
 
 @dataclass(frozen=True)
 class Plan:
-    """A sweep, fully described (see the module docstring); made and checked by :func:`tumble.sweep.sweep`.
+    """A sweep, fully described (see the module docstring); made and checked by :func:`tumble.sweeps.sweep`.
 
     model       : a :class:`~tumble.simulate.Model` (or what :func:`~tumble.simulate.as_model` takes), or a
                   function ``build(**parameters) -> Model`` of the dispersed parameters
-    dispersions : name → :class:`~tumble.sweep.dispersions.Dispersion`, in drawing order
+    dispersions : name → :class:`~tumble.sweeps.dispersions.Dispersion`, in drawing order
     states      : the dispersed names that are initial states of the model (the others are parameters)
     fixed       : initial states given as one value shared by every sample
     seed, samples, chunk : the random seed, the number of samples, the samples per chunk (a Dask task)
     t, method, options, torque : the arguments of :func:`tumble.simulate`
-    outcomes, series : name → function of a chunk's trajectory (:mod:`tumble.sweep.outcomes`)
+    outcomes, series : name → function of a chunk's trajectory (:mod:`tumble.sweeps.outcomes`)
     trajectories : keep every sample's trajectory (``q``, ``omega``, the extras and totals) too
     """
 
@@ -103,12 +104,10 @@ class Plan:
     # -- what sample i is -------------------------------------------------------------
 
     @property
-    def n_chunks(self) -> int:
-        return math.ceil(self.samples / self.chunk)
-
-    def bounds(self, k: int) -> tuple[int, int]:
-        """The samples ``[lo, hi)`` of chunk ``k``."""
-        return k * self.chunk, min(self.samples, (k + 1) * self.chunk)
+    def chunks(self) -> Chunks:
+        """The samples cut into chunks of :attr:`chunk` (:mod:`tumble.sweeps.chunks`): chunk ``k`` is a Dask
+        task."""
+        return Chunks(self.samples, self.chunk)
 
     def inputs(self, lo: int, hi: int) -> dict[str, np.ndarray]:
         """The dispersed inputs of samples ``lo`` to ``hi − 1`` (name → (m, *shape)), each a function of
@@ -127,7 +126,7 @@ class Plan:
 
     def run(self, k: int) -> ChunkResult:
         """Simulate chunk ``k`` and reduce it (what a Dask task does)."""
-        lo, hi = self.bounds(k)
+        lo, hi = self.chunks.bounds(k)
         inputs = self.inputs(lo, hi)
         traj = self.simulate(inputs)
         m = hi - lo
@@ -283,7 +282,7 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
               outcomes: dict[str, Callable[[Trajectory], np.ndarray]],
               series: dict[str, Callable[[Trajectory], np.ndarray]], fixed: Mapping[str, ArrayLike],
               trajectories: bool = False, parallel: int = 1) -> Plan:
-    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweep.sweep`); ``parallel``: the
+    """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweeps.sweep`); ``parallel``: the
     chunks the cluster runs at once (for the default chunk)."""
     if not isinstance(dispersions, Mapping):
         raise ValidationError(f"dispersions: must be a mapping of name -> dispersion, got {type(dispersions).__name__}")
@@ -319,7 +318,7 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
 def _sizes(dispersions: dict, samples, chunk, n_times: int, parallel: int) -> tuple[int, int]:
     """The number of samples (default: one per grid point when every dispersion is a grid) and the chunk
     (default: the samples shared evenly between ``parallel`` workers, and at most
-    :data:`tumble.ensemble.SAMPLES_PER_CHUNK` body-samples, the ensemble's memory budget)."""
+    :data:`~tumble.sweeps.chunks.SAMPLES_PER_CHUNK` member-samples, :meth:`tumble.sweeps.chunks.Chunks.of`)."""
     if samples is None:
         if not any(isinstance(d, Grid) for d in dispersions.values()) or any(d.n_raw for d in dispersions.values()):
             raise ValidationError("samples: needed unless every dispersion is a grid (then one sample per point)")
@@ -327,13 +326,7 @@ def _sizes(dispersions: dict, samples, chunk, n_times: int, parallel: int) -> tu
     samples = int(samples)
     if samples < 1:
         raise ValidationError(f"samples: must be >= 1, got {samples}")
-    if chunk is None:
-        from tumble.ensemble import SAMPLES_PER_CHUNK
-
-        chunk = max(1, min(math.ceil(samples / parallel), SAMPLES_PER_CHUNK // n_times))
-    if int(chunk) < 1:
-        raise ValidationError(f"chunk: must be >= 1 sample, got {chunk}")
-    return samples, int(chunk)
+    return samples, Chunks.of(samples, chunk, n_times=n_times, parallel=parallel).size
 
 
 def _parameters(model, dispersions: dict) -> set:
@@ -369,12 +362,12 @@ def _check_inertia(d: Dispersion) -> None:
     if isinstance(d, Grid) and d.shape == (3, 3):
         principal_axes(d.points, "dispersions['inertia']")
     elif not isinstance(d, Inertia):
-        raise ValidationError(f"dispersions['inertia']: must be a tumble.sweep.Inertia (it stays physical) or a "
+        raise ValidationError(f"dispersions['inertia']: must be a tumble.sweeps.Inertia (it stays physical) or a "
                               f"Grid of (3, 3) tensors (kg m^2), got {type(d).__name__} of shape {d.shape}")
 
 
 #: Names of the store's own variables and dimensions, and the suffixes of the variables it derives from an
-#: outcome or a series (:mod:`tumble.sweep.store`): no outcome or series may take them.
+#: outcome or a series (:mod:`tumble.sweeps.store`): no outcome or series may take them.
 STORE_NAMES = ("sample", "time", "percentile", "chunk", "done")
 DERIVED_SUFFIXES = ("_percentiles", "_count", "_mean", "_std", "_min", "_max")
 

@@ -6,7 +6,7 @@ whole chunk is reduced at once:
 
 * a **series** ``f(traj) -> (n, m)``: one number per output time and sample
   (its per-time statistics and percentile bands are kept, ``statistics=`` of
-  :func:`tumble.sweep.sweep`);
+  :func:`tumble.sweeps.sweep`);
 * an **outcome** ``f(traj) -> (m,)`` or ``(m, ...)``: one value (or array) per
   sample (``outcomes=``).
 

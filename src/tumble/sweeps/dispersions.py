@@ -357,6 +357,6 @@ def as_dispersion(value: Dispersion | ArrayLike, name: str) -> Dispersion:
     except ValidationError as exc:
         raise ValidationError(f"dispersions[{name!r}]: {exc.rule}") from None
     except (TypeError, ValueError):
-        raise ValidationError(f"dispersions[{name!r}]: must be a tumble.sweep dispersion (Normal, Uniform, "
+        raise ValidationError(f"dispersions[{name!r}]: must be a tumble.sweeps dispersion (Normal, Uniform, "
                               f"TruncatedNormal, Grid, UniformAttitude, Inertia, Misalignment, NoiseSeed) or a "
                               f"fixed value, got {type(value).__name__}") from None

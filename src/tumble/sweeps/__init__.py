@@ -1,7 +1,12 @@
 """Monte-Carlo and parameter sweeps of any model of :func:`tumble.simulate`, on Dask, streamed to Zarr.
 
+The package holds the chunker (:mod:`tumble.sweeps.chunks`), the dispersions,
+the outcomes, the stores and the Dask runner; its function :func:`sweep` is
+also ``tumble.sweep``, and :func:`simulate_to_store` streams a batch larger
+than memory to a Zarr store.
+
     >>> import numpy as np, tumble
-    >>> from tumble.sweep import Normal, UniformAttitude, NutationAngle, Final
+    >>> from tumble.sweeps import Normal, UniformAttitude, NutationAngle, Final
     >>> ds = tumble.sweep(tumble.RigidBody(np.diag([1.0, 2.0, 3.0])),
     ...                   {"omega0": Normal([0.0, 0.0, 1.0], 0.05), "q0": UniformAttitude()},
     ...                   samples=10_000, seed=1, t=np.linspace(0, 10, 101), method="rk4", dt=0.01,
@@ -10,12 +15,12 @@
 
 Sample ``i`` draws its dispersed inputs from its own part of one
 counter-based random stream keyed by ``SeedSequence(seed)``
-(:func:`tumble.sweep.dispersions.sample_uniforms`), so
+(:func:`tumble.sweeps.dispersions.sample_uniforms`), so
 every input and result of sample ``i`` depends on ``(seed, i)`` alone, never
 on the chunk size or the number of workers. The samples run in chunks, one
 Dask task per chunk, each chunk one batched call of :func:`tumble.simulate`
-where the model allows it (:mod:`tumble.sweep.plan`); the results are written
-to a Zarr store as the chunks complete (:mod:`tumble.sweep.store`) and a
+where the model allows it (:mod:`tumble.sweeps.plan`); the results are written
+to a Zarr store as the chunks complete (:mod:`tumble.sweeps.store`) and a
 sweep run again on the same store resumes, computing only what is missing.
 See ``docs/sweeps.md``.
 """
@@ -23,14 +28,12 @@ See ``docs/sweeps.md``.
 from __future__ import annotations
 
 import os
-import sys
-import types
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
 from tumble._validate import ValidationError, output_times, require_memory
 from tumble.simulate import _solver_options, as_model
-from tumble.sweep.dispersions import (
+from tumble.sweeps.dispersions import (
     Dispersion,
     Grid,
     Inertia,
@@ -41,7 +44,7 @@ from tumble.sweep.dispersions import (
     Uniform,
     UniformAttitude,
 )
-from tumble.sweep.outcomes import (
+from tumble.sweeps.outcomes import (
     Component,
     CrossingTime,
     Final,
@@ -50,9 +53,10 @@ from tumble.sweep.outcomes import (
     PointingError,
     SettlingTime,
 )
-from tumble.sweep.plan import _is_builder, make_plan
-from tumble.sweep.runner import local_cluster, run_chunks
-from tumble.sweep.store import StoreMismatchError, SweepStore, stored_chunk, writing
+from tumble.sweeps.plan import _is_builder, make_plan
+from tumble.sweeps.runner import local_cluster, run_chunks
+from tumble.sweeps.store import StoreMismatchError, SweepStore, stored_chunk, writing
+from tumble.sweeps.stream import simulate_to_store
 
 if TYPE_CHECKING:
     import xarray
@@ -64,7 +68,8 @@ if TYPE_CHECKING:
     from tumble.simulate import Model
     from tumble.torques import TorqueLike
 
-__all__ = ["sweep", "sweep_scenario", "open_sweep", "local_cluster", "StoreMismatchError", "Dispersion", "Normal",
+__all__ = ["sweep", "sweep_scenario", "open_sweep", "simulate_to_store", "local_cluster", "StoreMismatchError",
+           "Dispersion", "Normal",
            "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
            "Component", "Max", "Final", "SettlingTime", "CrossingTime"]
@@ -119,7 +124,7 @@ def sweep(
     t, method, dt, rtol, atol, max_steps, torque
         As :func:`tumble.simulate` (output times in s; the options the method reads).
     outcomes : mapping name → ``f(traj) -> (m, ...)``
-        Per-sample results from a chunk's batched trajectory (:mod:`tumble.sweep.outcomes`).
+        Per-sample results from a chunk's batched trajectory (:mod:`tumble.sweeps.outcomes`).
     statistics : mapping name → ``f(traj) -> (n, m)``
         Series kept per sample and output time, with their per-time mean, std,
         min, max and ``percentiles``.
@@ -133,7 +138,7 @@ def sweep(
         Samples per Dask task. Default: the samples shared evenly between the
         workers (``ceil(samples / W)``, ``W`` the cluster's worker threads; 1
         with ``workers=0``), so that a small sweep uses every worker, and at
-        most ``tumble.ensemble.SAMPLES_PER_CHUNK`` body-samples (a chunk's run
+        most :data:`tumble.sweeps.chunks.SAMPLES_PER_CHUNK` member-samples (a chunk's run
         takes about 200 MB); resuming a store, the store's.
     store : path of a Zarr store (directory), or None
         Where the results are written as they come; an existing store of the
@@ -224,19 +229,9 @@ def open_sweep(path: str | os.PathLike[str]) -> xarray.Dataset:
     """The sweep stored at ``path`` as an :class:`xarray.Dataset`, opened lazily (Dask arrays)."""
     import xarray as xr
 
-    from tumble.sweep.store import SETTINGS_ATTR
+    from tumble.sweeps.store import SETTINGS_ATTR
 
     ds = xr.open_zarr(path, consolidated=False, zarr_format=3)
     if SETTINGS_ATTR not in ds.attrs:
         raise ValidationError(f"path: {path} is not a tumble sweep store")
     return ds
-
-
-class _SweepModule(types.ModuleType):
-    """``tumble.sweep`` is both this package and its function: ``tumble.sweep(model, ...)`` calls :func:`sweep`."""
-
-    def __call__(self, *args, **kwargs):
-        return sweep(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _SweepModule

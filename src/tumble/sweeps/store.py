@@ -27,9 +27,9 @@ chunk marked done has its file in every per-sample array, and computes again
 a chunk whose file is gone (every chunk is written, even one whose values are
 all the fill value, NaN, so a missing file is always a lost chunk).
 
-The sweep's settings (:meth:`tumble.sweep.plan.Plan.settings`) are the
+The sweep's settings (:meth:`tumble.sweeps.plan.Plan.settings`) are the
 group's attribute ``tumble_sweep``, and a digest of its whole content
-(:meth:`~tumble.sweep.plan.Plan.digest`: the model's data, a tabulated
+(:meth:`~tumble.sweeps.plan.Plan.digest`: the model's data, a tabulated
 torque's values, a scenario's every table, ...) the attribute
 ``tumble_sweep_digest``; a store written with other settings or content is
 refused with :class:`StoreMismatchError`, naming the first setting that
@@ -43,7 +43,7 @@ half-made store; holding the lock, a writer removes the temporaries that a
 killed run left (:func:`writing`).
 
 The per-time statistics merge the chunks' moments in chunk order with
-:mod:`tumble.ensemble`'s exact pairwise update (Chan, Golub & LeVeque 1979),
+:mod:`tumble.sweeps.moments`' exact pairwise update (Chan, Golub & LeVeque 1979),
 so they are the same bit for bit whatever the number of workers or the order
 in which chunks finished; the percentiles are exact (``numpy.percentile``,
 linear interpolation), read from the stored series in blocks of output times,
@@ -51,8 +51,8 @@ each block's times shared between threads (one per core: NumPy's partition
 releases the GIL, and each time's percentiles are computed alone, so they are
 the same whatever the split).
 An outcome is NaN where its event did not happen within the run (a
-:class:`~tumble.sweep.CrossingTime` never crossed, a
-:class:`~tumble.sweep.SettlingTime` not settled at the end): its percentiles
+:class:`~tumble.sweeps.CrossingTime` never crossed, a
+:class:`~tumble.sweeps.SettlingTime` not settled at the end): its percentiles
 are those of the samples with a value (``numpy.nanpercentile``; NaN when none
 has one), and ``OUTCOME_count`` says how many of the samples that is.
 """
@@ -74,8 +74,8 @@ if TYPE_CHECKING:
     import zarr
 
 from tumble._validate import ValidationError
-from tumble.ensemble import STATISTICS, _merge, moments
-from tumble.sweep.plan import ChunkResult, Plan
+from tumble.sweeps.moments import STATISTICS, merge, moments, summary
+from tumble.sweeps.plan import ChunkResult, Plan
 
 __all__ = ["SweepStore", "StoreMismatchError", "stored_chunk", "temporary", "writing", "SETTINGS_ATTR", "DIGEST_ATTR",
            "COMPLETE_ATTR"]
@@ -148,7 +148,7 @@ class SweepStore:
         self._memory: xarray.Dataset | None = None  # the store when path is None, once made
         self._writable: zarr.Group | None = None  # the group open for writing once the store exists, and its arrays
         self._arrays: dict[str, zarr.Array] = {}
-        self._done = np.zeros(plan.n_chunks, dtype=bool)
+        self._done = np.zeros(len(plan.chunks), dtype=bool)
         if self.path is not None and os.path.exists(self.path):
             self._check()
 
@@ -254,7 +254,7 @@ class SweepStore:
         for name, v in first.trajectories.items():
             variables[name] = (("sample", "time", *(f"{name}_dim{k}" for k in range(v.ndim - 2))),
                                (s, *v.shape[1:]), np.dtype(np.float64))
-        variables["done"] = ("chunk",), (plan.n_chunks,), np.dtype(bool)
+        variables["done"] = ("chunk",), (len(plan.chunks),), np.dtype(bool)
         coords = {"sample": np.arange(s), "time": ("time", plan.t, {"units": "s"})}
         # as Zarr's JSON gives them back: lists for tuples
         attrs = json.loads(json.dumps({SETTINGS_ATTR: plan.settings(), DIGEST_ATTR: self._digest(),
@@ -314,13 +314,11 @@ class SweepStore:
         for name in plan.series:
             series = self._array(name)
             stats: list[np.ndarray] | None = None
-            for k in range(plan.n_chunks):
-                lo, hi = plan.bounds(k)
+            for lo, hi in plan.chunks:
                 part = moments(series[lo:hi].T)
-                stats = part if stats is None else _merge(stats, part)
+                stats = part if stats is None else merge(stats, part)
             assert stats is not None  # a sweep has at least one chunk
-            count, mean, m2, low, high = stats
-            for stat, value in zip(STATISTICS, (mean, np.sqrt(m2 / count), low, high), strict=True):
+            for stat, value in zip(STATISTICS, summary(stats), strict=True):
                 data[f"{name}_{stat}"] = ("time", value)
             block = max(1, _BLOCK_WORDS // plan.samples)
             bands = [_percentiles(series[:, a:a + block], p) for a in range(0, len(plan.t), block)]

@@ -32,8 +32,8 @@ from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from tumble._validate import ValidationError
-from tumble.sweep.plan import Plan
-from tumble.sweep.store import SweepStore
+from tumble.sweeps.plan import Plan
+from tumble.sweeps.store import SweepStore
 
 if TYPE_CHECKING:
     from distributed import Client, LocalCluster
@@ -138,7 +138,7 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
     from distributed import Client, as_completed
 
     missing = store.missing()
-    total = plan.n_chunks
+    total = len(plan.chunks)
     if progress is not None:
         progress(total - len(missing), total)
     if not missing:

@@ -1,14 +1,14 @@
-"""``tumble.simulate(..., store="run.zarr")``: a batch larger than memory, run in chunks and streamed to Zarr.
+"""A batch larger than memory, run in chunks and streamed to a Zarr store: :func:`simulate_to_store`.
 
-The batch's members are cut into chunks of ``chunk`` members; each chunk is
-one :func:`tumble.simulate` call (in parallel over the cores, as any batch)
-whose trajectory (:meth:`tumble.Trajectory.to_xarray`: ``q``, ``omega``, the
-extras and the totals, dimensions ``(time, body, ...)``) is written to the
-store's region of those members before the next chunk starts. The peak memory
-is that of one chunk (about 400 bytes per member and output time, plus the
-compressor's buffers), whatever the batch. The store is written under a
-temporary name and renamed onto ``store`` when complete, so the name never
-points at a half-written run; the result opens lazily with xarray
+The batch's members are cut into chunks (:mod:`tumble.sweeps.chunks`); each
+chunk is one :func:`tumble.simulate` call (in parallel over the cores, as any
+batch) whose trajectory (:meth:`tumble.Trajectory.to_xarray`: ``q``,
+``omega``, the extras and the totals, dimensions ``(time, body, ...)``) is
+written to the store's region of those members before the next chunk starts.
+The peak memory is that of one chunk (about 400 bytes per member and output
+time, plus the compressor's buffers), whatever the batch. The store is written
+under a temporary name and renamed onto ``store`` when complete, so the name
+never points at a half-written run; the result opens lazily with xarray
 (:func:`xarray.open_zarr`), chunked by member as written. The solver
 statistics ``n_steps``, ``n_rejected`` and ``n_rhs`` are summed over the
 chunks (as they are over a batch).
@@ -19,15 +19,14 @@ from __future__ import annotations
 import os
 import shutil
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tumble._validate import ValidationError
-from tumble.ensemble import SAMPLES_PER_CHUNK
-from tumble.rigid import RigidBodies
-from tumble.simulate import as_model, simulate
-from tumble.sweep.store import temporary, writing
+from tumble._validate import ValidationError, output_times
+from tumble.simulate import as_model
+from tumble.sweeps.chunks import Chunks, batch_members, simulate_chunks
+from tumble.sweeps.store import temporary, writing
 
 if TYPE_CHECKING:
     import xarray
@@ -35,29 +34,11 @@ if TYPE_CHECKING:
 
     from tumble.body import RigidBody
     from tumble.simulate import Model
+    from tumble.torques import TorqueLike
 
 __all__ = ["simulate_to_store"]
 
 _SUMMED = ("solver_n_steps", "solver_n_rejected", "solver_n_rhs")
-
-
-def _members(model, values: dict) -> int:
-    sizes = {np.shape(v)[0] for v in values.values() if np.ndim(v) == 2}
-    if model.batch_size is not None:
-        sizes.add(model.batch_size)
-    if len(sizes) > 1:
-        raise ValidationError(f"batch sizes disagree: {sorted(sizes)}")
-    return sizes.pop() if sizes else 1
-
-
-def _chunk_of(model, lo: int, hi: int):
-    """Members ``lo:hi`` of a model that carries its own batch (a batch of rigid bodies)."""
-    if model.batch_size is None:
-        return model
-    if not isinstance(model, RigidBodies):
-        raise ValidationError(f"store: a {type(model).__name__} with its own batch cannot be cut into chunks")
-    masses = None if model.masses is None else model.masses[lo:hi]
-    return RigidBodies(model.inertia[lo:hi], model.moments[lo:hi], model.axes[lo:hi], masses)
 
 
 def _template(ds: xarray.Dataset, n: int, chunk: int) -> xarray.Dataset:
@@ -78,15 +59,30 @@ def _template(ds: xarray.Dataset, n: int, chunk: int) -> xarray.Dataset:
     return template.assign({name: var for name, var in ds.data_vars.items() if "body" not in var.dims})
 
 
-def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike, store: str | os.PathLike[str], *,
-                      t: ArrayLike, initial_state: dict, options: dict, chunk: int | None = None,
-                      progress: Callable[[int, int], None] | None = None) -> xarray.Dataset:
-    """Run ``simulate(model, t=t, **options, **initial_state)`` in chunks of ``chunk`` members, written to the
-    Zarr store ``store`` (a directory that must not exist); return the run as a lazily opened
-    :class:`xarray.Dataset`.
+def simulate_to_store(
+    model: Model | RigidBody | Sequence[RigidBody] | ArrayLike,
+    omega0: ArrayLike | None = None,
+    *,
+    store: str | os.PathLike[str],
+    t: ArrayLike,
+    method: str = "dop853",
+    dt: float | None = None,
+    rtol: float | None = None,
+    atol: float | None = None,
+    max_steps: int | None = None,
+    torque: TorqueLike | ArrayLike = None,
+    device: str = "cpu",
+    chunk: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+    **initial_state: ArrayLike | None,
+) -> xarray.Dataset:
+    """:func:`tumble.simulate` of a batch, run in chunks of ``chunk`` members, each written to the Zarr store
+    ``store`` (a directory that must not exist) as it completes; return the run as a lazily opened
+    :class:`xarray.Dataset` (dimensions ``(time, body, ...)``, chunked by member).
 
-    ``options`` are the other arguments of :func:`tumble.simulate` (``method``, ``dt``, ``torque``, ...);
-    ``chunk`` defaults to ``tumble.ensemble.SAMPLES_PER_CHUNK // len(t)`` members (about 200 MB a chunk);
+    ``model``, ``omega0``, ``t``, the solver options, ``torque``, ``device`` and ``**initial_state`` are those
+    of :func:`tumble.simulate` (SI units; rates in rad/s, body axes); ``chunk`` defaults to
+    :data:`~tumble.sweeps.chunks.SAMPLES_PER_CHUNK` ``// len(t)`` members (about 200 MB a chunk);
     ``progress(done, total)`` counts members.
     """
     import xarray as xr
@@ -95,22 +91,20 @@ def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike
     if os.path.exists(path):
         raise ValidationError(f"store: {path} exists; give a new path (a run is never written over another)")
     model = as_model(model)
+    if omega0 is not None:
+        initial_state["omega0"] = omega0
     values = {name: np.asarray(v) for name, v in initial_state.items() if v is not None}
-    n = _members(model, values)
+    n = batch_members(model, values)
     if n < 1:
         raise ValidationError("store: the batch has no members (initial states of shape (0, size)): nothing to write")
-    t = np.asarray(t, dtype=np.float64)
-    chunk = max(1, SAMPLES_PER_CHUNK // max(1, t.size)) if chunk is None else int(chunk)
-    if chunk < 1:
-        raise ValidationError(f"chunk: must be >= 1 member, got {chunk}")
+    t = output_times(t)
+    chunks = Chunks.of(n, chunk, n_times=t.size)
+    options = dict(method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque, device=device)
     with writing(path):  # one writer at a time; the temporaries of killed runs removed
         tmp = None
         summed: dict[str, int] = {}  # the solver statistics, summed over the chunks
         try:
-            for lo in range(0, n, chunk):
-                hi = min(n, lo + chunk)
-                part: dict[str, Any] = {name: v[lo:hi] if np.ndim(v) == 2 else v for name, v in values.items()}
-                traj = simulate(_chunk_of(model, lo, hi), t=t, **options, **part)
+            for lo, hi, traj in simulate_chunks(model, chunks, t=t, initial_state=values, **options):
                 ds = traj.to_xarray()
                 # labels as variable-length strings: Zarr 3 specifies those, not NumPy's fixed-width ones
                 ds = ds.assign_coords({name: c.astype(object) for name, c in ds.coords.items()
@@ -119,7 +113,7 @@ def simulate_to_store(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike
                     ds = ds.expand_dims(body=[0], axis=1).transpose("time", "body", ...)
                 if tmp is None:  # the whole store, laid out from the first chunk
                     tmp = temporary(path)
-                    template = _template(ds, n, chunk)
+                    template = _template(ds, n, chunks.size)
                     template.to_zarr(tmp, mode="a", compute=False, consolidated=False, zarr_format=3)
                 region = ds.drop_vars([name for name, var in ds.variables.items() if "body" not in var.dims])
                 region = region.assign_coords(body=np.arange(lo, hi))

@@ -1,0 +1,72 @@
+"""``tumble.sweep``: the function :func:`tumble.sweeps.sweep`; the sweeps package is :mod:`tumble.sweeps`.
+
+``tumble.sweep`` was the package itself, made callable. The package's old
+spellings keep working until tumble 0.4 with a :class:`DeprecationWarning`
+that names the new one: ``tumble.sweep.NAME`` and ``from tumble.sweep import
+NAME`` give ``tumble.sweeps.NAME``; ``import tumble.sweep.MODULE`` and ``from
+tumble.sweep.MODULE import NAME`` give the module ``tumble.sweeps.MODULE``.
+
+For that, importing this module puts in its place (``sys.modules``, and so the
+attribute ``tumble.sweep`` that ``import tumble.sweep`` binds) one
+:class:`_Sweep`: the function, which also answers for the package's names, and
+a finder that gives the package's modules under their old names. In 0.4 this
+file goes and ``tumble.sweep`` is :func:`tumble.sweeps.sweep` itself.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+from typing import Any
+
+from tumble import sweeps
+
+_OLD, _NEW = "tumble.sweep", "tumble.sweeps"
+
+
+def _deprecated(old: str, new: str) -> None:
+    warnings.warn(f"{old} is deprecated and will be removed in tumble 0.4: use {new}", DeprecationWarning,
+                  stacklevel=3)
+
+
+class _Sweep:
+    """:func:`tumble.sweeps.sweep`, which also answers for the names of the package that ``tumble.sweep`` was
+    (deprecated: each gives the name of :mod:`tumble.sweeps`, with a warning)."""
+
+    __path__: list[str] = []  # a package to the import system, so that its modules are looked for (_Modules)
+
+    def __init__(self, spec) -> None:
+        functools.update_wrapper(self, sweeps.sweep)
+        self.__spec__ = spec  # this file's, which the import system reads from a package
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        return sweeps.sweep(*args, **kwargs)
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):  # what tools ask of any object: none of the package's names
+            raise AttributeError(name)
+        value = getattr(sweeps, name)
+        _deprecated(f"{_OLD}.{name}", f"{_NEW}.{name}")
+        return value
+
+
+class _Modules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
+    """Finds the module ``tumble.sweep.MODULE`` as ``tumble.sweeps.MODULE`` itself (deprecated)."""
+
+    def find_spec(self, fullname, path, target=None):
+        if not fullname.startswith(_OLD + ".") or importlib.util.find_spec(_NEW + fullname[len(_OLD):]) is None:
+            return None
+        return importlib.util.spec_from_loader(fullname, self)
+
+    def exec_module(self, module) -> None:
+        new = _NEW + module.__name__[len(_OLD):]
+        _deprecated(module.__name__, new)
+        sys.modules[module.__name__] = importlib.import_module(new)  # the import system returns this one
+
+
+sys.meta_path.append(_Modules())
+sys.modules[__name__] = _Sweep(__spec__)  # type: ignore[assignment]
