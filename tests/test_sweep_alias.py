@@ -1,5 +1,5 @@
 """``tumble.sweep`` is the function :func:`tumble.sweeps.sweep`; the old spellings of the package it was keep
-working until tumble 0.4, each with a DeprecationWarning that names its ``tumble.sweeps`` replacement.
+working until tumble 0.5, each with a DeprecationWarning that names its ``tumble.sweeps`` replacement.
 
 Each spelling runs in a new Python process (``sys.executable``), since an import changes the process for good:
 ``import tumble.sweep`` first, as a script would, then the others.
@@ -57,4 +57,4 @@ def test_each_old_spelling_of_the_sweep_package_gives_the_new_name_with_a_deprec
         same, said = results[code]
         assert same, code  # the very object of tumble.sweeps, and tumble.sweep still the function
         # `from tumble.sweep import X` warns twice, once for the import system's hasattr and once for X itself
-        assert said and set(said) == {f"{old} is deprecated and will be removed in tumble 0.4: use {new}"}, code
+        assert said and set(said) == {f"{old} is deprecated and will be removed in tumble 0.5: use {new}"}, code

@@ -241,7 +241,7 @@ def simulate(
         ``"cuda"``: ``method="rk4"`` batches of rigid bodies on an NVIDIA GPU,
         one thread per body (compiled torque models only; ``docs/gpu.md``).
     store : path of a Zarr store, optional
-        Deprecated (to be removed in 0.4): use
+        Deprecated (to be removed in 0.5): use
         :func:`tumble.sweeps.simulate_to_store`, which this then calls and
         whose ``xarray.Dataset`` it returns. A run whose states and outputs
         cannot fit in the memory available is refused before they are
@@ -264,7 +264,7 @@ def simulate(
     if omega0 is not None:
         initial_state["omega0"] = omega0
     if store is not None:
-        warnings.warn("simulate(store=...) is deprecated and will be removed in tumble 0.4: use "
+        warnings.warn("simulate(store=...) is deprecated and will be removed in tumble 0.5: use "
                       "tumble.sweeps.simulate_to_store(model, ..., store=...), which returns the xarray.Dataset",
                       DeprecationWarning, stacklevel=2)
         from tumble.sweeps.stream import simulate_to_store

@@ -1,7 +1,7 @@
 """``tumble.sweep``: the function :func:`tumble.sweeps.sweep`; the sweeps package is :mod:`tumble.sweeps`.
 
 ``tumble.sweep`` was the package itself, made callable. The package's old
-spellings keep working until tumble 0.4 with a :class:`DeprecationWarning`
+spellings keep working until tumble 0.5 with a :class:`DeprecationWarning`
 that names the new one: ``tumble.sweep.NAME`` and ``from tumble.sweep import
 NAME`` give ``tumble.sweeps.NAME``; ``import tumble.sweep.MODULE`` and ``from
 tumble.sweep.MODULE import NAME`` give the module ``tumble.sweeps.MODULE``.
@@ -9,7 +9,7 @@ tumble.sweep.MODULE import NAME`` give the module ``tumble.sweeps.MODULE``.
 For that, importing this module puts in its place (``sys.modules``, and so the
 attribute ``tumble.sweep`` that ``import tumble.sweep`` binds) one
 :class:`_Sweep`: the function, which also answers for the package's names, and
-a finder that gives the package's modules under their old names. In 0.4 this
+a finder that gives the package's modules under their old names. In 0.5 this
 file goes and ``tumble.sweep`` is :func:`tumble.sweeps.sweep` itself.
 """
 
@@ -29,7 +29,7 @@ _OLD, _NEW = "tumble.sweep", "tumble.sweeps"
 
 
 def _deprecated(old: str, new: str) -> None:
-    warnings.warn(f"{old} is deprecated and will be removed in tumble 0.4: use {new}", DeprecationWarning,
+    warnings.warn(f"{old} is deprecated and will be removed in tumble 0.5: use {new}", DeprecationWarning,
                   stacklevel=3)
 
 
