@@ -314,14 +314,15 @@ class Trajectory:
         """The leading shape ``(n,)`` or ``(n, N)`` of every sampled array."""
         return self.q.shape[:-1] if self.q is not None else self.totals["energy"].shape
 
-    def body(self, i: int) -> Trajectory:
-        """The trajectory of body ``i`` of a batch (negative ``i`` counts from the end)."""
-        n_bodies = self.batch_size
-        if n_bodies is None:
-            raise ValidationError("i: body(i) needs a batch; this Trajectory holds a single body")
+    def member(self, i: int) -> Trajectory:
+        """The trajectory of member ``i`` of a batch (negative ``i`` counts from the end): one body, spacecraft
+        or robot of the batch, as a Trajectory of its own."""
+        n_members = self.batch_size
+        if n_members is None:
+            raise ValidationError("i: member(i) needs a batch; this Trajectory holds a single run")
         i = operator.index(i)
-        if not -n_bodies <= i < n_bodies:
-            raise IndexError(f"i: body {i} is out of range for a batch of {n_bodies}")
+        if not -n_members <= i < n_members:
+            raise IndexError(f"i: member {i} is out of range for a batch of {n_members}")
         def pick(a):
             return None if a is None else a[:, i]
 
@@ -330,6 +331,13 @@ class Trajectory:
         totals = {name: value[:, i] for name, value in self.totals.items()}
         return Trajectory(self.t, pick(self.q), pick(self.omega), inertia, self.method, self.info, extras, totals,
                           self.model)
+
+    def body(self, i: int) -> Trajectory:
+        """Deprecated alias of :meth:`member` (a batch member need not be a body)."""
+        import warnings
+
+        warnings.warn("Trajectory.body(i) is deprecated: use Trajectory.member(i)", DeprecationWarning, stacklevel=2)
+        return self.member(i)
 
     def at(self, index: int | slice | Sequence[int] | np.ndarray) -> Trajectory:
         """The trajectory at the output samples ``index`` only: a slice or integer indices along time, kept
@@ -610,7 +618,7 @@ class Trajectory:
         """
         from matplotlib.figure import Figure
 
-        traj = self if self.batch_size is None else self.body(0)
+        traj = self if self.batch_size is None else self.member(0)
         if title is None:
             title = f"tumble trajectory ({self.method or 'unknown method'})"
         if self.batch_size is not None:

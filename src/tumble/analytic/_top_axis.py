@@ -54,7 +54,7 @@ def axis_motion(trajectory: Trajectory, *, com, g) -> AxisMotion:
     ``φ̇ = ė_N·(ẑ × e_N) / sin²θ``, ``ω₃ = ω·e``.
     """
     if trajectory.batch_size is not None:
-        raise ValidationError("trajectory: axis_motion takes a single body (use trajectory.body(i))")
+        raise ValidationError("trajectory: axis_motion takes a single body (use trajectory.member(i))")
     com, g = nonzero_vector(com, "com"), nonzero_vector(g, "g")
     up = -g / np.linalg.norm(g)
     state = axis_state(trajectory.q, trajectory.omega, com / np.linalg.norm(com), up)
