@@ -585,7 +585,7 @@ class Trajectory:
         """A notebook cell's view: the table of the run (model, method, samples, time span, solver statistics,
         largest drifts of energy and angular momentum), then the viewer (an ``<iframe>``;
         :func:`tumble.viewer.notebook_html`) where the trajectory can be drawn without its model."""
-        from tumble._tables import summary_html
+        from tumble.viz._notebook import summary_html
         from tumble.viewer import notebook_html
 
         return summary_html(self) + (notebook_html(self) or "")
@@ -595,9 +595,9 @@ class Trajectory:
 
         Columns ``q_w … q_z``, ``omega_x … omega_z`` (rad/s, body axes), ``energy`` (J),
         ``momentum_body_x …`` (N m s, body axes) and one per component of each extra
-        (:func:`tumble._tables.to_dataframe`). pandas comes with xarray; it is imported on the first call.
+        (:func:`tumble.viz._notebook.to_dataframe`). pandas comes with xarray; it is imported on the first call.
         """
-        from tumble._tables import to_dataframe
+        from tumble.viz._notebook import to_dataframe
 
         return to_dataframe(self)
 
