@@ -66,6 +66,9 @@ column                          width  meaning (algorithm)
 5.1, CRBA Table 6.2, ABA Table 7.1.) The single-state entries take one flat
 :func:`workspace` instead: ``W``, then two 6×6 matrices, the mimic joints'
 ``M`` (nv, nv) and nv zeros, then a contiguous copy of the state.
+
+The compiler options that the algorithms' modules share are defined here
+too (:data:`JIT`, :data:`INLINE`, :data:`NO_REFCOUNT`), below them all.
 """
 
 from __future__ import annotations
