@@ -7,7 +7,7 @@ import pytest
 from scipy.integrate import quad
 
 import tumble
-from tumble import attitude, dynamics
+from tumble import analytic, attitude, dynamics
 from tumble._validate import ValidationError
 from tumble.analytic import _heavy_top as ht
 from tumble.viz import top as viz_top
@@ -133,7 +133,7 @@ def test_from_simulation_state_in_any_body_and_inertial_axes(random_rotation):
     t = periods(top, 3)
     traj = tumble.simulate(s["body"], s["omega0"], q0=s["q0"], t=t, rtol=RTOL, atol=ATOL,
                            torque=tumble.torques.Gravity(top.mass, s["com"], s["g"]))
-    motion = ht.axis_motion(traj, com=s["com"], g=s["g"])
+    motion = analytic.axis_motion(traj, com=s["com"], g=s["g"])
     assert np.abs(motion.u - top.u(t)).max() <= TOL_SIMULATED_U
     assert np.abs(motion.phi - motion.phi[0] - top.precession_angle(t)).max() <= TOL_SIMULATED_PHI
 
@@ -145,7 +145,7 @@ def test_from_simulation_state_in_any_body_and_inertial_axes(random_rotation):
 def test_exact_motion_matches_simulation_over_several_periods(name):
     top = TOPS[name]
     t = periods(top, 5)
-    motion = ht.axis_motion(simulate_top(top, t, phi0=0.2, psi0=0.5), **standard_axes(top))
+    motion = analytic.axis_motion(simulate_top(top, t, phi0=0.2, psi0=0.5), **standard_axes(top))
     assert np.abs(motion.u - top.u(t)).max() <= TOL_SIMULATED_U
     assert np.abs(motion.theta - top.theta(t)).max() <= TOL_SIMULATED_U / math.sin(max(top.theta_min, 1e-2))
     if top.theta_min > 0.0:  # φ is defined while the axis is off the vertical
@@ -157,7 +157,7 @@ def test_exact_motion_matches_simulation_over_several_periods(name):
 @pytest.mark.parametrize("name", ["general", "looping", "cusp", "negative spin", "below horizontal"])
 def test_nutation_bounds_and_period_match_refined_simulated_extremes(name):
     top = TOPS[name]
-    measured = ht.measure_nutation(simulate_top(top, periods(top, 10)), **standard_axes(top))
+    measured = analytic.measure_nutation(simulate_top(top, periods(top, 10)), **standard_axes(top))
     assert measured.u_max.size >= 9 and measured.u_min.size >= 9
     assert np.abs(measured.u_max - top.u2).max() <= TOL_BOUNDS
     assert np.abs(measured.u_min - top.u1).max() <= TOL_BOUNDS
@@ -175,7 +175,7 @@ def test_mean_precession_rate_matches_quadrature_and_the_simulated_advance(name)
     # φ(t + N T) − φ(t) = N T ⟨φ̇⟩ exactly: sample the simulation at multiples of T.
     n = 20
     t = np.concatenate([np.linspace(0.0, period, 50, endpoint=False) + k * period for k in range(n)] + [[n * period]])
-    motion = ht.axis_motion(simulate_top(top, t), **standard_axes(top))
+    motion = analytic.axis_motion(simulate_top(top, t), **standard_axes(top))
     advance = motion.phi[-1] - motion.phi[0]
     assert abs(advance) >= 5.0
     assert abs(advance - n * period * top.mean_precession_rate) <= TOL_MEAN_SIMULATED * abs(advance)
@@ -192,7 +192,7 @@ def test_steady_precession_is_a_double_root_and_stays_at_its_angle():
         assert abs(top.u2 - top.u1) <= 4 * EPS  # the double root, without the √eps of a generic solver
         assert top.mean_precession_rate == pytest.approx(rate, rel=TOL_SAME_STATE)
         t = periods(top, 3)
-        motion = ht.axis_motion(simulate_top(top, t), **standard_axes(top))
+        motion = analytic.axis_motion(simulate_top(top, t), **standard_axes(top))
         assert np.abs(motion.theta - theta0).max() <= TOL_SIMULATED_U
         assert np.abs(motion.phi - motion.phi[0] - rate * t).max() <= TOL_SIMULATED_PHI
 
@@ -237,7 +237,7 @@ def test_tilted_sleeping_top_stays_up_above_the_critical_spin_and_falls_below(fa
     tilt = 1e-3  # rad
     top = ht.HeavyTop(**BASE, theta0=tilt, theta_dot0=0.0, phi_dot0=0.0, spin=factor * TOPS["cusp"].critical_spin)
     t = np.linspace(0.0, 2.5, 25001)  # 2.5 s: over ten nutation periods above, half a fall-and-return below
-    motion = ht.axis_motion(simulate_top(top, t), **standard_axes(top))
+    motion = analytic.axis_motion(simulate_top(top, t), **standard_axes(top))
     if factor > 1.0:
         assert top.is_sleeping_stable() and top.theta_max <= 2.0 * tilt
         assert motion.theta.max() <= top.theta_max + TOL_SIMULATED_U  # stays near upright

@@ -97,7 +97,7 @@ def test_drifts_from_a_zero_initial_value_are_absolute():
 
 
 @pytest.mark.parametrize("shared_inertia", [False, True])
-def test_batch_shapes_and_bodies(shared_inertia):
+def test_batch_shapes_and_members(shared_inertia):
     n, n_bodies = 5, 3
     traj = _batch(n, n_bodies, shared_inertia)
     assert traj.batch_size == n_bodies and len(traj) == n
@@ -107,7 +107,7 @@ def test_batch_shapes_and_bodies(shared_inertia):
     for name in ("momentum_body", "momentum_inertial"):
         assert getattr(traj, name).shape == (n, n_bodies, 3), name
     for i in range(n_bodies):
-        one = traj.body(i)
+        one = traj.member(i)
         assert one.batch_size is None and one.method == traj.method and one.info == traj.info
         np.testing.assert_array_equal(one.omega, traj.omega[:, i])
         np.testing.assert_array_equal(one.q, traj.q[:, i])
@@ -116,15 +116,23 @@ def test_batch_shapes_and_bodies(shared_inertia):
         for name in ("energy", "momentum_body", "momentum_inertial", "momentum_inertial_drift"):
             np.testing.assert_allclose(getattr(one, name), getattr(traj, name)[:, i], rtol=ROUNDING,
                                        atol=0, err_msg=name)
-    np.testing.assert_array_equal(traj.body(-1).omega, traj.omega[:, -1])
+    np.testing.assert_array_equal(traj.member(-1).omega, traj.omega[:, -1])
 
 
-def test_body_index_errors():
+def test_member_index_errors():
     traj = _batch(n_bodies=2)
-    with pytest.raises(IndexError, match="out of range"):
-        traj.body(2)
-    with pytest.raises(ValidationError, match="^i: .*single body"):
-        traj.body(0).body(0)
+    with pytest.raises(IndexError, match=r"^i: member 2 is out of range for a batch of 2$"):
+        traj.member(2)
+    with pytest.raises(ValidationError, match=r"^i: member\(i\) needs a batch; this Trajectory holds a single run$"):
+        traj.member(0).member(0)
+
+
+def test_body_is_a_deprecated_alias_of_member():
+    traj = _batch(n_bodies=3)
+    with pytest.warns(DeprecationWarning, match=r"^Trajectory\.body\(i\) is deprecated: use Trajectory\.member\(i\)$"):
+        one = traj.body(1)
+    np.testing.assert_array_equal(one.omega, traj.omega[:, 1])
+    np.testing.assert_array_equal(one.q, traj.q[:, 1])
 
 
 def test_at_cuts_every_sampled_array_along_time():
@@ -224,7 +232,7 @@ def test_decreasing_times_and_numpy_info_values_are_accepted():
 
 @pytest.mark.parametrize("batch", [False, True])
 def test_to_xarray_layout(batch):
-    traj = _batch() if batch else _batch().body(1)
+    traj = _batch() if batch else _batch().member(1)
     ds = traj.to_xarray()
     lead = ("time", "body") if batch else ("time",)
     expected = {
@@ -274,7 +282,7 @@ def test_from_xarray_refuses_other_datasets():
 # -- NetCDF -----------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("make", [lambda: _batch().body(0), _batch, lambda: _batch(shared_inertia=True)],
+@pytest.mark.parametrize("make", [lambda: _batch().member(0), _batch, lambda: _batch(shared_inertia=True)],
                          ids=["single", "batch", "batch-shared-inertia"])
 def test_save_load_round_trip_is_bitwise(tmp_path, make):
     traj = make()
@@ -301,7 +309,7 @@ def _with_extras(traj):
     })
 
 
-@pytest.mark.parametrize("make", [lambda: _batch().body(1), _batch], ids=["single", "batch"])
+@pytest.mark.parametrize("make", [lambda: _batch().member(1), _batch], ids=["single", "batch"])
 def test_extras_round_trip_bitwise_with_their_labels(tmp_path, make):
     traj = _with_extras(make())
     traj.save(tmp_path / "run.nc")
@@ -315,7 +323,7 @@ def test_extras_round_trip_bitwise_with_their_labels(tmp_path, make):
 
 def test_extras_follow_body_selection_and_are_read_only():
     traj = _with_extras(_batch())
-    one = traj.body(2)
+    one = traj.member(2)
     np.testing.assert_array_equal(one.extras["wheel_speed"].data, traj.extras["wheel_speed"].data[:, 2])
     assert one.extras["motor_work"].data.shape == (len(traj),)
     with pytest.raises(ValueError):
@@ -412,14 +420,14 @@ def test_write_atomic_file_permissions(tmp_path):
 def test_plot_returns_a_figure_that_saves_to_png(tmp_path, batch):
     from matplotlib.figure import Figure
 
-    traj = _batch(n=50) if batch else _batch(n=50).body(0)
+    traj = _batch(n=50) if batch else _batch(n=50).member(0)
     fig = traj.plot(title="test run")
     assert isinstance(fig, Figure)
     ax_rate, ax_drift, ax_direction = fig.axes
     assert len(ax_rate.lines) == 3 and len(ax_drift.lines) == 2 and len(ax_direction.lines) == 3
     assert "rad/s" in ax_rate.get_ylabel() and ax_direction.get_xlabel() == "time t (s)"
     assert ax_drift.get_yscale() == "symlog"
-    one = traj.body(0) if batch else traj
+    one = traj.member(0) if batch else traj
     np.testing.assert_array_equal(ax_rate.lines[1].get_ydata(), one.omega[:, 1])
     heading = fig.get_suptitle()
     assert heading.startswith("test run") and (("body 0 of 3" in heading) == batch)

@@ -157,7 +157,7 @@ def test_an_empty_trajectory_is_refused_and_nothing_written(tmp_path):
 def test_a_batch_a_wrong_model_and_a_robot_without_its_chain_are_refused():
     one = steady_spin(n=11)
     batch = Trajectory(one.t, np.stack([one.q, one.q], 1), np.stack([one.omega, one.omega], 1), INERTIA)
-    with pytest.raises(ValidationError, match=r"traj: a batch of 2 runs; view one run with traj.body\(i\)"):
+    with pytest.raises(ValidationError, match=r"traj: a batch of 2 runs; view one run with traj.member\(i\)"):
         viewer.scene(batch)
     with pytest.raises(ValidationError, match="model: a RigidBody trajectory is drawn with a RigidBody"):
         viewer.scene(one, model=tumble.robot.load(ROBOTS / "planar_2link.toml"))

@@ -29,6 +29,12 @@ the quaternion (…, 4), the vector (…, 3) or the matrix (…, 3, 3)), broadca
 the batch axes of two arguments against each other, and return float64 NumPy
 arrays. The conversion to and from scipy's scalar-last ``Rotation`` happens
 only in :func:`to_scipy` and :func:`from_scipy`.
+
+The module is one unit (about 550 lines), as scipy's ``Rotation`` is one
+class: every representation converts to and from the quaternion through the
+same input checks and batch shapes (the first section), and each public
+function is a few lines over its compiled loop (the second), so that a
+reader finds a conversion and the loop it runs side by side.
 """
 
 from __future__ import annotations

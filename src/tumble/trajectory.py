@@ -314,14 +314,15 @@ class Trajectory:
         """The leading shape ``(n,)`` or ``(n, N)`` of every sampled array."""
         return self.q.shape[:-1] if self.q is not None else self.totals["energy"].shape
 
-    def body(self, i: int) -> Trajectory:
-        """The trajectory of body ``i`` of a batch (negative ``i`` counts from the end)."""
-        n_bodies = self.batch_size
-        if n_bodies is None:
-            raise ValidationError("i: body(i) needs a batch; this Trajectory holds a single body")
+    def member(self, i: int) -> Trajectory:
+        """The trajectory of member ``i`` of a batch (negative ``i`` counts from the end): one body, spacecraft
+        or robot of the batch, as a Trajectory of its own."""
+        n_members = self.batch_size
+        if n_members is None:
+            raise ValidationError("i: member(i) needs a batch; this Trajectory holds a single run")
         i = operator.index(i)
-        if not -n_bodies <= i < n_bodies:
-            raise IndexError(f"i: body {i} is out of range for a batch of {n_bodies}")
+        if not -n_members <= i < n_members:
+            raise IndexError(f"i: member {i} is out of range for a batch of {n_members}")
         def pick(a):
             return None if a is None else a[:, i]
 
@@ -330,6 +331,13 @@ class Trajectory:
         totals = {name: value[:, i] for name, value in self.totals.items()}
         return Trajectory(self.t, pick(self.q), pick(self.omega), inertia, self.method, self.info, extras, totals,
                           self.model)
+
+    def body(self, i: int) -> Trajectory:
+        """Deprecated alias of :meth:`member` (a batch member need not be a body)."""
+        import warnings
+
+        warnings.warn("Trajectory.body(i) is deprecated: use Trajectory.member(i)", DeprecationWarning, stacklevel=2)
+        return self.member(i)
 
     def at(self, index: int | slice | Sequence[int] | np.ndarray) -> Trajectory:
         """The trajectory at the output samples ``index`` only: a slice or integer indices along time, kept
@@ -577,7 +585,7 @@ class Trajectory:
         """A notebook cell's view: the table of the run (model, method, samples, time span, solver statistics,
         largest drifts of energy and angular momentum), then the viewer (an ``<iframe>``;
         :func:`tumble.viewer.notebook_html`) where the trajectory can be drawn without its model."""
-        from tumble._tables import summary_html
+        from tumble.viz._notebook import summary_html
         from tumble.viewer import notebook_html
 
         return summary_html(self) + (notebook_html(self) or "")
@@ -587,9 +595,9 @@ class Trajectory:
 
         Columns ``q_w … q_z``, ``omega_x … omega_z`` (rad/s, body axes), ``energy`` (J),
         ``momentum_body_x …`` (N m s, body axes) and one per component of each extra
-        (:func:`tumble._tables.to_dataframe`). pandas comes with xarray; it is imported on the first call.
+        (:func:`tumble.viz._notebook.to_dataframe`). pandas comes with xarray; it is imported on the first call.
         """
-        from tumble._tables import to_dataframe
+        from tumble.viz._notebook import to_dataframe
 
         return to_dataframe(self)
 
@@ -610,7 +618,7 @@ class Trajectory:
         """
         from matplotlib.figure import Figure
 
-        traj = self if self.batch_size is None else self.body(0)
+        traj = self if self.batch_size is None else self.member(0)
         if title is None:
             title = f"tumble trajectory ({self.method or 'unknown method'})"
         if self.batch_size is not None:

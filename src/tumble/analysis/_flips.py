@@ -27,7 +27,7 @@ def intermediate_rate(trajectory: Trajectory, body: RigidBody) -> np.ndarray:
     if trajectory.batch_size is not None:
         raise ValidationError(
             f"trajectory: must hold a single body (omega of shape (n, 3)), got a batch of {trajectory.batch_size}; "
-            "pass trajectory.body(i)"
+            "pass trajectory.member(i)"
         )
     return trajectory.omega @ body.axes[:, 1]
 

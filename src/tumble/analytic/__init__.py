@@ -38,7 +38,7 @@ from tumble.analytic._integrable import (
     upward_vertical,
     vertical_momentum,
 )
-from tumble.analytic._heavy_top import AxisMotion, HeavyTop, NutationMeasurement, axis_motion, measure_nutation
+from tumble.analytic._heavy_top import HeavyTop
 from tumble.analytic._stability import (
     StabilityReport,
     classify_axes,
@@ -48,6 +48,7 @@ from tumble.analytic._stability import (
     polhode_period,
     stability,
 )
+from tumble.analytic._top_axis import AxisMotion, NutationMeasurement, axis_motion, measure_nutation
 
 __all__ = [
     "REGIMES",

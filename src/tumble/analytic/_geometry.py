@@ -321,7 +321,7 @@ def herpolhode(trajectory: Trajectory) -> Herpolhode:
         raise ValidationError(f"trajectory: must be a Trajectory, got {type(trajectory).__name__}")
     if trajectory.batch_size is not None:
         raise ValidationError(
-            f"trajectory: must hold a single body, got a batch of {trajectory.batch_size}; pass trajectory.body(i)"
+            f"trajectory: must hold a single body, got a batch of {trajectory.batch_size}; pass trajectory.member(i)"
         )
     torque = trajectory.info.get("torque", "none")
     if torque != "none":

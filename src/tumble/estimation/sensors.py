@@ -70,7 +70,7 @@ def _truth(t, q) -> tuple[np.ndarray, np.ndarray]:
     """(t, q) of a Trajectory of one body, or the arrays given, checked."""
     if isinstance(t, Trajectory):
         if t.batch_size is not None or t.q is None:
-            raise ValidationError("t: must be a Trajectory of one body with an attitude (use trajectory.body(i))")
+            raise ValidationError("t: must be a Trajectory of one body with an attitude (use trajectory.member(i))")
         return t.t, t.q
     t = increasing_times(t, "t", what="truth times", at_least=2)
     q = attitude._as_quat(q, "q")

@@ -117,7 +117,7 @@ def from_trajectory(trajectory: Trajectory, *, oversample: int = 2, specific_for
     ``(0, 0, 9.80665)`` for a body held against gravity ``(0, 0, −9.80665)``).
     """
     if not isinstance(trajectory, Trajectory) or trajectory.batch_size is not None:
-        raise ValidationError("trajectory: must be a Trajectory of one body (use trajectory.body(i))")
+        raise ValidationError("trajectory: must be a Trajectory of one body (use trajectory.member(i))")
     if trajectory.q is None or trajectory.omega is None:
         raise ValidationError("trajectory: must have an attitude (q and omega) for a gyro to measure, not the "
                               f"{trajectory.model or 'model'} trajectory given")

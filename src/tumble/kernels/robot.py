@@ -43,7 +43,7 @@ ZERO, CONSTANT, PYTHON = 0, 1, 2
 class RobotModel(NamedTuple):
     """Compiled parameters of a robot under a joint-torque law.
 
-    params  : (nb, 45) the tree (layout in :mod:`tumble.kernels.featherstone`)
+    params  : (nb, 45) the tree (columns in :mod:`tumble.kernels.featherstone.layout`)
     sizes   : (2,) int64: nq and nv
     gravity : (3,) gravitational acceleration, m/s², base frame
     law     : (2,) int64: the torque law (``ZERO``, ``CONSTANT`` or ``PYTHON``) and,

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError
 from tumble.kernels import featherstone as _kernels
+from tumble.kernels.featherstone import layout as _columns
 from tumble.robot.dynamics import _joints, _like
 from tumble.robot.tree import RobotTree
 
@@ -46,8 +47,8 @@ def _frame_in_canonical(model: RobotTree, frame) -> tuple[np.ndarray, np.ndarray
     """Pose of a named frame in its body's canonical frame (the body's user frame is ``(R_f, p_f)`` there)."""
     if frame.body < 0:
         return frame.rotation, frame.position
-    P = model._params[frame.body]
-    Rf, pf = P[30:39].reshape(3, 3), P[39:42]
+    P, F = model._params[frame.body], _columns.USER_FRAME
+    Rf, pf = P[F:F + 9].reshape(3, 3), P[F + _columns.ORIGIN:F + 12]
     return Rf @ frame.rotation, pf + Rf @ frame.position
 
 
@@ -93,22 +94,22 @@ def _ancestors(model: RobotTree, body: int) -> list[int]:
 
 def _point_jacobian(model: RobotTree, R, p, body: int, x: np.ndarray) -> np.ndarray:
     """``J`` (6, nv): ``(ω, v_x)`` of body ``body`` and its point ``x`` (world) from ``q̇``, world axes."""
-    P = model._params
+    P, c = model._params, _columns
     J = np.zeros((6, model._nv))
     for j in _ancestors(model, body):
-        if P[j, 15] == _kernels.FREE:
+        if P[j, c.JOINT_TYPE] == c.FREE:
             r = x - p[0]
             J[0:3, 0:3] = R[0]
             J[3:6, 0:3] = -np.cross(r, R[0].T).T  # v = (R ω_B) × r = −[r]× R ω_B
             J[3:6, 3:6] = R[0]
             continue
-        c, k = int(P[j, 43]), P[j, 44]
-        axis = R[j] @ P[j, 12:15]
-        if P[j, 15] == _kernels.REVOLUTE:
-            J[0:3, c] += k * axis
-            J[3:6, c] += k * np.cross(axis, x - p[j])
+        v, k = int(P[j, c.COORDINATE]), P[j, c.MULTIPLIER]
+        axis = R[j] @ P[j, c.AXIS:c.AXIS + 3]
+        if P[j, c.JOINT_TYPE] == c.REVOLUTE:
+            J[0:3, v] += k * axis
+            J[3:6, v] += k * np.cross(axis, x - p[j])
         else:
-            J[3:6, c] += k * axis
+            J[3:6, v] += k * axis
     return J
 
 
@@ -128,11 +129,11 @@ def frame_jacobian(model: RobotTree, q: ArrayLike, name: str) -> np.ndarray:
 
 def _mass_properties(model: RobotTree, R, p):
     """Masses (nb,), world centres of mass (nb, 3), world inertias about them (nb, 3, 3)."""
-    P = model._params
-    m = P[:, 17]
-    h = P[:, 18:21]
+    P, c = model._params, _columns
+    m = P[:, c.MASS]
+    h = P[:, c.FIRST_MOMENT:c.FIRST_MOMENT + 3]
     c_local = np.divide(h, m[:, None], out=np.zeros_like(h), where=m[:, None] > 0)
-    I_O = P[:, 21:30].reshape(-1, 3, 3)
+    I_O = P[:, c.INERTIA:c.INERTIA + 9].reshape(-1, 3, 3)
     eye = np.eye(3)
     I_c = I_O - m[:, None, None] * (np.einsum("ij,ij->i", c_local, c_local)[:, None, None] * eye
                                     - np.einsum("ij,ik->ijk", c_local, c_local))
@@ -143,9 +144,9 @@ def _mass_properties(model: RobotTree, R, p):
 def center_of_mass(model: RobotTree, q: ArrayLike) -> np.ndarray:
     """Centre of mass of the whole robot (3,) or (B, 3), m, world frame: ``Σ mᵢ cᵢ / Σ mᵢ``."""
     R, p = _bodies(model, q)
-    P = model._params
-    first = P[:, 17, None] * p + np.einsum("...bij,bj->...bi", R, P[:, 18:21])
-    return first.sum(axis=-2) / P[:, 17].sum()
+    P, c = model._params, _columns
+    first = P[:, c.MASS, None] * p + np.einsum("...bij,bj->...bi", R, P[:, c.FIRST_MOMENT:c.FIRST_MOMENT + 3])
+    return first.sum(axis=-2) / P[:, c.MASS].sum()
 
 
 def centroidal_momentum_matrix(model: RobotTree, q: ArrayLike) -> np.ndarray:

@@ -74,7 +74,7 @@ class ChainMotion(Model):
               "base velocity, joint rates] (6 + n,)")
 
     # -- what the tree provides (tumble.robot.RobotTree) -----------------------
-    _params: np.ndarray  # (nb, 45): the layout of tumble.kernels.featherstone
+    _params: np.ndarray  # (nb, 45): the columns of tumble.kernels.featherstone.layout
     _gravity: np.ndarray  # (3,) m/s², world frame
 
     @property

@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike
 from tumble._inertia import as_rotation, as_shape, frozen, parallel_axis
 from tumble._validate import ValidationError, as_array
 from tumble.kernels import featherstone as _kernels
+from tumble.kernels.featherstone import layout as _columns
 from tumble.robot.link import Frame, Link
 from tumble.robot.motion import ChainMotion
 from tumble.robot.urdf import UrdfRepairWarning, read_urdf
@@ -76,7 +77,7 @@ class RobotTree(ChainMotion):
     _name: str | None
     _frames: tuple[Frame, ...]
     _mimic: dict[int, tuple[int, float, float]]  # {link: (copied link, multiplier, offset)}
-    _params: np.ndarray  # (nb, 45), the layout of tumble.kernels.featherstone
+    _params: np.ndarray  # (nb, PARAMS): the columns of tumble.kernels.featherstone.layout
     _lower: np.ndarray  # (dof,) read-only
     _upper: np.ndarray
     _no_wrench: np.ndarray  # (6,) zeros
@@ -242,7 +243,7 @@ class RobotTree(ChainMotion):
 
     @property
     def params(self) -> np.ndarray:
-        """(nb, 45) array the compiled algorithms read (layout in :mod:`tumble.kernels.featherstone`), a copy."""
+        """(nb, 45) array the compiled algorithms read (columns in :mod:`tumble.kernels.featherstone.layout`), a copy."""
         return self._params.copy()
 
     def joint_coordinates(self, q: ArrayLike) -> np.ndarray:
@@ -375,27 +376,28 @@ def _pack(links, parents, coordinate, multiplier, offset) -> np.ndarray:
     properties move to the canonical frame: ``c' = R_f' c + p_f'``, ``I_c' =
     R_f' I_c R_f'ᵀ``, ``I_O = I_c' + m(|c'|² E − c'c'ᵀ)``.
     """
-    P = np.zeros((len(links), _kernels.PARAMS))
-    kinds = {"revolute": _kernels.REVOLUTE, "prismatic": _kernels.PRISMATIC, "floating": _kernels.FREE}
+    c = _columns
+    P = np.zeros((len(links), c.PARAMS))
+    kinds = {"revolute": c.REVOLUTE, "prismatic": c.PRISMATIC, "floating": c.FREE}
     turn = [np.eye(3) if link.joint == "floating" else _axis_frame(link.axis) for link in links]
     user_R = [Ra.T @ link.frame_rotation for Ra, link in zip(turn, links)]
     user_p = [Ra.T @ link.frame_position for Ra, link in zip(turn, links)]
     for i, link in enumerate(links):
         par = parents[i]
         prev_R, prev_p = (np.eye(3), np.zeros(3)) if par < 0 else (user_R[par], user_p[par])
-        P[i, 0:9] = (prev_R @ link.origin_rotation @ turn[i]).ravel()
-        P[i, 9:12] = prev_p + prev_R @ link.origin_position
-        P[i, 12:15] = (0.0, 0.0, 1.0)
-        P[i, 15] = kinds[link.joint]
-        P[i, 16] = offset[i]
+        P[i, c.JOINT_FRAME:c.JOINT_FRAME + 9] = (prev_R @ link.origin_rotation @ turn[i]).ravel()
+        P[i, c.JOINT_FRAME + c.ORIGIN:c.JOINT_FRAME + 12] = prev_p + prev_R @ link.origin_position
+        P[i, c.AXIS:c.AXIS + 3] = (0.0, 0.0, 1.0)
+        P[i, c.JOINT_TYPE] = kinds[link.joint]
+        P[i, c.OFFSET] = offset[i]
         Rf, pf = user_R[i], user_p[i]
         com = Rf @ link.com + pf
-        P[i, 17] = link.mass
-        P[i, 18:21] = link.mass * com
-        P[i, 21:30] = (Rf @ link.inertia @ Rf.T + parallel_axis(link.mass, com)).ravel()
-        P[i, 30:39] = Rf.ravel()
-        P[i, 39:42] = pf
-        P[i, 42] = par
-        P[i, 43] = coordinate[i]
-        P[i, 44] = multiplier[i]
+        P[i, c.MASS] = link.mass
+        P[i, c.FIRST_MOMENT:c.FIRST_MOMENT + 3] = link.mass * com
+        P[i, c.INERTIA:c.INERTIA + 9] = (Rf @ link.inertia @ Rf.T + parallel_axis(link.mass, com)).ravel()
+        P[i, c.USER_FRAME:c.USER_FRAME + 9] = Rf.ravel()
+        P[i, c.USER_FRAME + c.ORIGIN:c.USER_FRAME + 12] = pf
+        P[i, c.PARENT] = par
+        P[i, c.COORDINATE] = coordinate[i]
+        P[i, c.MULTIPLIER] = multiplier[i]
     return P

@@ -84,7 +84,7 @@ def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | Human | N
           shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
     """The :class:`~tumble.viewer._scene.Scene` of a trajectory (what the page draws), refusing what it cannot show.
 
-    traj   : a :class:`tumble.Trajectory` (one run, not a batch: ``traj.body(i)`` picks one) or the path of one
+    traj   : a :class:`tumble.Trajectory` (one run, not a batch: ``traj.member(i)`` picks one) or the path of one
     model  : the model that made it, for what the trajectory cannot tell (a robot's links, a spacecraft's
              wheels, a diver's segments); its class must be ``traj.model``
     frames : the frame budget, a whole number ≥ 2: at most this many samples are shown
@@ -94,7 +94,7 @@ def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | Human | N
     budget = check_budget(frames)
     traj = _trajectory(traj)
     if traj.batch_size is not None:
-        raise ValidationError(f"traj: a batch of {traj.batch_size} runs; view one run with traj.body(i)")
+        raise ValidationError(f"traj: a batch of {traj.batch_size} runs; view one run with traj.member(i)")
     builder = BUILDERS.get(traj.model)
     if builder is None:  # a model with no scene of its own: drawn from its attitude; its model adds nothing
         if traj.q is None:

@@ -1,6 +1,6 @@
 """Figures of the heavy symmetric top: the exact motion and a simulation side by side.
 
-:func:`top_figure` draws the symmetry axis of a :class:`~tumble.analytic._heavy_top.HeavyTop`
+:func:`top_figure` draws the symmetry axis of a :class:`~tumble.analytic.HeavyTop`
 (the exact theory) and, optionally, of a simulated trajectory; :func:`demo_top`
 simulates a default top with ``tumble.simulate`` and ``tumble.torques.Gravity``
 and writes ``top.nc`` and ``top.png``. Conventions and equations:
@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, require_positive
-from tumble.analytic._heavy_top import HeavyTop, axis_motion, measure_nutation
+from tumble.analytic import HeavyTop, axis_motion, measure_nutation
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory, write_atomic
 

@@ -1,4 +1,4 @@
-"""A trajectory as tables: the summary a notebook shows, and a pandas DataFrame of its samples.
+"""What a notebook shows of a trajectory: its summary as an HTML table, and its samples as a pandas DataFrame.
 
 :func:`summary_html` is the table of ``Trajectory._repr_html_`` (shape, model,
 method, time span, solver statistics and the drifts of the invariants);
