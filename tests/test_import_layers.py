@@ -28,15 +28,15 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("ground floor", ("tumble._quat", "tumble._vec", "tumble._validate", "tumble._inertia", "tumble._elliptic",
                       "tumble._free_flow", "tumble._gravity", "tumble._files", "tumble._cache", "tumble._compiling",
-                      "tumble._callback", "tumble._protocol", "tumble._tables", "tumble.limits")),
+                      "tumble._callback", "tumble._protocol", "tumble._tables", "tumble._version", "tumble.limits")),
     ("values", ("tumble.attitude", "tumble.dynamics", "tumble.body", "tumble.torques")),
+    ("result", ("tumble.trajectory",)),
+    ("estimators", ("tumble.estimation",)),
     ("kernels", ("tumble.kernels",)),
     ("integrate", ("tumble.integrate",)),
-    ("result", ("tumble.trajectory",)),
     ("front door", ("tumble", "tumble.model", "tumble.rigid", "tumble.simulate")),
-    ("domain", ("tumble.analytic", "tumble.analysis", "tumble.estimation", "tumble.flexible", "tumble.frames",
-                "tumble.ins", "tumble.lorentz", "tumble.robot", "tumble.slosh", "tumble.spacecraft",
-                "tumble.variable")),
+    ("domain", ("tumble.analytic", "tumble.analysis", "tumble.flexible", "tumble.frames", "tumble.ins",
+                "tumble.lorentz", "tumble.robot", "tumble.slosh", "tumble.spacecraft", "tumble.variable")),
     ("sweeps", ("tumble.ensemble", "tumble.sweep")),
     ("scenario, viz, viewer", ("tumble.scenario", "tumble.viz", "tumble.viewer", "tumble.examples")),
     ("cli", ("tumble.cli", "tumble.__main__", "tumble._cli_errors", "tumble._demos", "tumble._warmup",
@@ -54,6 +54,9 @@ PENDING: dict[tuple[str, str], str] = {
     ("tumble.sweep", "tumble.scenario"): "sweep() refuses a Scenario and sweep_scenario() reads one; the sweep "
                                          "of a scenario moves with the sweeps' front (issue 30, points 2 and 5)",
     ("tumble.sweep", "tumble.scenario.sweep"): "the same as ('tumble.sweep', 'tumble.scenario')",
+    ("tumble.spacecraft.damper", "tumble.spacecraft.model"): "the deprecated simulate_damped builds a Spacecraft, "
+                                                             "which holds a damper: a cycle; the 0.2 shims are "
+                                                             "removed (issue 30, point 5)",
 }
 
 
@@ -227,7 +230,7 @@ def _line(root: Path, module: str, statement: str) -> int:
 def test_a_planted_cycle_is_listed_with_each_file_and_line(tmp_path):
     root = _copy(tmp_path)
     line = _plant(root, "tumble._quat", "\n\ndef _planted():\n    from tumble import _inertia\n")
-    back = _line(root, "tumble._inertia", "from tumble._quat import qto_matrix")
+    back = _line(root, "tumble._inertia", "from tumble._quat import mdet")
     assert violations(root) == [f"import cycle: tumble._inertia (tumble/_inertia.py:{back}) -> "
                                 f"tumble._quat (tumble/_quat.py:{line}) -> tumble._inertia"]
 
@@ -241,10 +244,10 @@ def test_a_planted_upward_import_in_a_function_names_its_line_and_both_layers(tm
 
 def test_a_relative_import_of_a_package_counts_its_init(tmp_path):
     root = _copy(tmp_path)
-    line = _plant(root, "tumble.kernels.rigid", "\n\ndef _planted():\n    from ..estimation import _mekf\n")
+    line = _plant(root, "tumble.kernels.rigid", "\n\ndef _planted():\n    from ..analytic import _free\n")
     assert violations(root) == [
         f"tumble/kernels/rigid.py:{line}: tumble.kernels.rigid (kernels) imports {name} (domain), a layer above it"
-        for name in ("tumble.estimation", "tumble.estimation._mekf")]
+        for name in ("tumble.analytic", "tumble.analytic._free")]
 
 
 def test_an_import_under_type_checking_is_not_an_edge(tmp_path):

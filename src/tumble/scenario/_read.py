@@ -4,16 +4,15 @@ from __future__ import annotations
 
 import tomllib
 from collections.abc import Callable
-import pydantic
 
 from tumble._files import read_input
 from tumble._validate import ValidationError
 from tumble.scenario._base import Scenario
-from tumble.scenario._errors import ScenarioError, describe, in_file, toml_problem
+from tumble.scenario._errors import ScenarioError, in_file, toml_problem
 from tumble.scenario.kinds import kind_of, scenario_class
 from tumble.trajectory import Trajectory
 
-__all__ = ["load", "parse", "parse_data", "run_scenario"]
+__all__ = ["load", "parse", "run_scenario"]
 
 
 def parse(text: str, *, source: str = "<string>") -> Scenario:
@@ -28,19 +27,7 @@ def parse(text: str, *, source: str = "<string>") -> Scenario:
         raise ScenarioError(source, [toml_problem(exc)]) from None
     with in_file(source):
         kind = kind_of(data)
-    return parse_data(scenario_class(kind), {**data, "kind": kind}, source)
-
-
-def parse_data(cls: type[Scenario], data: dict, source: str) -> Scenario:
-    """Validate the parsed TOML ``data`` as a scenario of class ``cls``; it keeps ``data`` (a sweep rebuilds
-    its model from it with dispersed values in place)."""
-    try:
-        scenario = cls.model_validate(data)
-    except pydantic.ValidationError as exc:
-        raise ScenarioError(source, [describe(error, cls) for error in exc.errors()]) from None
-    scenario._source = source
-    scenario._data = data
-    return scenario
+    return scenario_class(kind).from_data({**data, "kind": kind}, source)
 
 
 def load(path) -> Scenario:

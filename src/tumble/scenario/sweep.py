@@ -166,9 +166,7 @@ class ScenarioModel:
             for name in tables:
                 node = node.setdefault(name, {})
             node[last] = value.tolist() if hasattr(value, "tolist") else value
-        from tumble.scenario._read import parse_data
-
-        return as_run(parse_data(self.cls, data, self.source).build()).model
+        return as_run(self.cls.from_data(data, self.source).build()).model
 
     def __repr__(self):
         return f"ScenarioModel({self.source!r}, keys={list(self.parameters)})"
