@@ -22,7 +22,7 @@ use_content_key()  # and compiled code is stale when any source compiled into it
 
 from tumble import attitude, dynamics, integrate, limits, torques  # noqa: E402
 from tumble._validate import ValidationError  # noqa: E402
-from tumble._version import __version__  # noqa: E402
+from tumble._version import __version__  # noqa: E402, F401 (tumble.__version__)
 from tumble.body import RigidBody  # noqa: E402
 from tumble.integrate import SolverError  # noqa: E402
 from tumble.limits import RigidityWarning  # noqa: E402

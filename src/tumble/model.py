@@ -87,7 +87,8 @@ class StateField:
                                   f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
         if self.quaternion:
             if not arr.any(axis=-1).all():  # |q| = 0; any other finite q normalises (attitude._normalized scales it)
-                raise ValidationError(f"{self.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
+                raise ValidationError(f"{self.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised "
+                                      "here)")
             _warn_non_unit(arr, self.name)
             arr = attitude._normalized(arr)
         return arr
@@ -182,4 +183,4 @@ def _warn_non_unit(q: np.ndarray, name: str) -> None:
     where = f"[{k}]" if q.ndim == 2 else ""
     warnings.warn(f"{name}: |{name}{where}| = {lengths[k]:.17g} is not 1 (further than "
                   f"{UNIT_Q0_TOL:g}): normalised to {name} / |{name}|; give a unit quaternion [w, x, y, z]",
-                  attitude.NonUnitQuaternionWarning, stacklevel=5)  # the caller of simulate (simulate, its state, check)
+                  attitude.NonUnitQuaternionWarning, stacklevel=5)  # simulate's caller: simulate, its state, check

@@ -127,7 +127,8 @@ class RigidBodies(Model):
             np.asarray(bodies, dtype=np.float64)
         except (TypeError, ValueError):
             raise ValidationError(f"model: must be a tumble model (RigidBody, FlexibleBody, Spacecraft, SerialChain, "
-                                  f"...) or an inertia array (kg m^2, body axes), got {type(bodies).__name__}") from None
+                                  f"...) or an inertia array (kg m^2, body axes), got {type(bodies).__name__}"
+                                  ) from None
         inertia = as_array(bodies, "inertia", tail=(3, 3))
         if inertia.ndim not in (2, 3):
             raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
@@ -172,7 +173,7 @@ class RigidBodies(Model):
 RigidBody._model_of = RigidBodies.of  # the deprecated model interface of a RigidBody answers as its model
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> type[RigidBodies]:
     if name == "RigidMotion":  # deprecated in 0.4: the base of RigidBody and RigidBodies, now RigidBodies alone
         warnings.warn("tumble.rigid.RigidMotion is deprecated: the rigid-body model is tumble.rigid.RigidBodies "
                       "(RigidBodies.of(body) for one RigidBody)", DeprecationWarning, stacklevel=2)
