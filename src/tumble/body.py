@@ -170,9 +170,11 @@ class RigidBody:
     @property
     def axes_quaternion(self) -> np.ndarray:
         """(4,) the unit quaternion ``q_BP`` ``[w, x, y, z]`` of :attr:`axes` (principal → body axes), read-only."""
-        if self._q_bp is None:
-            object.__setattr__(self, "_q_bp", frozen(attitude.from_matrix(self._axes)))
-        return self._q_bp
+        q_bp = self._q_bp
+        if q_bp is None:
+            q_bp = frozen(attitude.from_matrix(self._axes))
+            object.__setattr__(self, "_q_bp", q_bp)
+        return q_bp
 
     @property
     def mass(self) -> float | None:

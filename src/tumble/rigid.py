@@ -96,14 +96,14 @@ class RigidBodies(Model):
     (N, 3, 3) (kg·m², body axes), validated with the rules of :class:`tumble.RigidBody`
     (:func:`tumble._inertia.principal_axes`). ``moments`` (B, 3) (kg·m², ascending), ``axes`` R_BP (B, 3, 3)
     and their quaternions ``q_bp`` (B, 4) are those of B = 1 body or one per member; ``inertia`` is the
-    tensor in body axes, (3, 3) or (N, 3, 3); ``masses`` (kg) are None when unknown (they serve the rigidity
-    check of :mod:`tumble.limits`).
+    tensor in body axes, (3, 3) or (N, 3, 3); ``masses`` (B,) (kg) are None when unknown (they serve the
+    rigidity check of :mod:`tumble.limits`).
     """
 
     __slots__ = ("inertia", "moments", "axes", "q_bp", "masses", "_kind")
 
     def __init__(self, inertia: np.ndarray, moments: np.ndarray, axes: np.ndarray,
-                 masses: float | np.ndarray | None, *, q_bp: np.ndarray | None = None,
+                 masses: np.ndarray | None, *, q_bp: np.ndarray | None = None,
                  kind: str = "RigidBodies") -> None:
         # read-only: the batch's own tensors, which each Trajectory of it shares instead of copying
         self.inertia, self.moments, self.axes, self.masses = readonly(inertia), moments, axes, masses
@@ -115,7 +115,8 @@ class RigidBodies(Model):
         """The model of ``bodies``: a RigidBody (its :attr:`kind` is ``"RigidBody"``), a sequence of them, or
         an inertia array (3, 3) or (N, 3, 3)."""
         if isinstance(bodies, RigidBody):
-            return cls(bodies.inertia, bodies.moments[None], bodies.axes[None], bodies.mass,
+            mass = None if bodies.mass is None else np.array([bodies.mass])
+            return cls(bodies.inertia, bodies.moments[None], bodies.axes[None], mass,
                        q_bp=bodies.axes_quaternion[None], kind="RigidBody")
         if isinstance(bodies, Sequence) and bodies and all(isinstance(b, RigidBody) for b in bodies):
             rigid = cast("Sequence[RigidBody]", bodies)

@@ -56,6 +56,7 @@ from tumble.sweep.plan import store_name_problem
 if TYPE_CHECKING:
     import numpy as np
 
+    from tumble.body import RigidBody
     from tumble.scenario._base import Scenario
     from tumble.scenario.rigid import Problem
     from tumble.simulate import Model
@@ -158,7 +159,7 @@ class ScenarioModel:
         self.cls, self.data, self.source = type(scenario), scenario._data, scenario.source
         self.parameters = tuple(keys)
 
-    def __call__(self, **values: Any) -> Model:
+    def __call__(self, **values: Any) -> Model | RigidBody:
         data = copy.deepcopy(self.data)
         for key, value in values.items():
             *tables, last = key.split(".")
