@@ -7,6 +7,7 @@ import tumble
 from tumble import integrate
 from tumble._protocol import CAPABILITIES
 from tumble._validate import ValidationError
+from tumble.rigid import RigidBodies
 from tumble.simulate import Model
 
 DIAG = np.diag([1.0, 2.0, 3.0])
@@ -71,7 +72,7 @@ def test_a_method_is_refused_exactly_when_the_kernel_misses_what_it_needs(method
     # a rigid body under a torque provides everything but "torque_free" (and "cuda" with a Python torque)
     body = tumble.RigidBody(DIAG)
     torque = tumble.torques.ConstantBody([0.0, 0.0, 0.1])
-    provides = body.compile(torque, 0.0).provides
+    provides = tumble.as_model(body).compile(torque, 0.0).provides
     options = {"dt": 0.1} if "dt" in integrate.METHODS[method].options else {}
     if integrate.METHODS[method].needs <= provides:
         traj = tumble.simulate(body, OMEGA0, t=T, method=method, torque=torque, **options)
@@ -101,10 +102,33 @@ def test_the_engine_imports_no_model():
 # -- the model interface --------------------------------------------------------------------------
 
 
-def test_a_rigid_body_is_a_model_and_arrays_become_one():
-    assert isinstance(tumble.RigidBody(DIAG), Model)
+def test_a_rigid_body_is_a_value_that_simulate_turns_into_its_model_as_it_does_arrays():
+    body = tumble.RigidBody(DIAG, mass=2.0)
+    assert not isinstance(body, Model)
+    model = tumble.as_model(body)
+    assert isinstance(model, RigidBodies) and model.kind == "RigidBody" and model.batch_size is None
+    assert model.masses.tolist() == [2.0] and model.inertia is body.inertia
+    np.testing.assert_array_equal(model.q_bp[0], tumble.attitude.from_matrix(body.axes))
+    assert tumble.simulate(body, OMEGA0, t=T).model == "RigidBody"
     traj = tumble.simulate(np.stack([DIAG, 2.0 * DIAG]), np.tile(OMEGA0, (2, 1)), t=T)
     assert traj.model == "RigidBodies" and traj.batch_size == 2
+
+
+def test_the_model_interface_of_a_rigid_body_answers_for_one_release_with_a_deprecation_naming_as_model():
+    body = tumble.RigidBody(DIAG)
+    traj = tumble.simulate(body, OMEGA0, t=T)
+    message = r"^RigidBody\.invariants is deprecated: .* use tumble\.as_model\(body\)\.invariants$"
+    with pytest.warns(DeprecationWarning, match=message):
+        kept = body.invariants(traj)
+    assert kept.keys() == {"energy", "momentum_inertial"}
+    for name, values in tumble.as_model(body).invariants(traj).items():
+        np.testing.assert_array_equal(kept[name], values)
+    with pytest.warns(DeprecationWarning, match=r"^RigidBody\.state_fields is deprecated"):
+        assert [f.name for f in body.state_fields()] == ["omega0", "q0"]
+    with pytest.warns(DeprecationWarning, match=r"^tumble\.rigid\.RigidMotion is deprecated: .*RigidBodies"):
+        assert tumble.rigid.RigidMotion is RigidBodies
+    with pytest.raises(AttributeError, match="'RigidBody' object has no attribute 'spin'"):
+        body.spin  # noqa: B018 (the attribute access is the test)
 
 
 def test_torque_free_invariants_of_a_rigid_body_hold_under_dop853():
@@ -112,7 +136,7 @@ def test_torque_free_invariants_of_a_rigid_body_hold_under_dop853():
     # to ~1e-12 (test_simulate measures 3e-11 over 1000 s); bound 1e-11 relative.
     body = tumble.RigidBody(DIAG)
     traj = tumble.simulate(body, OMEGA0, t=np.linspace(0.0, 20.0, 21), rtol=1e-12, atol=1e-12)
-    invariants = body.invariants(traj)
+    invariants = tumble.as_model(body).invariants(traj)
     assert set(invariants) == {"energy", "momentum_inertial"}
     for values in invariants.values():
         assert np.abs(values - values[0]).max() <= 1e-11 * np.abs(values[0]).max()
@@ -121,4 +145,4 @@ def test_torque_free_invariants_of_a_rigid_body_hold_under_dop853():
 def test_a_torque_has_no_invariant_to_promise():
     body = tumble.RigidBody(DIAG)
     traj = tumble.simulate(body, OMEGA0, t=T, torque=tumble.torques.ConstantBody([0.0, 0.0, 0.1]))
-    assert body.invariants(traj) == {}
+    assert tumble.as_model(body).invariants(traj) == {}

@@ -89,7 +89,7 @@ KEPT = {
 # torque-free, the exact-flow splittings are the exact motion. Measured: dop853 8.7e-13, rk4 and cf4
 # 8.0e-15, splitting2 3.7e-9 (its O(dt²) energy error), splitting4 2.8e-14, exact_split2/4 1.7e-15,
 # exact 6.8e-16.
-CASES["RigidBody"] = (lambda: tumble.RigidBody(INERTIA), dict(omega0=OMEGA0, q0=Q0), 5.0, 1e-3,
+CASES["RigidBody"] = (lambda: tumble.as_model(tumble.RigidBody(INERTIA)), dict(omega0=OMEGA0, q0=Q0), 5.0, 1e-3,
                       {"dop853": 1e-11, "rk4": 1e-12, "cf4": 1e-12, "splitting2": 1e-7, "splitting4": 1e-12,
                        "exact_split2": 1e-13, "exact_split4": 1e-13, "exact": 1e-14})
 KEPT["RigidBody"] = {"energy", "momentum_inertial"}

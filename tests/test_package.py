@@ -122,7 +122,7 @@ def test_validation_error_prints_its_public_name():
 def test_one_version_source():
     project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
     assert "version" not in project["project"] and project["project"]["dynamic"] == ["version"]
-    assert project["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "tumble.__version__"}
+    assert project["tool"]["setuptools"]["dynamic"]["version"] == {"attr": "tumble._version.__version__"}
     # the changelog's newest entry is this version
     newest = re.search(r"^## (\S+)", (ROOT / "CHANGELOG.md").read_text(encoding="utf-8"), flags=re.M)
     assert newest.group(1) == tumble.__version__

@@ -396,9 +396,9 @@ def test_ctrl_c_during_tumble_sweep_is_one_line_and_exit_130_and_the_store_resum
                                    "resumes the sweep"]
     written = _done(store)
     assert 1 <= written < 16
-    resumed = tumble.sweeps.sweep_scenario(scenario, store=store, workers=0)
+    resumed = tumble.scenario.sweep_scenario(scenario, store=store, workers=0)
     assert resumed.attrs["chunks_computed"] == 16 - written
-    assert_same(resumed, tumble.sweeps.sweep_scenario(scenario, workers=0))
+    assert_same(resumed, tumble.scenario.sweep_scenario(scenario, workers=0))
 
 
 def _done(store):

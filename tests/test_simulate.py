@@ -227,7 +227,7 @@ def test_states_reach_body_axes_by_the_quaternion_product_and_the_rotation(bodie
     from tumble.rigid import RigidBodies, _to_body_axes
 
     model = RigidBodies.of(random_batch(bodies)[0])
-    _, axes, q_bp = model._principal()
+    axes, q_bp = model.axes, model.q_bp
     states = np.random.default_rng(8).normal(size=(4, 6, 7)) * [1.0, 1.0, 1.0, 1.0, 1e-3, 1.0, 1e3]
     q, omega = np.empty((4, 6, 4)), np.empty((4, 6, 3))
     _to_body_axes(states, q_bp, axes, q, omega)

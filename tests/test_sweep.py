@@ -417,7 +417,7 @@ def test_tumble_sweep_of_a_scenario_file_writes_the_store_and_the_figure(tmp_pat
     assert "samples   12 (seed 2026), 1 of 1 chunks of 50 done" in result.output
     assert figure.stat().st_size > 10_000
     # the same sweep from Python: the scenario's model rebuilt per sample with its dispersed inertia
-    ds = tumble.sweeps.sweep_scenario(SPINNER, samples=12, workers=0)
+    ds = tumble.scenario.sweep_scenario(SPINNER, samples=12, workers=0)
     stored = tumble.sweeps.open_sweep(store)
     for name in ("body.inertia", "omega0", "q0", "nutation", "nutation_angle"):
         np.testing.assert_array_equal(stored[name].values, ds[name].values, err_msg=name)

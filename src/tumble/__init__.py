@@ -22,13 +22,13 @@ use_content_key()  # and compiled code is stale when any source compiled into it
 
 from tumble import attitude, dynamics, integrate, limits, torques  # noqa: E402
 from tumble._validate import ValidationError  # noqa: E402
+from tumble._version import __version__  # noqa: E402, F401 (tumble.__version__)
 from tumble.body import RigidBody  # noqa: E402
 from tumble.integrate import SolverError  # noqa: E402
 from tumble.limits import RigidityWarning  # noqa: E402
-from tumble.simulate import Model, simulate  # noqa: E402
+from tumble.simulate import Model, as_model, simulate  # noqa: E402
 from tumble.trajectory import Trajectory, load  # noqa: E402
 
-__version__ = "0.3.0"
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
@@ -49,6 +49,7 @@ __all__ = [
     "RigidityWarning",
     "analysis",
     "analytic",
+    "as_model",
     "SolverError",
     "Trajectory",
     "ValidationError",

@@ -32,7 +32,7 @@ _INERTIA = np.diag([1.0, 2.0, 3.0])  # kg·m²
 def _rigid() -> tuple[Model, dict[str, Any]]:
     import tumble
 
-    return tumble.RigidBody(_INERTIA), {"omega0": _OMEGA0}
+    return tumble.as_model(tumble.RigidBody(_INERTIA)), {"omega0": _OMEGA0}
 
 
 def _spacecraft() -> tuple[Model, dict[str, Any]]:

@@ -19,8 +19,10 @@ moments of inertia" (Wikipedia).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import warnings
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -28,11 +30,15 @@ from numpy.typing import ArrayLike
 from tumble import attitude
 from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes  # noqa: F401 (re-exported: tumble.body.principal_axes)
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.rigid import RigidMotion
 
 __all__ = ["RigidBody", "Part"]
 
 _AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+
+#: The model interface a RigidBody had when it was its own model (before 0.4): each name still answers, for one
+#: release, as the body's model (``tumble.as_model(body)``) does, with a DeprecationWarning.
+_MODEL_INTERFACE = frozenset({"state_fields", "compile", "initial_states", "outputs", "check_run", "invariants",
+                              "batch_size", "torque"})
 
 
 def _positive_vector(value, name: str) -> np.ndarray:
@@ -91,8 +97,9 @@ class Part:
         return Part(mass=self.mass, com=p + r @ self.com, inertia=r @ self.inertia @ r.T)
 
 
-class RigidBody(RigidMotion):
-    """Immutable, validated mass properties of a rigid body.
+class RigidBody:
+    """Immutable, validated mass properties of a rigid body: a value, which :func:`tumble.simulate` turns into
+    its model (:func:`tumble.as_model`: :class:`tumble.rigid.RigidBodies`).
 
     ``RigidBody(inertia, *, mass=None, com=None, check_triangle=True, name=None)``
 
@@ -121,6 +128,10 @@ class RigidBody(RigidMotion):
     _name: str | None
     _q_bp: np.ndarray | None
 
+    #: How a body becomes its model, registered by :mod:`tumble.rigid` (the model builds on this value): what the
+    #: deprecated model interface (:data:`_MODEL_INTERFACE`) answers with.
+    _model_of: ClassVar[Callable[[RigidBody], Any] | None] = None
+
     def __init__(self, inertia: ArrayLike, *, mass: float | None = None, com: ArrayLike | None = None,
                  check_triangle: bool = True, name: str | None = None) -> None:
         inertia, moments, axes = check_inertia(inertia, "inertia", definite=True, check_triangle=check_triangle)
@@ -132,7 +143,7 @@ class RigidBody(RigidMotion):
         set_(self, "_com", None if com is None else frozen(as_shape(com, "com", (3,))))
         set_(self, "_check_triangle", bool(check_triangle))
         set_(self, "_name", name)
-        set_(self, "_q_bp", None)  # the quaternion of R_BP, made on the first simulation
+        set_(self, "_q_bp", None)  # the quaternion of R_BP, made on first use (the first simulation)
 
     # -- data ---------------------------------------------------------------
 
@@ -155,6 +166,15 @@ class RigidBody(RigidMotion):
         the third column is flipped when needed for det +1.
         """
         return self._axes
+
+    @property
+    def axes_quaternion(self) -> np.ndarray:
+        """(4,) the unit quaternion ``q_BP`` ``[w, x, y, z]`` of :attr:`axes` (principal → body axes), read-only."""
+        q_bp = self._q_bp
+        if q_bp is None:
+            q_bp = frozen(attitude.from_matrix(self._axes))
+            object.__setattr__(self, "_q_bp", q_bp)
+        return q_bp
 
     @property
     def mass(self) -> float | None:
@@ -401,18 +421,14 @@ class RigidBody(RigidMotion):
     def __delattr__(self, name):
         raise AttributeError(f"RigidBody is immutable: cannot delete {name!r}")
 
-    # -- the model interface (tumble.rigid.RigidMotion) -----------------------
-
-    def _principal(self):
-        if self._q_bp is None:
-            object.__setattr__(self, "_q_bp", frozen(attitude.from_matrix(self._axes)))
-        return self._moments[None], self._axes[None], self._q_bp[None]
-
-    def _reported_inertia(self):
-        return self._inertia
-
-    def _masses(self):
-        return self._mass
+    def __getattr__(self, name: str) -> Any:
+        """The deprecated model interface of :data:`_MODEL_INTERFACE`, answered by the body's model."""
+        model_of = RigidBody._model_of
+        if name not in _MODEL_INTERFACE or model_of is None:
+            raise AttributeError(f"'RigidBody' object has no attribute {name!r}")
+        warnings.warn(f"RigidBody.{name} is deprecated: a RigidBody is a value, and tumble.as_model(body) is its "
+                      f"model; use tumble.as_model(body).{name}", DeprecationWarning, stacklevel=2)
+        return getattr(model_of(self), name)
 
     def __reduce__(self):
         return (_rebuild, (self._inertia, self._mass, self._com, self._check_triangle, self._name))

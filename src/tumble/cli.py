@@ -310,7 +310,7 @@ def sweep_command(
     Running it again on the same store computes only the chunks not yet written. A bad file or a store of
     another sweep is reported on stderr with exit code 2, and nothing is written.
     """
-    from tumble.sweeps import sweep_scenario
+    from tumble.scenario import sweep_scenario
     from tumble.sweeps.figure import sweep_figure
 
     with _exit_codes():

@@ -1,4 +1,4 @@
-"""The rigid body as a model of the front door (:class:`tumble.simulate.Model`).
+"""The rigid body as a model of the front door (:class:`tumble.model.Model`).
 
 The integrators work in each body's principal axes P, where Euler's
 equations are cheapest (``I₁ω̇₁ = τ₁ + (I₂ − I₃)ω₂ω₃`` and cyclic; the kernel
@@ -12,18 +12,18 @@ with ``R_BP = body.axes`` (columns: the principal axes in body axes). The
 change of axes is exact for a diagonal inertia and costs a few rounding errors
 otherwise; the motion does not depend on the body axes chosen (tested).
 
-:class:`RigidMotion` implements the model interface for anything that has
-principal moments and axes: a :class:`tumble.RigidBody`, or
-:class:`RigidBodies`, a batch with one body per member (a sequence of
-RigidBody or an (N, 3, 3) inertia array, validated in one vectorised call).
+:class:`RigidBodies` is that model: of one :class:`tumble.RigidBody` (a
+value: mass properties only), which :func:`tumble.simulate` turns into its
+model, or of a batch with one body per member (a sequence of RigidBody or an
+(N, 3, 3) inertia array, validated in one vectorised call).
 """
 
 from __future__ import annotations
 
-import abc
 import functools
+import warnings
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, cast
+from typing import cast
 
 import numpy as np
 from numba import njit
@@ -34,12 +34,10 @@ from tumble._inertia import principal_axes
 from tumble._quat import qmul
 from tumble._validate import ValidationError, as_array, readonly
 from tumble.kernels import rigid as _kernel
-from tumble.simulate import Model, Outputs, StateField
+from tumble.body import RigidBody
+from tumble.model import Model, Outputs, StateField
 
-if TYPE_CHECKING:
-    from tumble.body import RigidBody
-
-__all__ = ["RigidMotion", "RigidBodies"]
+__all__ = ["RigidBodies"]
 
 #: The stack depth from the warnings of :mod:`tumble.limits` to the caller of ``simulate``.
 _STACKLEVEL = 4
@@ -54,53 +52,6 @@ def _state_fields() -> tuple[StateField, ...]:
         StateField("q0", 4, "initial attitude, unit quaternion [w, x, y, z], body → inertial",
                    default=attitude.identity(), quaternion=True),
     )
-
-
-class RigidMotion(Model):
-    """The model interface of rigid bodies: initial state ``omega0`` (and ``q0``), outputs in body axes.
-
-    A subclass provides ``_principal()``, the principal moments (B, 3) (kg·m²,
-    ascending), axes R_BP (B, 3, 3) and their quaternions q_BP (B, 4) of B = 1
-    body or one per member,
-    ``_reported_inertia()`` (the inertia tensor(s) in body axes) and
-    ``_masses()`` (kg, or None when unknown: for the rigidity check).
-    """
-
-    __slots__ = ()
-
-    @abc.abstractmethod
-    def _principal(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The principal moments (B, 3), kg·m², ascending; axes R_BP (B, 3, 3); quaternions q_BP (B, 4)."""
-
-    @abc.abstractmethod
-    def _reported_inertia(self) -> np.ndarray:
-        """The inertia tensor(s) in body axes, kg·m²: (3, 3), or (N, 3, 3) with one per member."""
-
-    @abc.abstractmethod
-    def _masses(self) -> float | np.ndarray | None:
-        """The mass(es), kg, or None when unknown (for the rigidity check)."""
-
-    def state_fields(self) -> tuple[StateField, ...]:
-        return _state_fields()
-
-    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.RigidModel:
-        moments, axes, _ = self._principal()
-        return _kernel.from_principal(moments, axes, torques.as_torque_model(torque))
-
-    def initial_states(self, kernel: _kernel.RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
-        moments, axes, q_bp = self._principal()
-        y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
-        _to_principal_axes(readonly(values["q0"]), readonly(values["omega0"]), readonly(q_bp), readonly(axes), y0)
-        limits.check_rigid_motion(moments, y0[:, 4:], self._masses(), stacklevel=_STACKLEVEL)
-        return y0
-
-    def outputs(self, kernel: _kernel.RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
-        moments, axes, q_bp = self._principal()
-        if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
-            limits.check_rigid_motion(moments, states[-1, :, 4:], self._masses(), stacklevel=_STACKLEVEL)
-        q, omega = np.empty(states.shape[:-1] + (4,)), np.empty(states.shape[:-1] + (3,))
-        _to_body_axes(states, readonly(q_bp), readonly(axes), q, omega)
-        return Outputs(q=q, omega=omega, inertia=self._reported_inertia(), extras={}, totals={}, info={})
 
 
 @njit(cache=True)
@@ -136,36 +87,49 @@ def _to_body_axes(states, q_bp, axes, q, omega):
                     + axes[j, i, 2] * states[k, b, 6]
 
 
-class RigidBodies(RigidMotion):
-    """A batch of rigid bodies, one per member: ``simulate(bodies, omega0 (N, 3), ...)``.
 
-    Made by :meth:`of` from a sequence of :class:`tumble.RigidBody` or an
-    inertia array (3, 3) or (N, 3, 3) (kg·m², body axes), validated with the
-    rules of :class:`tumble.RigidBody` (:func:`tumble._inertia.principal_axes`).
+class RigidBodies(Model):
+    """The rigid-body model: one body, ``simulate(body, omega0, ...)``, or a batch with one body per member,
+    ``simulate(bodies, omega0 (N, 3), ...)``; initial state ``omega0`` (and ``q0``), outputs in body axes.
+
+    Made by :meth:`of` from a :class:`tumble.RigidBody`, a sequence of them, or an inertia array (3, 3) or
+    (N, 3, 3) (kg·m², body axes), validated with the rules of :class:`tumble.RigidBody`
+    (:func:`tumble._inertia.principal_axes`). ``moments`` (B, 3) (kg·m², ascending), ``axes`` R_BP (B, 3, 3)
+    and their quaternions ``q_bp`` (B, 4) are those of B = 1 body or one per member; ``inertia`` is the
+    tensor in body axes, (3, 3) or (N, 3, 3); ``masses`` (B,) (kg) are None when unknown (they serve the
+    rigidity check of :mod:`tumble.limits`).
     """
 
-    __slots__ = ("inertia", "moments", "axes", "q_bp", "masses")
+    __slots__ = ("inertia", "moments", "axes", "q_bp", "masses", "_kind")
 
-    def __init__(self, inertia: np.ndarray, moments: np.ndarray, axes: np.ndarray, masses: np.ndarray | None) -> None:
+    def __init__(self, inertia: np.ndarray, moments: np.ndarray, axes: np.ndarray,
+                 masses: np.ndarray | None, *, q_bp: np.ndarray | None = None,
+                 kind: str = "RigidBodies") -> None:
         # read-only: the batch's own tensors, which each Trajectory of it shares instead of copying
         self.inertia, self.moments, self.axes, self.masses = readonly(inertia), moments, axes, masses
-        self.q_bp = attitude.from_matrix(axes)
+        self.q_bp = attitude.from_matrix(axes) if q_bp is None else q_bp
+        self._kind = kind
 
     @classmethod
-    def of(cls, bodies: Sequence[RigidBody] | ArrayLike) -> RigidBodies:
-        """The batch of ``bodies``: a sequence of RigidBody, or an inertia array (3, 3) or (N, 3, 3)."""
-        from tumble.body import RigidBody  # the rigid body's class builds on this module
-
+    def of(cls, bodies: RigidBody | Sequence[RigidBody] | ArrayLike) -> RigidBodies:
+        """The model of ``bodies``: a RigidBody (its :attr:`kind` is ``"RigidBody"``), a sequence of them, or
+        an inertia array (3, 3) or (N, 3, 3)."""
+        if isinstance(bodies, RigidBody):
+            mass = None if bodies.mass is None else np.array([bodies.mass])
+            return cls(bodies.inertia, bodies.moments[None], bodies.axes[None], mass,
+                       q_bp=bodies.axes_quaternion[None], kind="RigidBody")
         if isinstance(bodies, Sequence) and bodies and all(isinstance(b, RigidBody) for b in bodies):
             rigid = cast("Sequence[RigidBody]", bodies)
             masses = [b.mass for b in rigid]
             return cls(np.stack([b.inertia for b in rigid]), np.stack([b.moments for b in rigid]),
-                       np.stack([b.axes for b in rigid]), None if None in masses else np.array(masses))
+                       np.stack([b.axes for b in rigid]), None if None in masses else np.array(masses),
+                       q_bp=np.stack([b.axes_quaternion for b in rigid]))
         try:
             np.asarray(bodies, dtype=np.float64)
         except (TypeError, ValueError):
             raise ValidationError(f"model: must be a tumble model (RigidBody, FlexibleBody, Spacecraft, SerialChain, "
-                                  f"...) or an inertia array (kg m^2, body axes), got {type(bodies).__name__}") from None
+                                  f"...) or an inertia array (kg m^2, body axes), got {type(bodies).__name__}"
+                                  ) from None
         inertia = as_array(bodies, "inertia", tail=(3, 3))
         if inertia.ndim not in (2, 3):
             raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {inertia.shape}")
@@ -173,6 +137,11 @@ class RigidBodies(RigidMotion):
         if inertia.ndim == 2:
             return cls(inertia, moments[None], axes[None], None)
         return cls(inertia, moments, axes, None)
+
+    @property
+    def kind(self) -> str:
+        """``"RigidBody"`` for the model of one :class:`tumble.RigidBody`, else ``"RigidBodies"``."""
+        return self._kind
 
     @property
     def batch_size(self) -> int | None:
@@ -183,16 +152,39 @@ class RigidBodies(RigidMotion):
         if self.batch_size is None:
             return self
         masses = None if self.masses is None else self.masses[lo:hi]
-        return RigidBodies(self.inertia[lo:hi], self.moments[lo:hi], self.axes[lo:hi], masses)
+        return RigidBodies(self.inertia[lo:hi], self.moments[lo:hi], self.axes[lo:hi], masses,
+                           q_bp=self.q_bp[lo:hi], kind=self._kind)
 
-    def _principal(self):
-        return self.moments, self.axes, self.q_bp
+    def state_fields(self) -> tuple[StateField, ...]:
+        return _state_fields()
 
-    def _reported_inertia(self):
-        return self.inertia
+    def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.RigidModel:
+        return _kernel.from_principal(self.moments, self.axes, torques.as_torque_model(torque))
 
-    def _masses(self):
-        return self.masses
+    def initial_states(self, kernel: _kernel.RigidModel, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
+        y0 = np.empty((values["omega0"].shape[0], _kernel.STATE_SIZE))
+        _to_principal_axes(readonly(values["q0"]), readonly(values["omega0"]), readonly(self.q_bp),
+                           readonly(self.axes), y0)
+        limits.check_rigid_motion(self.moments, y0[:, 4:], self.masses, stacklevel=_STACKLEVEL)
+        return y0
+
+    def outputs(self, kernel: _kernel.RigidModel, t: np.ndarray, states: np.ndarray) -> Outputs:
+        if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
+            limits.check_rigid_motion(self.moments, states[-1, :, 4:], self.masses, stacklevel=_STACKLEVEL)
+        q, omega = np.empty(states.shape[:-1] + (4,)), np.empty(states.shape[:-1] + (3,))
+        _to_body_axes(states, readonly(self.q_bp), readonly(self.axes), q, omega)
+        return Outputs(q=q, omega=omega, inertia=self.inertia, extras={}, totals={}, info={})
 
     def __repr__(self) -> str:
-        return f"RigidBodies(batch_size={self.batch_size})"
+        return f"RigidBodies(kind={self._kind!r}, batch_size={self.batch_size})"
+
+
+RigidBody._model_of = RigidBodies.of  # the deprecated model interface of a RigidBody answers as its model
+
+
+def __getattr__(name: str) -> type[RigidBodies]:
+    if name == "RigidMotion":  # deprecated in 0.4: the base of RigidBody and RigidBodies, now RigidBodies alone
+        warnings.warn("tumble.rigid.RigidMotion is deprecated: the rigid-body model is tumble.rigid.RigidBodies "
+                      "(RigidBodies.of(body) for one RigidBody)", DeprecationWarning, stacklevel=2)
+        return RigidBodies
+    raise AttributeError(f"module 'tumble.rigid' has no attribute {name!r}")

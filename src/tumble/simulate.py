@@ -1,4 +1,4 @@
-"""The front door: ``simulate(model, ...)`` runs every model, and :class:`Model` is what a model implements.
+"""The front door: ``simulate(model, ...)`` runs every model (:class:`tumble.model.Model`).
 
 One function integrates every model of the package: a rigid body (or a batch
 of them), a hub with flexible appendages, a sloshing hub, a body whose inertia
@@ -10,38 +10,27 @@ name (unknown names refused, quaternions checked and normalised, batches
 broadcast), which method applies to which model (:func:`tumble.integrate.check_method`),
 progress reporting, the device, and the one result type :class:`~tumble.Trajectory`.
 
-A model is an immutable, validated description (MuJoCo's ``MjModel``,
-Pinocchio's ``Model``) that implements :class:`Model` once:
-
-* :meth:`Model.state_fields`: the named parts of its initial state (the
-  keywords of :func:`simulate`, e.g. ``omega0``, ``q0``, ``wheel_speeds0``);
-* :meth:`Model.compile`: its compiled kernel (:mod:`tumble.kernels`) under a
-  torque, which says which methods it provides for (``provides``);
-* :meth:`Model.initial_states`: the state vectors from the named values;
-* :meth:`Model.outputs`: the :class:`~tumble.Trajectory` fields from the
-  integrated states (attitude, body rate, named extras, the system's totals);
-* :meth:`Model.invariants`: what its exact motion keeps constant on a run.
-
-Sweeps, the viewer, scenario files and the command line work on any model
-through this interface.
+A model implements :class:`tumble.model.Model` once (re-exported here with
+:class:`~tumble.model.Outputs` and :class:`~tumble.model.StateField`); a
+:class:`~tumble.RigidBody`, a sequence of them or an inertia array is a value,
+which :func:`as_model` turns into its model, :class:`tumble.rigid.RigidBodies`.
 """
 
 from __future__ import annotations
 
-import abc
 import difflib
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple, TypedDict
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import _callback, _compiling, attitude, integrate
-from tumble._validate import ValidationError, as_array, output_times, require_finite
-from tumble._vec import norm
+from tumble import _callback, _compiling, integrate
+from tumble._validate import ValidationError, output_times, require_finite
+from tumble.model import Model, Outputs, StateField
+from tumble.rigid import RigidBodies
 from tumble.trajectory import Extra, Trajectory
 
 if TYPE_CHECKING:
@@ -49,13 +38,6 @@ if TYPE_CHECKING:
     from tumble.torques import TorqueLike
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
-
-#: The largest |component| of an initial state (quaternions aside: normalised): its square stays finite in float64.
-_LARGEST_STATE = 1e150
-
-#: An initial quaternion whose length is within this of 1 is normalised silently (a unit quaternion typed to 7
-#: digits, or rounded by a computation); one further off is normalised with a NonUnitQuaternionWarning.
-UNIT_Q0_TOL = 1e-6
 
 #: Solver options when not given (those the method reads).
 DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
@@ -73,118 +55,11 @@ class SolverOptions(TypedDict, total=False):
     max_steps: int
 
 
-@dataclass(frozen=True)
-class StateField:
-    """One named part of a model's initial state: a keyword of :func:`simulate`.
-
-    name        : the keyword, e.g. ``"omega0"``
-    size        : number of components; a value has shape (size,) or (N, size) (a batch);
-                  a field of size 1 also takes a plain number
-    description : what it is, with units and frame (used in messages and the docs)
-    default     : array_like, a function of the values of the fields before it
-                  (``dict`` name → (N, size) array) returning one, or None for a required field;
-                  an array_like is checked (and a quaternion normalised) here, once
-    quaternion  : a unit quaternion ``[w, x, y, z]``: refused when zero, normalised here
-    """
-
-    name: str
-    size: int
-    description: str
-    default: Any = None
-    quaternion: bool = False
-
-    def __post_init__(self) -> None:
-        if self.default is not None and not callable(self.default):
-            default = np.array(_checked_value(self, self.default))  # its own copy, shared by every run: read-only
-            default.setflags(write=False)
-            object.__setattr__(self, "default", default)
-
-
-class Outputs(NamedTuple):
-    """What a model makes of its integrated states (see :meth:`Model.outputs`); every sampled array has
-    the leading axes (time, member) of the states, which :func:`simulate` removes for a single run.
-
-    q, omega : (n, N, 4), (n, N, 3) attitude (body → inertial) and body rate (rad/s, body axes), or None
-    inertia  : (3, 3) or (N, 3, 3), kg·m², body axes, or None
-    extras   : name → :class:`~tumble.trajectory.Extra` with data (n, N, ...)
-    totals   : ``"energy"`` (n, N) J and ``"momentum_body"`` (n, N, 3) N·m·s of the whole system
-    info     : model entries for ``Trajectory.info``
-    """
-
-    q: np.ndarray | None
-    omega: np.ndarray | None
-    inertia: np.ndarray | None
-    extras: dict
-    totals: dict
-    info: dict
-
-
-class Model(abc.ABC):
-    """The interface every model implements once (see the module docstring).
-
-    Class attribute ``torque``: what the ``torque=`` argument of :func:`simulate`
-    means for this model (in words, with units and frame), or ``None`` when the
-    model takes none.
-    """
-
-    __slots__ = ()
-
-    torque: str | None = "external torque on the body, body axes (N·m): a tumble.torques model or f(t, q, omega)"
-
-    @property
-    def batch_size(self) -> int | None:
-        """Members of a batch carried by the model itself (one inertia per body), or None."""
-        return None
-
-    def members(self, lo: int, hi: int) -> Model:
-        """The members ``lo`` to ``hi − 1`` of the model's own batch, a model of the same kind (what the
-        sweeps' chunker runs a chunk on, :mod:`tumble.sweeps.chunks`). A model without a batch of its own is
-        every member's: itself; one with a :attr:`batch_size` overrides this."""
-        return self
-
-    @abc.abstractmethod
-    def state_fields(self) -> tuple[StateField, ...]:
-        """The named parts of the initial state, in the order their defaults may depend on."""
-
-    @abc.abstractmethod
-    def compile(self, torque: Any, t0: float) -> Any:
-        """The compiled kernel (a NamedTuple of :mod:`tumble.kernels`) under ``torque`` (None: none), clock at ``t0`` (s).
-
-        The kernel's ``provides`` says which methods apply; its ``calls_python``
-        whether the run must stay on one core.
-        """
-
-    @abc.abstractmethod
-    def initial_states(self, kernel: Any, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
-        """The state vectors (N, n) from the validated initial values (name → (N, size)): a new array, which
-        the run integrates in place."""
-
-    @abc.abstractmethod
-    def outputs(self, kernel: Any, t: np.ndarray, states: np.ndarray) -> Outputs:
-        """The trajectory's fields from the states (len(t), N, n) at the output times ``t`` (s)."""
-
-    def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:  # noqa: B027
-        """Refuse a run this model cannot make (e.g. output times outside its data); nothing by default."""
-
-    def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
-        """What the exact motion keeps constant on the run ``traj`` (name → samples (n, [N,] ...)).
-
-        By default: the total energy and the inertial angular momentum of the
-        system when the run had no torque. Models with internal work or
-        dissipation say what remains.
-        """
-        if traj.info.get("torque") != "none":
-            return {}
-        return {"energy": traj.energy, "momentum_inertial": traj.momentum_inertial}
-
-
 def as_model(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike) -> Model:
-    """``model`` itself when it is a :class:`Model`; a rigid body, a sequence of them or an inertia array
-    (3, 3) or (N, 3, 3) (kg·m², body axes) as the rigid-body model."""
+    """``model`` itself when it is a :class:`Model`; a rigid body (a value), a sequence of them or an inertia
+    array (3, 3) or (N, 3, 3) (kg·m², body axes) as the rigid-body model, :class:`~tumble.rigid.RigidBodies`."""
     if isinstance(model, Model):
         return model
-    from tumble.rigid import RigidBodies  # the rigid model builds on this module
-
     return RigidBodies.of(model)
 
 
@@ -278,14 +153,14 @@ def simulate(
     if device not in ("cpu", "cuda"):
         raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
     if torque is not None and model.torque is None:
-        raise ValidationError(f"torque: a {type(model).__name__} takes no torque argument")
+        raise ValidationError(f"torque: a {model.kind} takes no torque argument")
     values, n = _initial_values(model, initial_state)
     model.check_run(m, times, options.get("dt"))
     # Python functions wrapped while compiling live through the run, outputs included (a model may
     # evaluate its torque law at the samples)
-    with _callback.keep_alive(), _compiling.notice(f"the {m.name} path of {type(model).__name__}"):
+    with _callback.keep_alive(), _compiling.notice(f"the {m.name} path of {model.kind}"):
         kernel = model.compile(torque, float(times[0]))
-        who = f"a {type(model).__name__}" + (f" under torque={torque!r}" if torque is not None else "")
+        who = f"a {model.kind}" + (f" under torque={torque!r}" if torque is not None else "")
         integrate.check_method(m.name, kernel.provides, who)
         if device == "cuda" and (m.name != "rk4" or progress is not None or "cuda" not in kernel.provides):
             raise ValidationError(f"device: 'cuda' runs method='rk4' on rigid bodies with compiled torques, without "
@@ -386,20 +261,20 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
         if name not in names:
             close = difflib.get_close_matches(name, names, n=1)
             hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise ValidationError(f"{name}: a {type(model).__name__} has no initial state {name!r}{hint}; it takes "
+            raise ValidationError(f"{name}: a {model.kind} has no initial state {name!r}{hint}; it takes "
                                   + ", ".join(f"{f.name} ({f.description})" for f in fields))
     arrays: dict[str, np.ndarray] = {}
     sizes: dict[str, int] = {}
     for f in fields:
         value = given.get(f.name)
         if value is not None:
-            arr = _checked_value(f, value)
+            arr = f.check(value)
             if arr.ndim == 2:
                 sizes[f.name] = arr.shape[0]
         elif f.default is None:
-            raise ValidationError(f"{f.name}: a {type(model).__name__} needs it: {f.description}")
+            raise ValidationError(f"{f.name}: a {model.kind} needs it: {f.description}")
         elif callable(f.default):
-            arr = _checked_value(f, f.default(_broadcast(arrays, sizes)))
+            arr = f.check(f.default(_broadcast(arrays, sizes)))
         else:
             arr = f.default  # checked when the field was made
         arrays[f.name] = arr
@@ -413,42 +288,6 @@ def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray]
                               f"(batch sizes: {', '.join(f'{k} {v}' for k, v in sizes.items())})")
     n = next(iter(sizes.values()), None)
     return _broadcast(arrays, sizes), n
-
-
-def _checked_value(f: StateField, value: ArrayLike) -> np.ndarray:
-    """The value of the field ``f`` as a float64 array (size,) or (N, size): finite, at most
-    :data:`_LARGEST_STATE` in magnitude, a quaternion non-zero and normalised."""
-    scalar = f.size == 1 and np.ndim(value) == 0  # a number for a field of one component
-    # finite checked below with the magnitude (one pass over the values), quaternions here
-    arr = as_array(value, f.name, tail=() if scalar else (f.size,), finite=f.quaternion)
-    if scalar:
-        arr = arr.reshape(1)
-    if arr.ndim > 2:
-        raise ValidationError(f"{f.name}: a batch has one leading axis, got shape {arr.shape}")
-    if not f.quaternion and arr.size and not np.abs(arr).max() <= _LARGEST_STATE:  # NaN fails too
-        require_finite(arr, f.name)
-        raise ValidationError(f"{f.name}: must be at most {_LARGEST_STATE:g} in magnitude (the energy and "
-                              f"momentum square it: float64 would overflow), got {np.abs(arr).max():g}")
-    if f.quaternion:
-        if not arr.any(axis=-1).all():  # |q| = 0; any other finite q normalises (attitude._normalized scales it)
-            raise ValidationError(f"{f.name}: must be a non-zero quaternion [w, x, y, z] (it is normalised here)")
-        _warn_non_unit(arr, f.name)
-        arr = attitude._normalized(arr)
-    return arr
-
-
-def _warn_non_unit(q: np.ndarray, name: str) -> None:
-    """One :class:`~tumble.attitude.NonUnitQuaternionWarning` when a quaternion of ``q`` (…, 4) is further than
-    :data:`UNIT_Q0_TOL` from unit length (it is then normalised: the rotation of ``q / |q|`` is meant)."""
-    lengths = norm(q.reshape(-1, 4))
-    off = np.abs(lengths - 1.0)
-    if np.all(off <= UNIT_Q0_TOL):
-        return
-    k = int(np.argmax(off))
-    where = f"[{k}]" if q.ndim == 2 else ""
-    warnings.warn(f"{name}: |{name}{where}| = {lengths[k]:.17g} is not 1 (further than "
-                  f"{UNIT_Q0_TOL:g}): normalised to {name} / |{name}|; give a unit quaternion [w, x, y, z]",
-                  attitude.NonUnitQuaternionWarning, stacklevel=5)  # the caller of simulate
 
 
 def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str, np.ndarray]:
@@ -488,4 +327,4 @@ def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: di
               for name, e in out.extras.items()}
     totals = {name: value[:, 0] if single else value for name, value in out.totals.items()}
     return Trajectory._of_run(np.array(t), pick(out.q, "q"), pick(out.omega, "omega"), inertia, method, info,
-                              extras, totals, type(model).__name__)
+                              extras, totals, model.kind)

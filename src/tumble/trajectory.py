@@ -674,10 +674,10 @@ def _plot_extra(ax, t, name: str, extra: Extra, panel: str) -> None:
 
 
 def _tumble_version() -> str:
-    """``tumble.__version__``, or ``"unknown"`` when the package does not define it."""
-    import tumble
+    """``tumble.__version__``."""
+    from tumble._version import __version__
 
-    return str(getattr(tumble, "__version__", "unknown"))
+    return __version__
 
 
 #: Largest ``||q| − 1|`` a trajectory file may hold: every method keeps ``|q| = 1`` to ~1e-13 over 1e8 steps

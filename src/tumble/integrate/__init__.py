@@ -47,13 +47,10 @@ import numpy as np
 from tumble._protocol import CAPABILITIES
 from tumble._validate import ValidationError, readonly, require_memory, require_positive
 from tumble.integrate import _dop853, _exact, _exactsplit, _fixed, _liegroup, _rk4, _splitting
+from tumble.integrate._fixed import MAX_STEPS
 
 __all__ = ["MAX_STEPS", "METHODS", "Diverged", "Method", "Solution", "SolverError", "check_method", "check_options",
            "solve"]
-
-#: Default ``max_steps``: the most steps per body of one run, for every method (about 10 s of ``rk4`` on a
-#: torque-free rigid body; a run past it is refused, before it starts for the fixed-step methods).
-MAX_STEPS = 10**8
 
 #: The largest ``max_steps`` accepted: step counts stay exact whole float64 numbers and fit an int64.
 MAX_STEPS_LIMIT = 2**53

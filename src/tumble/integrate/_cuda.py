@@ -45,7 +45,7 @@ from numba.extending import overload, register_jitable
 from tumble import torques
 from tumble.dynamics import rigid_rates
 from tumble._validate import ValidationError
-from tumble.integrate._fixed import landing_steps
+from tumble.integrate._fixed import MAX_STEPS, landing_steps
 from tumble.integrate._rk4 import axpy, update
 
 #: Threads per block, a multiple of the warp (32). The kernel uses no shared
@@ -161,11 +161,7 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None) -> tuple[np.ndarray, int]:
         raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
     y0 = np.ascontiguousarray(y0, dtype=np.float64)
     t_out = np.ascontiguousarray(t_out, dtype=np.float64)
-    if max_steps is None:
-        from tumble.integrate import MAX_STEPS  # the package imports this module lazily: no cycle at run time
-
-        max_steps = MAX_STEPS
-    m, h = landing_steps(t_out, float(dt), max_steps)
+    m, h = landing_steps(t_out, float(dt), MAX_STEPS if max_steps is None else max_steps)
     # torque-free: an empty tuple, and the kernel compiles without torque code (see _torque)
     program = () if codes is None else cuda.to_device(np.ascontiguousarray(codes, dtype=np.int64))
     out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)

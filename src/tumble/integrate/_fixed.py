@@ -29,6 +29,10 @@ from numba.extending import overload
 
 from tumble._validate import ValidationError
 
+#: Default ``max_steps``: the most steps per body of one run, for every method (about 10 s of ``rk4`` on a
+#: torque-free rigid body; a run past it is refused, before it starts for the fixed-step methods).
+MAX_STEPS = 10**8
+
 #: Bodies advanced together in one structure-of-arrays block (SIMD lanes × unrolling).
 LANES = 64
 

@@ -45,7 +45,7 @@ the library's :class:`~tumble.ValidationError` names the argument it refuses
 
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError
-from tumble.scenario._read import load, parse, run_scenario
+from tumble.scenario._read import load, parse, run_scenario, sweep_scenario
 from tumble.scenario._run import Run
 from tumble.scenario.kinds import DEFAULT_KIND, KINDS, Kind
 from tumble.scenario.tables import Body, EulerAngles, Initial, ModelState, Solver, Time
@@ -72,4 +72,5 @@ __all__ = [
     "parse",
     "parse_scenario",
     "run_scenario",
+    "sweep_scenario",
 ]

@@ -5,8 +5,10 @@ from __future__ import annotations
 import abc
 from collections.abc import Callable
 
+import pydantic
 from pydantic import PrivateAttr
 
+from tumble.scenario._errors import ScenarioError, describe
 from tumble.scenario._values import _Table, _Text
 from tumble.scenario.sweep import SweepTable
 from tumble.trajectory import Trajectory
@@ -36,6 +38,18 @@ class Scenario(_Table):
 
     _source: str = PrivateAttr("<scenario>")
     _data: dict = PrivateAttr(default_factory=dict)
+
+    @classmethod
+    def from_data(cls, data: dict, source: str) -> Scenario:
+        """Validate the parsed TOML ``data`` as a scenario of this kind; it keeps ``data`` (a sweep rebuilds
+        its model from it with dispersed values in place). Raises :class:`~tumble.scenario.ScenarioError`."""
+        try:
+            scenario = cls.model_validate(data)
+        except pydantic.ValidationError as exc:
+            raise ScenarioError(source, [describe(error, cls) for error in exc.errors()]) from None
+        scenario._source = source
+        scenario._data = data
+        return scenario
 
     @property
     def source(self) -> str:

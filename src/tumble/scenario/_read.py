@@ -2,18 +2,24 @@
 
 from __future__ import annotations
 
+import os
 import tomllib
 from collections.abc import Callable
-import pydantic
+from typing import TYPE_CHECKING
 
 from tumble._files import read_input
 from tumble._validate import ValidationError
 from tumble.scenario._base import Scenario
-from tumble.scenario._errors import ScenarioError, describe, in_file, toml_problem
+from tumble.scenario._errors import ScenarioError, in_file, toml_problem
 from tumble.scenario.kinds import kind_of, scenario_class
+from tumble.scenario.sweep import sweep_arguments
 from tumble.trajectory import Trajectory
 
-__all__ = ["load", "parse", "parse_data", "run_scenario"]
+if TYPE_CHECKING:
+    import xarray
+    from distributed import Client
+
+__all__ = ["load", "parse", "run_scenario"]
 
 
 def parse(text: str, *, source: str = "<string>") -> Scenario:
@@ -28,19 +34,7 @@ def parse(text: str, *, source: str = "<string>") -> Scenario:
         raise ScenarioError(source, [toml_problem(exc)]) from None
     with in_file(source):
         kind = kind_of(data)
-    return parse_data(scenario_class(kind), {**data, "kind": kind}, source)
-
-
-def parse_data(cls: type[Scenario], data: dict, source: str) -> Scenario:
-    """Validate the parsed TOML ``data`` as a scenario of class ``cls``; it keeps ``data`` (a sweep rebuilds
-    its model from it with dispersed values in place)."""
-    try:
-        scenario = cls.model_validate(data)
-    except pydantic.ValidationError as exc:
-        raise ScenarioError(source, [describe(error, cls) for error in exc.errors()]) from None
-    scenario._source = source
-    scenario._data = data
-    return scenario
+    return scenario_class(kind).from_data({**data, "kind": kind}, source)
 
 
 def load(path) -> Scenario:
@@ -63,3 +57,18 @@ def run_scenario(scenario, *, progress: Callable[[int, int], None] | None = None
     if not isinstance(scenario, Scenario):
         scenario = load(scenario)
     return scenario.run(progress=progress)
+
+
+def sweep_scenario(scenario: Scenario | str | os.PathLike[str], *, samples: int | None = None,
+                   store: str | os.PathLike[str] | None = None, client: Client | None = None,
+                   workers: int | None = None, progress: Callable[[int, int], None] | None = None,
+                   retries: int = 2) -> xarray.Dataset:
+    """:func:`tumble.sweep` of a scenario (a :class:`tumble.scenario.Scenario` or the path of its file) as its
+    ``[sweep]`` table describes (:mod:`tumble.scenario.sweep`); ``samples`` overrides the table's."""
+    from tumble.sweeps import sweep
+
+    if not isinstance(scenario, Scenario):
+        scenario = load(scenario)
+    arguments = sweep_arguments(scenario, samples=samples)
+    return sweep(arguments.pop("model"), arguments.pop("dispersions"), store=store, client=client,
+                 workers=workers, progress=progress, retries=retries, **arguments)

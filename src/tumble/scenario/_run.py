@@ -4,13 +4,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from tumble.scenario._errors import in_file, keyed
 from tumble.simulate import Model, SolverOptions, simulate
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from tumble.body import RigidBody
 
 __all__ = ["RUN_KEYS", "Run"]
 
@@ -23,7 +26,8 @@ RUN_KEYS = {"t": "time", "method": "solver.method", "rtol": "solver.rtol", "atol
 class Run:
     """The arguments of ``tumble.simulate(model, t=t, method=method, torque=torque, **initial, **options)``.
 
-    model   : the tumble model (:class:`tumble.simulate.Model`)
+    model   : the tumble model (:class:`tumble.model.Model`), or a :class:`~tumble.RigidBody`, which
+              :func:`tumble.simulate` turns into its model
     initial : its initial state by name (the keywords of :meth:`~tumble.simulate.Model.state_fields`)
     t       : output times, s
     method  : integration method; ``options`` the solver options the file gives (``rtol``, ``atol``, ``dt``)
@@ -32,7 +36,7 @@ class Run:
     source  : the scenario file, for messages
     """
 
-    model: Model
+    model: Model | RigidBody
     initial: dict[str, Any]  # array_like values; keyword arguments of simulate, so typed as its **initial_state
     t: np.ndarray
     method: str

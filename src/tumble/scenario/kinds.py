@@ -14,8 +14,12 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from tumble.scenario._errors import ScenarioError, short
+
+if TYPE_CHECKING:
+    from tumble.scenario._base import Scenario
 
 __all__ = ["DEFAULT_KIND", "KINDS", "Kind", "kind_of", "scenario_class"]
 
@@ -79,7 +83,7 @@ def kind_of(data: dict) -> str:
     return marked[0] if marked else DEFAULT_KIND
 
 
-def scenario_class(kind: str) -> type:
+def scenario_class(kind: str) -> type[Scenario]:
     """The :class:`~tumble.scenario.Scenario` subclass of ``kind`` (a key of :data:`KINDS`)."""
     module, name = KINDS[kind].scenario.split(":")
     return getattr(importlib.import_module(module), name)

@@ -56,6 +56,7 @@ from tumble.sweeps.plan import store_name_problem
 if TYPE_CHECKING:
     import numpy as np
 
+    from tumble.body import RigidBody
     from tumble.scenario._base import Scenario
     from tumble.scenario.rigid import Problem
     from tumble.simulate import Model
@@ -158,7 +159,7 @@ class ScenarioModel:
         self.cls, self.data, self.source = type(scenario), scenario._data, scenario.source
         self.parameters = tuple(keys)
 
-    def __call__(self, **values: Any) -> Model:
+    def __call__(self, **values: Any) -> Model | RigidBody:
         data = copy.deepcopy(self.data)
         for key, value in values.items():
             *tables, last = key.split(".")
@@ -166,9 +167,7 @@ class ScenarioModel:
             for name in tables:
                 node = node.setdefault(name, {})
             node[last] = value.tolist() if hasattr(value, "tolist") else value
-        from tumble.scenario._read import parse_data
-
-        return as_run(parse_data(self.cls, data, self.source).build()).model
+        return as_run(self.cls.from_data(data, self.source).build()).model
 
     def __repr__(self):
         return f"ScenarioModel({self.source!r}, keys={list(self.parameters)})"

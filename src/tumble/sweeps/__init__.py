@@ -64,11 +64,10 @@ if TYPE_CHECKING:
     from numpy.typing import ArrayLike
 
     from tumble.body import RigidBody
-    from tumble.scenario import Scenario
     from tumble.simulate import Model
     from tumble.torques import TorqueLike
 
-__all__ = ["sweep", "sweep_scenario", "open_sweep", "simulate_to_store", "local_cluster", "StoreMismatchError",
+__all__ = ["sweep", "open_sweep", "simulate_to_store", "local_cluster", "StoreMismatchError",
            "Dispersion", "Normal",
            "Uniform", "TruncatedNormal", "Grid",
            "UniformAttitude", "Inertia", "Misalignment", "NoiseSeed", "PointingError", "NutationAngle",
@@ -166,7 +165,7 @@ def sweep(
     """
     times = output_times(t)
     if _is_scenario(model):
-        raise ValidationError("model: a scenario sweeps with sweep_scenario(scenario, ...) (its [sweep] table "
+        raise ValidationError("model: a scenario sweeps with tumble.scenario.sweep_scenario(scenario, ...) (its [sweep] table "
                               "gives the dispersions, times and solver)")
     if not _is_builder(model):
         as_model(cast(Any, model))  # refuse what is not a model before anything else
@@ -204,25 +203,9 @@ def _parallel(client: Client | None, workers: int | None) -> int:
 
 
 def _is_scenario(model) -> bool:
-    from tumble.scenario import Scenario
-
-    return isinstance(model, Scenario)
-
-
-def sweep_scenario(scenario: Scenario | str | os.PathLike[str], *, samples: int | None = None,
-                   store: str | os.PathLike[str] | None = None, client: Client | None = None,
-                   workers: int | None = None, progress: Callable[[int, int], None] | None = None,
-                   retries: int = 2) -> xarray.Dataset:
-    """:func:`sweep` of a scenario (a :class:`tumble.scenario.Scenario` or the path of its file) as its
-    ``[sweep]`` table describes (:mod:`tumble.scenario.sweep`); ``samples`` overrides the table's."""
-    from tumble.scenario import load
-    from tumble.scenario.sweep import sweep_arguments
-
-    if not _is_scenario(scenario):
-        scenario = load(scenario)
-    arguments = sweep_arguments(cast("Scenario", scenario), samples=samples)  # loaded above when a path
-    return sweep(arguments.pop("model"), arguments.pop("dispersions"), store=store, client=client,
-                 workers=workers, progress=progress, retries=retries, **arguments)
+    """Whether ``model`` is a :class:`tumble.scenario.Scenario`, known by its classes' names (the scenario
+    layer sits above the sweeps)."""
+    return any(c.__module__ == "tumble.scenario._base" and c.__name__ == "Scenario" for c in type(model).__mro__)
 
 
 def open_sweep(path: str | os.PathLike[str]) -> xarray.Dataset:
@@ -235,3 +218,15 @@ def open_sweep(path: str | os.PathLike[str]) -> xarray.Dataset:
     if SETTINGS_ATTR not in ds.attrs:
         raise ValidationError(f"path: {path} is not a tumble sweep store")
     return ds
+
+
+def __getattr__(name: str):
+    if name == "sweep_scenario":  # deprecated in 0.4.0, removed in 0.5
+        import warnings
+
+        from tumble.scenario import sweep_scenario
+
+        warnings.warn("tumble.sweeps.sweep_scenario is deprecated and will be removed in tumble 0.5: use "
+                      "tumble.scenario.sweep_scenario", DeprecationWarning, stacklevel=2)
+        return sweep_scenario
+    raise AttributeError(f"module 'tumble.sweeps' has no attribute {name!r}")
