@@ -216,9 +216,10 @@ class SamplingTable(_Table):
 class FlightSoftwareTable(_Table):
     """``[spacecraft.flight_software]``: a gyro (``gyro_arw``, rad/√s; ``gyro_rrw``, rad/s^1.5) and attitude
     sensors — a star tracker (``star_tracker_sigma``, rad: a number or 3), a fine Sun sensor
-    (``sun_sensor_sigma``, rad; ``sun_direction``, inertial), a magnetometer (``magnetometer_sigma``, rad) —
+    (``sun_sensor_sigma``, rad), a magnetometer (``magnetometer_sigma``, rad), six coarse Sun sensor heads
+    (``coarse_sun_sensor_sigma``; the Sun: ``sun_direction``, inertial, or the environment's) —
     each sampled as its ``*_sampling`` table says (``period``, ``latency``, ``stream``), read through the MEKF
-    at ``control_period``, the law fed the estimate; ``delay`` (0 or 1 period), ``sensor_noise``, ``seed``, and
+    at ``control_period``, the law fed the estimate; ``delay`` (in control periods, in [0, 1]), ``sensor_noise``, ``seed``, and
     the filter's initial ``attitude_sigma0`` (rad) and ``bias_sigma0`` (rad/s)."""
 
     gyro_arw: _Number
@@ -227,13 +228,15 @@ class FlightSoftwareTable(_Table):
     sun_sensor_sigma: _Positive | None = None
     sun_direction: _Vector | None = None
     magnetometer_sigma: _Positive | None = None
+    coarse_sun_sensor_sigma: _Positive | None = None
     gyro_sampling: SamplingTable = SamplingTable()
     star_tracker_sampling: SamplingTable = SamplingTable()
     sun_sensor_sampling: SamplingTable = SamplingTable()
     magnetometer_sampling: SamplingTable = SamplingTable()
+    coarse_sun_sensor_sampling: SamplingTable = SamplingTable()
     attitude_sigma0: _Positive = 1e-2
     bias_sigma0: _Positive = 1e-4
-    delay: Annotated[int, Field(strict=True)] = 1
+    delay: _Number = 1.0
     sensor_noise: _Bool = True
     seed: Annotated[int, Field(strict=True)] = 0
 

@@ -1,6 +1,6 @@
-"""The flight-software loop: a gyro, a star tracker and direction sensors (a fine Sun sensor, a magnetometer),
-each read at its own rate with its own latency, the MEKF fed their time-stamped readings, and the control law
-fed the estimate instead of the truth (:mod:`tumble.kernels.spacecraft.flight_software`).
+"""The flight-software loop: a gyro, a star tracker and direction sensors (fine and coarse Sun sensors, a
+magnetometer), each read at its own rate with its own latency, the MEKF fed their time-stamped readings, and
+the control law fed the estimate instead of the truth (:mod:`tumble.kernels.spacecraft.flight_software`).
 
 The estimator is :func:`tumble.estimation.mekf`'s compiled step; the sensors are
 the MEKF's own models (gyro angle and rate random walks, star-tracker noise in
@@ -65,16 +65,22 @@ class FlightSoftware:
     gyro_arw : σ_v, the gyro's angle random walk, rad/√s
     gyro_rrw : σ_u, its rate random walk (bias instability), rad/s^1.5
     star_tracker_sigma : σ_st, the star tracker's noise about each body axis, rad (a number or 3), or None
-    sun_sensor_sigma, sun_direction : a fine Sun sensor's noise (rad) and the Sun's direction (3, inertial
-        axes, normalised here), or None
+    sun_sensor_sigma : a fine Sun sensor's noise (rad), or None
     magnetometer_sigma : a magnetometer's direction noise (rad; it reads the spacecraft's ``magnetic_field``),
         or None
-    gyro_sampling, star_tracker_sampling, sun_sensor_sampling, magnetometer_sampling : each sensor's
-        :class:`Sampling` (default: at the control period, no latency). The direction sensors read at gyro
-        sample times: their periods are whole numbers of the gyro's.
+    coarse_sun_sensor_sigma : the noise of each of six coarse (cosine) Sun sensor heads on the body's faces
+        ±x, ±y, ±z (of full scale 1), or None
+    sun_direction : the Sun's direction (3, inertial axes, normalised here) the Sun sensors see, or None: the
+        spacecraft's ``environment`` (the Sun's direction and the eclipses along the orbit). A Sun sensor gives
+        no reading while less than half the Sun is seen.
+    gyro_sampling, star_tracker_sampling, sun_sensor_sampling, magnetometer_sampling,
+    coarse_sun_sensor_sampling : each sensor's :class:`Sampling` (default: at the control period, no
+        latency). The direction sensors read at gyro sample times: their periods are whole numbers of the
+        gyro's.
     attitude_sigma0, bias_sigma0 : the filter's initial 1σ uncertainty of the attitude (rad) and the bias (rad/s)
-    delay : the computation delay in control periods, 0 or 1: the command computed at ``t_k`` acts from
-        ``t_k + delay·T`` (zero before the first one is out)
+    delay : the computation delay in control periods, a number in [0, 1]: the command computed at ``t_k`` acts
+        from ``t_k + delay·T`` exactly, the steps ending there (the one before it until then; zero before the
+        first one is out)
     sensor_noise : False: the sensors read the truth exactly (the filter keeps its noise model)
     seed : the default of ``sensor_seed0`` (each run's noise seed, a whole number in [0, 2⁵³)), the same for
         every run of a batch: give ``sensor_seed0`` one per run for a Monte-Carlo over the noise
@@ -90,13 +96,15 @@ class FlightSoftware:
     sun_sensor_sigma: float | None = None
     sun_direction: np.ndarray | None = None
     magnetometer_sigma: float | None = None
+    coarse_sun_sensor_sigma: float | None = None
     gyro_sampling: Sampling = Sampling()
     star_tracker_sampling: Sampling = Sampling()
     sun_sensor_sampling: Sampling = Sampling()
     magnetometer_sampling: Sampling = Sampling()
+    coarse_sun_sensor_sampling: Sampling = Sampling()
     attitude_sigma0: float = 1e-2
     bias_sigma0: float = 1e-4
-    delay: int = 1
+    delay: float = 1
     sensor_noise: bool = True
     seed: int = 0
 
@@ -106,11 +114,12 @@ class FlightSoftware:
         set_(self, "gyro_rrw", require_non_negative(self.gyro_rrw, "gyro_rrw"))
         if self.star_tracker_sigma is not None:
             set_(self, "star_tracker_sigma", _axes_sigma(self.star_tracker_sigma))
-        for name in ("sun_sensor_sigma", "magnetometer_sigma"):
+        for name in ("sun_sensor_sigma", "magnetometer_sigma", "coarse_sun_sensor_sigma"):
             if getattr(self, name) is not None:
                 set_(self, name, require_positive(getattr(self, name), name))
-        if (self.sun_sensor_sigma is None) != (self.sun_direction is None):
-            raise ValidationError("sun_direction: give it with sun_sensor_sigma (the fine Sun sensor), or neither")
+        if self.sun_direction is not None and not self.sees_the_sun:
+            raise ValidationError("sun_direction: give it with a Sun sensor (sun_sensor_sigma, "
+                                  "coarse_sun_sensor_sigma), or not at all")
         if self.sun_direction is not None:
             sun = as_array(self.sun_direction, "sun_direction")
             if sun.shape != (3,) or not np.any(sun):
@@ -119,7 +128,7 @@ class FlightSoftware:
             sun = sun / np.linalg.norm(sun)
             sun.setflags(write=False)
             set_(self, "sun_direction", sun)
-        if self.star_tracker_sigma is None and self.sun_sensor_sigma is None and self.magnetometer_sigma is None:
+        if self.sensors == ("gyro",):
             raise ValidationError("star_tracker_sigma: the filter needs an attitude sensor: a star tracker, a Sun "
                                   "sensor or a magnetometer")
         for sensor in SENSORS:
@@ -131,8 +140,9 @@ class FlightSoftware:
             raise ValidationError(f"stream: each sensor needs its own noise stream, got {streams} for {SENSORS}")
         set_(self, "attitude_sigma0", require_positive(self.attitude_sigma0, "attitude_sigma0"))
         set_(self, "bias_sigma0", require_positive(self.bias_sigma0, "bias_sigma0"))
-        if self.delay not in (0, 1) or isinstance(self.delay, bool):
-            raise ValidationError(f"delay: must be 0 or 1 control period, got {self.delay!r}")
+        if isinstance(self.delay, (bool, np.bool_)) or not 0.0 <= require_non_negative(self.delay, "delay") <= 1.0:
+            raise ValidationError(f"delay: must be a number in [0, 1] (control periods), got {self.delay!r}")
+        set_(self, "delay", float(self.delay))
         if not isinstance(self.sensor_noise, (bool, np.bool_)):
             raise ValidationError(f"sensor_noise: must be True or False, got {self.sensor_noise!r}")
         check_seed(self.seed, "seed")
@@ -140,16 +150,21 @@ class FlightSoftware:
     @property
     def sensors(self) -> tuple[str, ...]:
         """The sensors present, of :data:`SENSORS` (the gyro always)."""
-        sigma = {"gyro": self.gyro_arw, "star_tracker": self.star_tracker_sigma,
-                 "sun_sensor": self.sun_sensor_sigma, "magnetometer": self.magnetometer_sigma}
+        sigma = {"gyro": self.gyro_arw, "star_tracker": self.star_tracker_sigma, "sun_sensor": self.sun_sensor_sigma,
+                 "magnetometer": self.magnetometer_sigma, "coarse_sun_sensor": self.coarse_sun_sensor_sigma}
         return tuple(sensor for sensor in SENSORS if sigma[sensor] is not None)
+
+    @property
+    def sees_the_sun(self) -> bool:
+        """True with a Sun sensor, fine or coarse."""
+        return self.sun_sensor_sigma is not None or self.coarse_sun_sensor_sigma is not None
 
     def _stream(self, sensor: str) -> int:
         stream = getattr(self, f"{sensor}_sampling").stream
         return SENSORS.index(sensor) if stream is None else int(stream)
 
     def clocks(self, control_period: float) -> np.ndarray:
-        """(4, 3): period (s; 0 for a sensor absent), latency (s) and stream number of each of :data:`SENSORS`,
+        """(5, 3): period (s; 0 for a sensor absent), latency (s) and stream number of each of :data:`SENSORS`,
         a period of None being ``control_period``."""
         rows = []
         for sensor in SENSORS:
@@ -185,7 +200,8 @@ class FlightSoftware:
         return _kernel.program(self.gyro_arw, self.gyro_rrw, self.star_tracker_sigma if tracker else np.ones(3),
                                self.delay, bool(self.sensor_noise), self.sun_sensor_sigma or 0.0,
                                self.sun_direction if self.sun_direction is not None else np.zeros(3),
-                               self.magnetometer_sigma or 0.0, self.clocks(control_period))
+                               self.magnetometer_sigma or 0.0, self.coarse_sun_sensor_sigma or 0.0,
+                               self.clocks(control_period))
 
 
 def _axes_sigma(value) -> np.ndarray:

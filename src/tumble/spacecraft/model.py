@@ -217,6 +217,10 @@ class Spacecraft(Model):
         if self.control_period is None:
             raise ValidationError("flight_software: needs a control_period (its sensors and filter run at it)")
         self.flight_software.check_clocks(self.control_period)
+        if self.flight_software.sees_the_sun and (self.flight_software.sun_direction is None) == (
+                self.environment is None):
+            raise ValidationError("flight_software: a Sun sensor needs the Sun: a sun_direction or an environment "
+                                  "(its Sun and eclipses), not both")
         if self.flight_software.magnetometer_sigma is not None and not self._has_field:
             raise ValidationError("flight_software: a magnetometer needs a magnetic_field")
         if self._torque_law() is None or any(isinstance(law, WheelTorques) for law in self.controller):
@@ -427,6 +431,26 @@ class Spacecraft(Model):
                                   f"land on the sample times; t[{k + 1}] − t[{k}] = {t[k + 1] - t[k]} s is "
                                   f"{steps[k]:.6g} steps of {dt} s")
 
+    def step_ends(self, t: np.ndarray, dt: float | None) -> np.ndarray | None:
+        """With a flight software whose computation delay ``δ = delay·control_period`` is not a whole number of
+        steps ``dt``: the times ``t₀ + k T + δ`` its commands start acting, and with them every sample time
+        ``t₀ + k T`` and sensor reading time ``t₀ + m P`` (s), so that steps end on each (between them a step is
+        at most ``dt``); else None."""
+        fsw, period = self.flight_software, self.control_period
+        if fsw is None or period is None or dt is None:
+            return None
+        lag = fsw.delay * period
+        ratio = lag / dt
+        if abs(ratio - round(ratio)) <= _WHOLE * max(ratio, 1.0):
+            return None
+        t0, span = float(t[0]), float(t[-1] - t[0])
+        samples = t0 + np.arange(math.floor(span / period) + 1) * period
+        ends = [samples, samples + lag]
+        for clock in fsw.clocks(period)[:, 0]:
+            if clock > 0.0:
+                ends.append(t0 + np.arange(math.floor(span / clock) + 1) * clock)
+        return np.concatenate(ends)
+
     def initial_states(self, kernel: Any, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         n = values["omega0"].shape[0]
         y0 = np.zeros((n, kernel.size))
@@ -591,7 +615,7 @@ class Spacecraft(Model):
         used = fsw[..., k.USED:k.USED + len(k.SENSORS)]
         add("sensor_time", np.where(used > k.NEVER, used, np.nan), ("sensor",), "s",
             "the time of each sensor's newest reading the flight software used (gyro, star tracker, Sun sensor, "
-            "magnetometer; NaN: none yet, or no such sensor)")
+            "magnetometer, coarse Sun sensor; NaN: none yet, or no such sensor)")
         add("knowledge_error", attitude.to_rotvec(attitude.multiply(attitude.conjugate(q), q_estimate)), ("xyz",),
             "rad", "estimate − truth: rotation vector of q* ⊗ q_estimate, body axes")
         add("knowledge_error_3sigma", 3.0 * sigma[..., :3], ("xyz",), "rad",

@@ -1,4 +1,4 @@
-"""The flight software: a gyro, a star tracker, a fine Sun sensor and a magnetometer, each sampled at its own
+"""The flight software: a gyro, a star tracker, fine and coarse Sun sensors and a magnetometer, each sampled at its own
 rate with its own latency, the MEKF fed the time-stamped readings, the estimate fed to the control law, the
 command held after a computation delay.
 
@@ -25,7 +25,14 @@ magnetometer: the direction ``r`` (inertial: the Sun's, fixed; the field's
 ``R(q) B``, ``B`` the spacecraft's field in body axes) seen in body axes,
 ``b = R(q)ᵀ r``, turned by a rotation vector ``v ~ N(0, σ² I)``, so that its
 error ``v × b`` has the covariance ``σ² (I − b bᵀ)`` of the MEKF's vector model
-(Shuster's). Each sensor keeps its two newest readings with their times
+(Shuster's). Coarse Sun sensor: six cosine heads on the body's faces ±x, ±y,
+±z, each reading ``I = ν max(0, n · ŝ_B) + σ w`` (full scale 1, ``ν`` the
+fraction of the Sun seen, :mod:`tumble.spacecraft.eclipse`); the flight
+software's Sun vector is ``v_i = I₊ᵢ − I₋ᵢ`` (``= ν ŝ_B`` without noise), a
+direction ``v/|v|`` of noise ``√2 σ/|v|`` across it. The Sun is the
+spacecraft's environment table's (its direction and ``ν`` at ``t``) or the
+fixed ``sun_direction`` (``ν = 1``); a Sun sensor gives no reading while
+``ν`` (coarse: ``|v|``) is below :data:`DARK`: no Sun, no measurement. Each sensor keeps its two newest readings with their times
 (with a latency below the period, one of them is out).
 
 **The flight software** (``step``, at each sample ``t_k = t₀ + k T`` of the
@@ -42,9 +49,11 @@ zero-order hold) uses the newest reading of each sensor that is out by
 2. it predicts, without keeping it, to the newest gyro reading ``τ_g`` and on
    to ``t_k`` with that reading's rate: the estimate ``q̂_k`` and its covariance;
 3. gives the control law ``q̂_k`` and ``ω̂_k = ω̃(τ_g) − β̂`` (0 before the gyro's first
-   reading is out); the command it computes acts after the computation delay,
-   0 or one period ``T``: with one, the command of ``t_k`` is held from
-   ``t_{k+1}`` (the part keeps it pending meanwhile; none acts before the first is out).
+   reading is out); the command it computes acts after the computation delay
+   ``δ = delay·T`` (``delay`` in [0, 1]): the part keeps it pending and, at the
+   step that ends at ``t_k + δ`` (:meth:`tumble.spacecraft.Spacecraft.step_ends`
+   makes the steps end there), hands it to the zero-order hold; the one held
+   acts until then (none acts before the first is out).
 
 With ``sensor_noise`` off the sensors read the truth exactly (bias ``β`` included,
 constant) while the filter keeps its noise model, so that the loop fed a perfect
@@ -63,22 +72,27 @@ import numpy as np
 from tumble._quat import qexp, qlog, qmul, qrotate, qrotate_inv
 from tumble.estimation._mekf import _propagate, _update_star_tracker, _update_vector
 from tumble.kernels.spacecraft._base import SAMPLE_TOLERANCE, Lane, Program, inline
-from tumble.kernels.spacecraft._layout import START
+from tumble.kernels.spacecraft._layout import PERIOD, START
 
 #: The sensors, in the order of their clocks and readings (the gyro first: the others read its state).
-SENSORS = ("gyro", "star_tracker", "sun_sensor", "magnetometer")
-GYRO, STAR_TRACKER, SUN_SENSOR, MAGNETOMETER = range(4)
+SENSORS = ("gyro", "star_tracker", "sun_sensor", "magnetometer", "coarse_sun_sensor")
+GYRO, STAR_TRACKER, SUN_SENSOR, MAGNETOMETER, COARSE_SUN_SENSOR = range(5)
+
+#: A Sun sensor gives no reading when less than this fraction of the Sun is seen (coarse: when its Sun vector
+#: is shorter than this, of full scale 1): no Sun, no measurement.
+DARK = 0.5
 
 # Parameters:
 ARW = 0            # σ_v, rad/√s
 RRW = 1            # σ_u, rad/s^1.5
 ST_SIGMA = 2       # σ_st (3), rad, body axes
-DELAY = 5          # the computation delay in periods: 0 or 1
+DELAY = 5          # the computation delay in periods, in [0, 1]
 NOISE = 6          # 1: noisy sensors, 0: perfect ones
 SUN_SIGMA = 7      # σ of the fine Sun sensor, rad (0: none)
 SUN_DIRECTION = 8  # the Sun's direction (3), inertial axes, unit
 MAG_SIGMA = 11     # σ of the magnetometer's direction, rad (0: none)
-CLOCKS = 12        # per sensor of SENSORS: period P (s; 0: none), latency L (s), stream number
+CSS_SIGMA = 12     # σ of each coarse Sun sensor head's current, of full scale 1 (0: none)
+CLOCKS = 13        # per sensor of SENSORS: period P (s; 0: none), latency L (s), stream number
 CLOCK = 3
 SIZE = CLOCKS + CLOCK * len(SENSORS)
 # State slice:
@@ -94,10 +108,11 @@ FILTER_P = 60      # its P (36) at t_f
 FILTER_TIME = 96   # t_f, s: the time of its last update
 FILTER_GYRO = 97   # the gyro's reading at t_f: q (4), E (3)
 GYRO_ERROR = 104   # the gyro's accumulated angle error E (3), rad
-NEXT = 107         # per sensor: the index m of its next sample (4)
-USED = 111         # per sensor: the time of its newest reading the flight software used, s (4; NEVER: none)
-READINGS = 115     # per sensor: its two newest readings, the newest first, each of READING values:
-READING = 15       # τ (s; NEVER: none), value (4: q̃; b̃ (3); the gyro's rate (3)), reference r (3), gyro q (4), E (3)
+NEXT = 107         # per sensor: the index m of its next sample
+USED = NEXT + len(SENSORS)      # per sensor: the time of its newest reading the flight software used, s (NEVER: none)
+READINGS = USED + len(SENSORS)  # per sensor: its two newest readings, the newest first, each of READING values:
+READING = 15       # τ (s; NEVER: none), value (4: q̃; b̃ (3) [and the coarse Sun sensor's σ]; the gyro's rate (3)),
+                   # reference r (3), gyro q (4), E (3)
 TAU, VALUE, REFERENCE, READ_Q, READ_E = 0, 1, 5, 8, 12
 STATE = READINGS + 2 * READING * len(SENSORS)
 
@@ -114,12 +129,13 @@ _S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(
 _TWO53 = 2.0 ** -53
 
 
-def program(arw: float, rrw: float, star_tracker_sigma, delay: int, noise: bool, sun_sensor_sigma: float,
-            sun_direction, magnetometer_sigma: float, clocks) -> Program:
+def program(arw: float, rrw: float, star_tracker_sigma, delay: float, noise: bool, sun_sensor_sigma: float,
+            sun_direction, magnetometer_sigma: float, coarse_sun_sensor_sigma: float, clocks) -> Program:
     """The flight software's :class:`~tumble.kernels.spacecraft._base.Program` (parameters: the offsets above;
-    ``clocks`` (4, 3): period, latency and stream number of each of :data:`SENSORS`)."""
+    ``clocks`` (5, 3): period, latency and stream number of each of :data:`SENSORS`)."""
     params = np.concatenate([[arw, rrw], star_tracker_sigma, [delay, 1.0 if noise else 0.0, sun_sensor_sigma],
-                             sun_direction, [magnetometer_sigma], np.ravel(clocks)]).astype(np.float64)
+                             sun_direction, [magnetometer_sigma, coarse_sun_sensor_sigma],
+                             np.ravel(clocks)]).astype(np.float64)
     return Program("flight_software", params, state=STATE)
 
 
@@ -169,12 +185,14 @@ def normal(key, m, i):
 
 
 def kernel(lane: Lane):
-    """``(sense, step, delayed)`` of the flight software for the state access ``lane``.
+    """``(sense, step, pend, due)`` of the flight software for the state access ``lane``.
 
-    ``sense(model, p, s, t, y, j, B)``: the sensors whose sample time is ``t`` (s) read the truth (in place;
-    ``B`` the field, T, body axes); ``step(model, p, s, period, t, y, j) -> (q̂, ω̂)``: the MEKF at the
-    flight software's sample time ``t`` (in place); ``delayed(model, p, s, y, j, u, m) -> (u, m)``: the
-    command that acts now, given the one just computed."""
+    ``sense(model, p, s, t, y, j, B, ŝ, ν)``: the sensors whose sample time is ``t`` (s) read the truth (in
+    place; ``B`` the field, T, body axes; ``ŝ`` the Sun's direction, inertial, and ``ν`` the fraction of it
+    seen); ``step(model, p, s, period, t, y, j) -> (q̂, ω̂)``: the MEKF at the
+    flight software's sample time ``t`` (in place); ``pend(model, p, s, y, j, u, m) -> bool``: keeps the
+    command just computed pending when it acts after a delay; ``due(model, p, t) -> bool``: whether a pending
+    command starts acting at ``t`` (the pending command is at ``PENDING``: u_c (3), m_c (3))."""
     at, put, put3 = lane
 
     @inline
@@ -218,11 +236,12 @@ def kernel(lane: Lane):
         return qrotate(nw, nx, ny, nz, b1, b2, b3)
 
     @inline
-    def sense(model, p, s, t, y, j, f1, f2, f3):
+    def sense(model, p, s, t, y, j, f1, f2, f3, s1, s2, s3, light):
         d = model.data
         t0, noise, seed = d[START], d[p + NOISE], int(at(y, s + SEED, j))
         qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
-        present = (True, d[p + CLOCKS + CLOCK * STAR_TRACKER] > 0.0, d[p + SUN_SIGMA] > 0.0, d[p + MAG_SIGMA] > 0.0)
+        present = (True, d[p + CLOCKS + CLOCK * STAR_TRACKER] > 0.0, d[p + SUN_SIGMA] > 0.0, d[p + MAG_SIGMA] > 0.0,
+                   d[p + CSS_SIGMA] > 0.0)
         for sensor in range(len(SENSORS)):
             c = p + CLOCKS + CLOCK * sensor
             period = d[c]
@@ -254,16 +273,25 @@ def kernel(lane: Lane):
                                       noise * d[o + 2] * normal(key, m, 2))
                 mw, mx, my, mz = qmul(qw, qx, qy, qz, dw, dx, dy, dz)
                 record(y, j, s, sensor, tau, mw, mx, my, mz, 0.0, 0.0, 0.0)
+            elif sensor == COARSE_SUN_SENSOR:  # heads on ±x, ±y, ±z: v_i = I₊ᵢ − I₋ᵢ
+                sigma = noise * d[p + CSS_SIGMA]
+                b = qrotate_inv(qw, qx, qy, qz, s1, s2, s3)
+                v = np.empty(3)
+                for i in range(3):
+                    v[i] = (light * max(0.0, b[i]) + sigma * normal(key, m, 2 * i)
+                            - light * max(0.0, -b[i]) - sigma * normal(key, m, 2 * i + 1))
+                size = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+                if size >= DARK:
+                    record(y, j, s, sensor, tau, v[0] / size, v[1] / size, v[2] / size,
+                           math.sqrt(2.0) * d[p + CSS_SIGMA] / size, s1, s2, s3)
+            elif sensor == SUN_SENSOR:
+                if light >= DARK:
+                    b1, b2, b3 = qrotate_inv(qw, qx, qy, qz, s1, s2, s3)
+                    m1, m2, m3 = turned(key, m, d[p + SUN_SIGMA], noise, b1, b2, b3)
+                    record(y, j, s, sensor, tau, m1, m2, m3, 0.0, s1, s2, s3)
             else:
-                if sensor == SUN_SENSOR:
-                    sigma = d[p + SUN_SIGMA]
-                    o = p + SUN_DIRECTION
-                    r1, r2, r3 = d[o], d[o + 1], d[o + 2]
-                else:
-                    sigma = d[p + MAG_SIGMA]
-                    r1, r2, r3 = qrotate(qw, qx, qy, qz, f1, f2, f3)
-                b1, b2, b3 = qrotate_inv(qw, qx, qy, qz, r1, r2, r3)
-                m1, m2, m3 = turned(key, m, sigma, noise, b1, b2, b3)
+                r1, r2, r3 = qrotate(qw, qx, qy, qz, f1, f2, f3)
+                m1, m2, m3 = turned(key, m, d[p + MAG_SIGMA], noise, f1, f2, f3)
                 record(y, j, s, sensor, tau, m1, m2, m3, 0.0, r1, r2, r3)
 
     @inline
@@ -304,7 +332,8 @@ def kernel(lane: Lane):
                 R[i, i] = d[p + ST_SIGMA + i] ** 2
             _update_star_tracker(q_hat, beta_hat, P, gather(y, j, o + VALUE, 4), R)
         else:
-            sigma = d[p + SUN_SIGMA] if sensor == SUN_SENSOR else d[p + MAG_SIGMA]
+            sigma = (d[p + SUN_SIGMA] if sensor == SUN_SENSOR else d[p + MAG_SIGMA] if sensor == MAGNETOMETER
+                     else at(y, o + VALUE + 3, j))
             _update_vector(q_hat, beta_hat, P, gather(y, j, o + VALUE, 3), gather(y, j, o + REFERENCE, 3), sigma)
 
     @inline
@@ -357,13 +386,20 @@ def kernel(lane: Lane):
         return q_hat[0], q_hat[1], q_hat[2], q_hat[3], w1, w2, w3
 
     @inline
-    def delayed(model, p, s, y, j, u1, u2, u3, m1, m2, m3):
+    def pend(model, p, s, y, j, u1, u2, u3, m1, m2, m3):
+        """Keep the command just computed pending when it acts after a delay (then True: the one held stays)."""
         if model.data[p + DELAY] == 0.0:
-            return u1, u2, u3, m1, m2, m3
-        o = s + PENDING
-        acting = (at(y, o, j), at(y, o + 1, j), at(y, o + 2, j), at(y, o + 3, j), at(y, o + 4, j), at(y, o + 5, j))
-        put3(y, o, j, u1, u2, u3)
-        put3(y, o + 3, j, m1, m2, m3)
-        return acting
+            return False
+        put3(y, s + PENDING, j, u1, u2, u3)
+        put3(y, s + PENDING + 3, j, m1, m2, m3)
+        return True
 
-    return sense, step, delayed
+    @inline
+    def due(model, p, t):
+        """True when the step end ``t`` is a time ``t₀ + k T + δ`` (k ≥ 0, δ > 0) a pending command starts acting."""
+        d = model.data
+        period, lag = d[PERIOD], d[p + DELAY] * d[PERIOD]
+        k = round((t - d[START] - lag) / period)
+        return lag > 0.0 and k >= 0 and abs(t - d[START] - k * period - lag) <= SAMPLE_TOLERANCE * period
+
+    return sense, step, pend, due
