@@ -166,6 +166,12 @@ class Model(abc.ABC):
     def check_run(self, method: Method, t: np.ndarray, dt: float | None) -> None:  # noqa: B027
         """Refuse a run this model cannot make (e.g. output times outside its data); nothing by default."""
 
+    def step_ends(self, t: np.ndarray, dt: float | None) -> np.ndarray | None:
+        """Times (s) between the output times ``t`` at which a fixed step of at most ``dt`` must end (a
+        discrete event the steps would otherwise straddle), or None: the run is integrated through them as
+        well and only ``t`` is kept. None by default."""
+        return None
+
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """What the exact motion keeps constant on the run ``traj`` (name → samples (n, [N,] ...)).
 

@@ -167,16 +167,33 @@ def simulate(
                                   f"progress reporting; got method={m.name!r} on {who}"
                                   + (" and a progress callback" if progress is not None else ""))
         y0 = model.initial_states(kernel, values, float(times[0]))
-        _check_memory(times.size, y0)
+        grid, kept = _with_step_ends(times, model.step_ends(times, options.get("dt")))
+        _check_memory(grid.size, y0)
         try:
-            solution = integrate.solve(kernel, y0, times, method=m.name, progress=progress, device=device,
+            solution = integrate.solve(kernel, y0, grid, method=m.name, progress=progress, device=device,
                                        overwrite_y0=True, **options)
         except integrate.Diverged as diverged:
-            raise _divergence(model, kernel, times, diverged) from None
-        out = model.outputs(kernel, times, solution.states)
+            raise _divergence(model, kernel, grid, diverged) from None
+        out = model.outputs(kernel, times, solution.states if kept is None else solution.states[kept])
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
     return _trajectory(model, m.name, times, out, info, single=n is None)
+
+
+def _with_step_ends(times: np.ndarray, ends: np.ndarray | None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The times to integrate through: the output ``times`` and the model's step ``ends`` (s) between them (an
+    end within round-off, 1e-12 of the largest |t|, of an output time or of another end counted as that one), and the
+    indices of ``times`` in them (None without ends)."""
+    if ends is None or ends.size == 0:
+        return times, None
+    tolerance = 1e-12 * max(abs(times[0]), abs(times[-1]), np.finfo(float).tiny)
+    ends = np.sort(ends)
+    ends = ends[np.r_[True, np.diff(ends) > tolerance]]
+    near = np.searchsorted(times, ends)
+    gap = np.minimum(np.abs(ends - times[np.minimum(near, times.size - 1)]),
+                     np.abs(ends - times[np.maximum(near - 1, 0)]))
+    grid = np.union1d(times, ends[(gap > tolerance) & (ends > times[0]) & (ends < times[-1])])
+    return grid, np.searchsorted(grid, times)
 
 
 def _divergence(model: Model, kernel, t: np.ndarray, diverged: integrate.Diverged) -> integrate.SolverError:

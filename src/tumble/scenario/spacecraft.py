@@ -69,7 +69,7 @@ from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
 from tumble.spacecraft import actuators
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
-from tumble.spacecraft.flight_software import FlightSoftware
+from tumble.spacecraft.flight_software import FlightSoftware, Sampling
 from tumble.spacecraft.model import Spacecraft
 from tumble.trajectory import Trajectory
 
@@ -201,29 +201,49 @@ class ResidualDipoleTable(_Table):
         return ResidualDipole(np.array(self.dipole))
 
 
+class SamplingTable(_Table):
+    """A sensor's sampling (:class:`tumble.spacecraft.Sampling`): ``period`` (s; default the control period),
+    ``latency`` (s) and ``stream`` (its noise stream's number)."""
+
+    period: _Positive | None = None
+    latency: _Number = 0.0
+    stream: Annotated[int, Field(strict=True)] | None = None
+
+    def build(self) -> Sampling:
+        return Sampling(**self.model_dump())
+
+
 class FlightSoftwareTable(_Table):
     """``[spacecraft.flight_software]``: a gyro (``gyro_arw``, rad/√s; ``gyro_rrw``, rad/s^1.5) and attitude
-    sensors — a star tracker (``star_tracker_sigma``, rad: a number or 3; ``star_tracker_every`` samples), a
-    fine Sun sensor (``sun_sensor_sigma``, rad; ``sun_direction``, inertial), a magnetometer
-    (``magnetometer_sigma``, rad) — read through the MEKF at ``control_period``, the law fed the estimate;
-    ``delay`` (0 or 1 period), ``sensor_noise``, ``seed``, and the filter's initial ``attitude_sigma0`` (rad)
-    and ``bias_sigma0`` (rad/s)."""
+    sensors — a star tracker (``star_tracker_sigma``, rad: a number or 3), a fine Sun sensor
+    (``sun_sensor_sigma``, rad), a magnetometer (``magnetometer_sigma``, rad), six coarse Sun sensor heads
+    (``coarse_sun_sensor_sigma``; the Sun: ``sun_direction``, inertial, or the environment's) —
+    each sampled as its ``*_sampling`` table says (``period``, ``latency``, ``stream``), read through the MEKF
+    at ``control_period``, the law fed the estimate; ``delay`` (in control periods, in [0, 1]), ``sensor_noise``, ``seed``, and
+    the filter's initial ``attitude_sigma0`` (rad) and ``bias_sigma0`` (rad/s)."""
 
     gyro_arw: _Number
     gyro_rrw: _Number
     star_tracker_sigma: _Positive | _Vector | None = None
-    star_tracker_every: Annotated[int, Field(strict=True)] = 1
     sun_sensor_sigma: _Positive | None = None
     sun_direction: _Vector | None = None
     magnetometer_sigma: _Positive | None = None
+    coarse_sun_sensor_sigma: _Positive | None = None
+    gyro_sampling: SamplingTable = SamplingTable()
+    star_tracker_sampling: SamplingTable = SamplingTable()
+    sun_sensor_sampling: SamplingTable = SamplingTable()
+    magnetometer_sampling: SamplingTable = SamplingTable()
+    coarse_sun_sensor_sampling: SamplingTable = SamplingTable()
     attitude_sigma0: _Positive = 1e-2
     bias_sigma0: _Positive = 1e-4
-    delay: Annotated[int, Field(strict=True)] = 1
+    delay: _Number = 1.0
     sensor_noise: _Bool = True
     seed: Annotated[int, Field(strict=True)] = 0
 
     def build(self) -> FlightSoftware:
-        values: dict[str, Any] = {name: np.array(value) if isinstance(value, list) else value for name, value in self}
+        values: dict[str, Any] = {name: np.array(value) if isinstance(value, list) else
+                                  value.build() if isinstance(value, SamplingTable) else value
+                                  for name, value in self}
         return FlightSoftware(**values)
 
 

@@ -23,7 +23,7 @@ from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MR
 from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
-from tumble.spacecraft.flight_software import FlightSoftware
+from tumble.spacecraft.flight_software import FlightSoftware, Sampling
 from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
@@ -34,6 +34,7 @@ __all__ = [
     "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "Environment", "FlightSoftware", "MRPFeedback",
     "Magnetorquers",
     "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
+    "Sampling",
     "SaturationWarning", "SingularityWarning", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE", "Thruster",
     "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",

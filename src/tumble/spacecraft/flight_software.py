@@ -1,13 +1,14 @@
-"""The flight-software loop: a gyro, a star tracker and direction sensors (a fine Sun sensor, a magnetometer)
-read at the control period, the MEKF, and the control law fed the estimate instead of the truth
-(:mod:`tumble.kernels.spacecraft.flight_software`).
+"""The flight-software loop: a gyro, a star tracker and direction sensors (fine and coarse Sun sensors, a
+magnetometer), each read at its own rate with its own latency, the MEKF fed their time-stamped readings, and
+the control law fed the estimate instead of the truth (:mod:`tumble.kernels.spacecraft.flight_software`).
 
 The estimator is :func:`tumble.estimation.mekf`'s compiled step; the sensors are
 the MEKF's own models (gyro angle and rate random walks, star-tracker noise in
-body axes, direction noise across the direction), their noise drawn from a counter-based generator keyed by the seed
-of each run (``sensor_seed0``), so that a run is reproducible per seed and a
-batch of seeds is a Monte-Carlo over sensor noise. ``docs/estimation.md``,
-"The flight-software loop".
+body axes, direction noise across the direction), each drawing its noise from a
+counter-based generator keyed by the seed of each run (``sensor_seed0``) and
+its own stream number, so that a run is reproducible per seed, a batch of seeds
+is a Monte-Carlo over sensor noise, and no sensor's rate or stream changes
+another's noise. ``docs/estimation.md``, "The flight-software loop".
 """
 
 from __future__ import annotations
@@ -21,28 +22,65 @@ from tumble._validate import ValidationError, as_array, require_non_negative, re
 from tumble.kernels.spacecraft import flight_software as _kernel
 from tumble.kernels.spacecraft._base import Program
 
-__all__ = ["FlightSoftware"]
+__all__ = ["FlightSoftware", "Sampling"]
+
+#: The sensors of the flight software, in the order of their clocks.
+SENSORS = _kernel.SENSORS
 
 #: Seeds are held in the float64 state: whole numbers below 2⁵³.
 MAX_SEED = 2**53
 
 
 @dataclass(frozen=True)
+class Sampling:
+    """When a sensor reads: at ``t₀ + m·period`` (``t₀`` the run's start), its reading out ``latency`` later.
+
+    period : s, > 0, a whole number of integration steps; None: the spacecraft's ``control_period``
+    latency : s, ≥ 0 and shorter than the period (one reading in flight at a time)
+    stream : the number of the sensor's own noise stream (a whole number in [0, 2⁵³)); None: the sensor's
+        place in :data:`SENSORS`. Two sensors of one flight software need two streams.
+    """
+
+    period: float | None = None
+    latency: float = 0.0
+    stream: int | None = None
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        if self.period is not None:
+            set_(self, "period", require_positive(self.period, "period"))
+        set_(self, "latency", require_non_negative(self.latency, "latency"))
+        if self.period is not None and self.latency >= self.period:
+            raise ValidationError(f"latency: must be shorter than the period {self.period} s (one reading in "
+                                  f"flight at a time), got {self.latency} s")
+        if self.stream is not None:
+            check_seed(self.stream, "stream")
+
+
+@dataclass(frozen=True)
 class FlightSoftware:
-    """Gyro + star tracker and/or direction sensors + MEKF in the loop, sampled at the spacecraft's
-    ``control_period`` ``T``.
+    """Gyro + star tracker and/or direction sensors + MEKF in the loop, the filter run at the spacecraft's
+    ``control_period`` ``T``, each sensor at its own rate.
 
     gyro_arw : σ_v, the gyro's angle random walk, rad/√s
     gyro_rrw : σ_u, its rate random walk (bias instability), rad/s^1.5
     star_tracker_sigma : σ_st, the star tracker's noise about each body axis, rad (a number or 3), or None
-    star_tracker_every : the star tracker reads every n-th sample (n ≥ 1; its rate is 1/(n T))
-    sun_sensor_sigma, sun_direction : a fine Sun sensor's noise (rad) and the Sun's direction (3, inertial
-        axes, normalised here), or None
+    sun_sensor_sigma : a fine Sun sensor's noise (rad), or None
     magnetometer_sigma : a magnetometer's direction noise (rad; it reads the spacecraft's ``magnetic_field``),
         or None
+    coarse_sun_sensor_sigma : the noise of each of six coarse (cosine) Sun sensor heads on the body's faces
+        ±x, ±y, ±z (of full scale 1), or None
+    sun_direction : the Sun's direction (3, inertial axes, normalised here) the Sun sensors see, or None: the
+        spacecraft's ``environment`` (the Sun's direction and the eclipses along the orbit). A Sun sensor gives
+        no reading while less than half the Sun is seen.
+    gyro_sampling, star_tracker_sampling, sun_sensor_sampling, magnetometer_sampling,
+    coarse_sun_sensor_sampling : each sensor's :class:`Sampling` (default: at the control period, no
+        latency). The direction sensors read at gyro sample times: their periods are whole numbers of the
+        gyro's.
     attitude_sigma0, bias_sigma0 : the filter's initial 1σ uncertainty of the attitude (rad) and the bias (rad/s)
-    delay : the computation delay in control periods, 0 or 1: the command computed at ``t_k`` acts from
-        ``t_k + delay·T`` (zero before the first one is out)
+    delay : the computation delay in control periods, a number in [0, 1]: the command computed at ``t_k`` acts
+        from ``t_k + delay·T`` exactly, the steps ending there (the one before it until then; zero before the
+        first one is out)
     sensor_noise : False: the sensors read the truth exactly (the filter keeps its noise model)
     seed : the default of ``sensor_seed0`` (each run's noise seed, a whole number in [0, 2⁵³)), the same for
         every run of a batch: give ``sensor_seed0`` one per run for a Monte-Carlo over the noise
@@ -55,13 +93,18 @@ class FlightSoftware:
     gyro_arw: float
     gyro_rrw: float
     star_tracker_sigma: float | np.ndarray | None = None
-    star_tracker_every: int = 1
     sun_sensor_sigma: float | None = None
     sun_direction: np.ndarray | None = None
     magnetometer_sigma: float | None = None
+    coarse_sun_sensor_sigma: float | None = None
+    gyro_sampling: Sampling = Sampling()
+    star_tracker_sampling: Sampling = Sampling()
+    sun_sensor_sampling: Sampling = Sampling()
+    magnetometer_sampling: Sampling = Sampling()
+    coarse_sun_sensor_sampling: Sampling = Sampling()
     attitude_sigma0: float = 1e-2
     bias_sigma0: float = 1e-4
-    delay: int = 1
+    delay: float = 1
     sensor_noise: bool = True
     seed: int = 0
 
@@ -71,14 +114,12 @@ class FlightSoftware:
         set_(self, "gyro_rrw", require_non_negative(self.gyro_rrw, "gyro_rrw"))
         if self.star_tracker_sigma is not None:
             set_(self, "star_tracker_sigma", _axes_sigma(self.star_tracker_sigma))
-        if not isinstance(self.star_tracker_every, (int, np.integer)) or self.star_tracker_every < 1:
-            raise ValidationError(f"star_tracker_every: must be a whole number ≥ 1 (samples), got "
-                                  f"{self.star_tracker_every!r}")
-        for name in ("sun_sensor_sigma", "magnetometer_sigma"):
+        for name in ("sun_sensor_sigma", "magnetometer_sigma", "coarse_sun_sensor_sigma"):
             if getattr(self, name) is not None:
                 set_(self, name, require_positive(getattr(self, name), name))
-        if (self.sun_sensor_sigma is None) != (self.sun_direction is None):
-            raise ValidationError("sun_direction: give it with sun_sensor_sigma (the fine Sun sensor), or neither")
+        if self.sun_direction is not None and not self.sees_the_sun:
+            raise ValidationError("sun_direction: give it with a Sun sensor (sun_sensor_sigma, "
+                                  "coarse_sun_sensor_sigma), or not at all")
         if self.sun_direction is not None:
             sun = as_array(self.sun_direction, "sun_direction")
             if sun.shape != (3,) or not np.any(sun):
@@ -87,29 +128,80 @@ class FlightSoftware:
             sun = sun / np.linalg.norm(sun)
             sun.setflags(write=False)
             set_(self, "sun_direction", sun)
-        if self.star_tracker_sigma is None and self.sun_sensor_sigma is None and self.magnetometer_sigma is None:
+        if self.sensors == ("gyro",):
             raise ValidationError("star_tracker_sigma: the filter needs an attitude sensor: a star tracker, a Sun "
                                   "sensor or a magnetometer")
+        for sensor in SENSORS:
+            sampling = getattr(self, f"{sensor}_sampling")
+            if not isinstance(sampling, Sampling):
+                raise ValidationError(f"{sensor}_sampling: must be a Sampling, got {type(sampling).__name__}")
+        streams = [self._stream(sensor) for sensor in SENSORS]
+        if len(set(streams)) < len(streams):
+            raise ValidationError(f"stream: each sensor needs its own noise stream, got {streams} for {SENSORS}")
         set_(self, "attitude_sigma0", require_positive(self.attitude_sigma0, "attitude_sigma0"))
         set_(self, "bias_sigma0", require_positive(self.bias_sigma0, "bias_sigma0"))
-        if self.delay not in (0, 1) or isinstance(self.delay, bool):
-            raise ValidationError(f"delay: must be 0 or 1 control period, got {self.delay!r}")
+        if isinstance(self.delay, (bool, np.bool_)) or not 0.0 <= require_non_negative(self.delay, "delay") <= 1.0:
+            raise ValidationError(f"delay: must be a number in [0, 1] (control periods), got {self.delay!r}")
+        set_(self, "delay", float(self.delay))
         if not isinstance(self.sensor_noise, (bool, np.bool_)):
             raise ValidationError(f"sensor_noise: must be True or False, got {self.sensor_noise!r}")
         check_seed(self.seed, "seed")
+
+    @property
+    def sensors(self) -> tuple[str, ...]:
+        """The sensors present, of :data:`SENSORS` (the gyro always)."""
+        sigma = {"gyro": self.gyro_arw, "star_tracker": self.star_tracker_sigma, "sun_sensor": self.sun_sensor_sigma,
+                 "magnetometer": self.magnetometer_sigma, "coarse_sun_sensor": self.coarse_sun_sensor_sigma}
+        return tuple(sensor for sensor in SENSORS if sigma[sensor] is not None)
+
+    @property
+    def sees_the_sun(self) -> bool:
+        """True with a Sun sensor, fine or coarse."""
+        return self.sun_sensor_sigma is not None or self.coarse_sun_sensor_sigma is not None
+
+    def _stream(self, sensor: str) -> int:
+        stream = getattr(self, f"{sensor}_sampling").stream
+        return SENSORS.index(sensor) if stream is None else int(stream)
+
+    def clocks(self, control_period: float) -> np.ndarray:
+        """(5, 3): period (s; 0 for a sensor absent), latency (s) and stream number of each of :data:`SENSORS`,
+        a period of None being ``control_period``."""
+        rows = []
+        for sensor in SENSORS:
+            sampling = getattr(self, f"{sensor}_sampling")
+            period = control_period if sampling.period is None else sampling.period
+            rows.append([period if sensor in self.sensors else 0.0, sampling.latency, self._stream(sensor)])
+        return np.array(rows, dtype=np.float64)
+
+    def check_clocks(self, control_period: float) -> None:
+        """Each sensor's latency shorter than its period, the direction sensors' periods whole numbers of the
+        gyro's (their readings fall on its samples), else a ValidationError naming the sensor's sampling."""
+        clocks = self.clocks(control_period)
+        gyro = clocks[0, 0]
+        for sensor, (period, latency, _) in zip(SENSORS, clocks):
+            if period == 0.0:
+                continue
+            name = f"{sensor}_sampling"
+            if latency >= period:
+                raise ValidationError(f"{name}: the latency {latency} s must be shorter than the period {period} s "
+                                      "(one reading in flight at a time)")
+            ratio = period / gyro
+            if abs(ratio - round(ratio)) > 1e-9 * ratio:
+                raise ValidationError(f"{name}: the period {period} s must be a whole number of the gyro's period "
+                                      f"{gyro} s (the filter propagates to each reading with the gyro's)")
 
     @property
     def covariance0(self) -> np.ndarray:
         """The filter's initial covariance of ``[δθ, δβ]``: diag(σ_θ² I, σ_β² I) (rad², rad²/s²)."""
         return np.diag(np.repeat([self.attitude_sigma0**2, self.bias_sigma0**2], 3))
 
-    def _program(self) -> Program:
+    def _program(self, control_period: float) -> Program:
         tracker = self.star_tracker_sigma is not None
         return _kernel.program(self.gyro_arw, self.gyro_rrw, self.star_tracker_sigma if tracker else np.ones(3),
-                               self.star_tracker_every if tracker else 0, self.delay, bool(self.sensor_noise),
-                               self.sun_sensor_sigma or 0.0,
+                               self.delay, bool(self.sensor_noise), self.sun_sensor_sigma or 0.0,
                                self.sun_direction if self.sun_direction is not None else np.zeros(3),
-                               self.magnetometer_sigma or 0.0)
+                               self.magnetometer_sigma or 0.0, self.coarse_sun_sensor_sigma or 0.0,
+                               self.clocks(control_period))
 
 
 def _axes_sigma(value) -> np.ndarray:
@@ -130,10 +222,11 @@ def check_seed(seed: ArrayLike, name: str) -> np.ndarray:
     return values
 
 
-def initial_state(fsw: FlightSoftware, values: dict[str, np.ndarray], y0: np.ndarray, s: int) -> None:
-    """Write the flight software's initial state (estimate, covariance, true gyro bias, seed) into the rows of
-    ``y0`` (N, size) at its state offset ``s``; ``values`` holds the state fields, each (N, size)."""
+def initial_state(fsw: FlightSoftware, values: dict[str, np.ndarray], y0: np.ndarray, s: int, t0: float) -> None:
+    """Write the flight software's initial state (estimate, covariance, true gyro bias, seed; the filter at
+    ``t0``, s) into the rows of ``y0`` (N, size) at its state offset ``s``; ``values`` holds the state fields,
+    each (N, size)."""
     for offset, name in ((_kernel.Q_EST, "q_estimate0"), (_kernel.BIAS_EST, "bias_estimate0"),
                          (_kernel.GYRO_BIAS, "gyro_bias0"), (_kernel.SEED, "sensor_seed0")):
         y0[:, s + offset:s + offset + values[name].shape[-1]] = values[name]
-    y0[:, s + _kernel.COVARIANCE:s + _kernel.COVARIANCE + 36] = fsw.covariance0.ravel()
+    _kernel.initial_state(y0, s, t0, values["q0"], fsw.covariance0)

@@ -114,7 +114,8 @@ class Spacecraft(Model):
         (:class:`BDot`, :class:`MomentumDumping`) and one :class:`WheelTorques`
     control_period : None (continuous) or the sample period of a zero-order-hold controller, s
     flight_software : :class:`~tumble.spacecraft.flight_software.FlightSoftware` or None: gyro, star tracker
-        and MEKF at the control period (needed), the control law fed the estimate instead of the truth
+        and direction sensors at their own rates, the MEKF at the control period (needed), the control law fed
+        the estimate instead of the truth
 
     The torque command goes to the wheels if there are any, else to the CMGs,
     else to the thrusters (through the PWPF modulators), else to the
@@ -218,6 +219,11 @@ class Spacecraft(Model):
             return
         if self.control_period is None:
             raise ValidationError("flight_software: needs a control_period (its sensors and filter run at it)")
+        self.flight_software.check_clocks(self.control_period)
+        if self.flight_software.sees_the_sun and (self.flight_software.sun_direction is None) == (
+                self.environment is None):
+            raise ValidationError("flight_software: a Sun sensor needs the Sun: a sun_direction or an environment "
+                                  "(its Sun and eclipses), not both")
         if self.flight_software.magnetometer_sigma is not None and not self._has_field:
             raise ValidationError("flight_software: a magnetometer needs a magnetic_field")
         if self._torque_law() is None or any(isinstance(law, WheelTorques) for law in self.controller):
@@ -310,9 +316,11 @@ class Spacecraft(Model):
                 axes, spin, max_torque, max_speed, viscous, coulomb, coulomb_speed,
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
         programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper, self.residual_dipole,
-                                                  self.environment, self.solar_pressure, self.drag,
-                                                  self.flight_software)
+                                                  self.environment, self.solar_pressure, self.drag)
                      if part is not None]
+        if self.flight_software is not None:
+            assert self.control_period is not None  # checked in __post_init__
+            programs.append(self.flight_software._program(self.control_period))
         thrusters = self._thruster_program()
         if thrusters is not None:  # None: no thrusters
             programs.append(thrusters)
@@ -412,6 +420,12 @@ class Spacecraft(Model):
         if abs(ratio - round(ratio)) > _WHOLE * ratio:
             raise ValidationError(f"dt: must divide control_period = {period} s into whole steps, got dt = {dt} "
                                   f"({ratio:.6g} steps)")
+        if self.flight_software is not None:
+            for sensor, (sensor_period, _, _) in zip(_fsw_kernel.SENSORS, self.flight_software.clocks(period)):
+                ratio = sensor_period / dt
+                if sensor_period > 0.0 and (ratio < 1.0 - _WHOLE or abs(ratio - round(ratio)) > _WHOLE * ratio):
+                    raise ValidationError(f"dt: must divide the {sensor}'s period {sensor_period} s into whole "
+                                          f"steps (its readings fall on the steps), got dt = {dt} ({ratio:.6g} steps)")
         steps = np.diff(t) / dt
         bad = np.abs(steps - np.round(steps)) > _WHOLE * np.maximum(steps, 1.0)
         if bad.any():
@@ -419,6 +433,26 @@ class Spacecraft(Model):
             raise ValidationError(f"dt: must divide every output interval into whole steps so that the steps "
                                   f"land on the sample times; t[{k + 1}] − t[{k}] = {t[k + 1] - t[k]} s is "
                                   f"{steps[k]:.6g} steps of {dt} s")
+
+    def step_ends(self, t: np.ndarray, dt: float | None) -> np.ndarray | None:
+        """With a flight software whose computation delay ``δ = delay·control_period`` is not a whole number of
+        steps ``dt``: the times ``t₀ + k T + δ`` its commands start acting, and with them every sample time
+        ``t₀ + k T`` and sensor reading time ``t₀ + m P`` (s), so that steps end on each (between them a step is
+        at most ``dt``); else None."""
+        fsw, period = self.flight_software, self.control_period
+        if fsw is None or period is None or dt is None:
+            return None
+        lag = fsw.delay * period
+        ratio = lag / dt
+        if abs(ratio - round(ratio)) <= _WHOLE * max(ratio, 1.0):
+            return None
+        t0, span = float(t[0]), float(t[-1] - t[0])
+        samples = t0 + np.arange(math.floor(span / period) + 1) * period
+        ends = [samples, samples + lag]
+        for clock in fsw.clocks(period)[:, 0]:
+            if clock > 0.0:
+                ends.append(t0 + np.arange(math.floor(span / clock) + 1) * clock)
+        return np.concatenate(ends)
 
     def initial_states(self, kernel: Any, values: dict[str, np.ndarray], t0: float) -> np.ndarray:
         n = values["omega0"].shape[0]
@@ -443,7 +477,7 @@ class Spacecraft(Model):
             y0[:, s:s + 3] = values["attitude_error_integral0"]
         if self.flight_software is not None:
             check_seed(values["sensor_seed0"], "sensor_seed0")
-            _fsw_initial_state(self.flight_software, values, y0, where("flight_software").s)
+            _fsw_initial_state(self.flight_software, values, y0, where("flight_software").s, float(t0))
         for y in y0:
             _kernel.initialise(kernel, float(t0), y)
         return y0
@@ -570,14 +604,21 @@ class Spacecraft(Model):
         ``log(q* ⊗ q_c)`` (target − truth), rad, body axes."""
         k = _fsw_kernel
         q_estimate = fsw[..., k.Q_EST:k.Q_EST + 4]
-        sigma = np.sqrt(np.diagonal(fsw[..., k.COVARIANCE:k.COVARIANCE + 36].reshape(*fsw.shape[:-1], 6, 6),
-                                    axis1=-2, axis2=-1))
+        covariance = fsw[..., k.COVARIANCE:k.COVARIANCE + 36].reshape(*fsw.shape[:-1], 6, 6)
+        sigma = np.sqrt(np.diagonal(covariance, axis1=-2, axis2=-1))
         add("q_estimate", q_estimate, ("quaternion",), "1",
             "the flight software's attitude estimate [w, x, y, z], body → inertial, at the last sample")
+        add("covariance", covariance, ("error_state", "error_state_column"), "1",
+            "the filter's covariance of [δθ, δβ] predicted to the sample, body axes: blocks in rad², rad²/s, "
+            "rad²/s²")
         add("bias_estimate", fsw[..., k.BIAS_EST:k.BIAS_EST + 3], ("xyz",), "rad/s", "gyro bias estimate, body axes")
         add("omega_estimate", fsw[..., k.OMEGA_EST:k.OMEGA_EST + 3], ("xyz",), "rad/s",
             "the rate the control law read: gyro rate less the bias estimate, body axes")
         add("gyro_bias", fsw[..., k.GYRO_BIAS:k.GYRO_BIAS + 3], ("xyz",), "rad/s", "the gyro's true bias, body axes")
+        used = fsw[..., k.USED:k.USED + len(k.SENSORS)]
+        add("sensor_time", np.where(used > k.NEVER, used, np.nan), ("sensor",), "s",
+            "the time of each sensor's newest reading the flight software used (gyro, star tracker, Sun sensor, "
+            "magnetometer, coarse Sun sensor; NaN: none yet, or no such sensor)")
         add("knowledge_error", attitude.to_rotvec(attitude.multiply(attitude.conjugate(q), q_estimate)), ("xyz",),
             "rad", "estimate − truth: rotation vector of q* ⊗ q_estimate, body axes")
         add("knowledge_error_3sigma", 3.0 * sigma[..., :3], ("xyz",), "rad",

@@ -162,7 +162,7 @@ def slices(model: SpacecraftModel, kind: str) -> Slices | None:
 # (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
 @_protocol.implements(_protocol.rhs, SpacecraftModel)
 def _spacecraft_rhs(model, b0, t, Y, OUT):
-    derivative, _, _ = _assemble(Y.ndim, _python(model))
+    derivative, _, _, _ = _assemble(Y.ndim, _python(model))
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
             derivative(model, t, Y, 0, OUT, Y, _STORE[0])
@@ -175,7 +175,7 @@ def _spacecraft_rhs(model, b0, t, Y, OUT):
 
 @_protocol.implements(_protocol.project, SpacecraftModel)
 def _spacecraft_project(model, b0, t, Y):
-    _, sample, discrete = _assemble(Y.ndim, _python(model))
+    _, sense, sample, discrete = _assemble(Y.ndim, _python(model))
     has_hold, _ = locator("hold")
     if Y.ndim == 1:
         normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
@@ -184,6 +184,8 @@ def _spacecraft_project(model, b0, t, Y):
 
     def impl(model, b0, t, Y):
         normalize(Y)
+        for j in range(lanes(Y)):  # the flight software's sensors read at their own sample times
+            sense(model, t, Y, j)
         if has_hold(model):  # a zero-order hold samples at t₀ + k·period
             period, start = model.data[PERIOD], model.data[START]
             k = round((t - start) / period)
@@ -212,7 +214,7 @@ def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload 
 
 @overload(_evaluate, jit_options={"cache": True})
 def _evaluate_overload(model, t, y, aux):
-    derivative, _, _ = _assemble(1, _python(model))
+    derivative, _, _, _ = _assemble(1, _python(model))
 
     def impl(model, t, y, aux):
         out = np.empty(y.shape[1])
@@ -228,8 +230,13 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sample, _ = _assemble(1, _python(model))
-    return lambda model, t, y: sample(model, t, y, 0)
+    _, sense, sample, _ = _assemble(1, _python(model))
+
+    def impl(model, t, y):
+        sense(model, t, y, 0)
+        sample(model, t, y, 0)
+
+    return impl
 
 
 @njit(cache=True)
@@ -240,6 +247,6 @@ def evaluate(model, t, y, aux):
 
 @njit(cache=True)
 def initialise(model, t, y):
-    """Apply the discrete updates of the start time ``t`` (s) to the state vector ``y``: the commands held
-    from the first sample, the PWPF triggers."""
+    """Apply the discrete updates of the start time ``t`` (s) to the state vector ``y``: the sensors' first
+    readings, the commands held from the first sample, the PWPF triggers."""
     _sample(model, t, y)

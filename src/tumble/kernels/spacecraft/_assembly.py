@@ -21,7 +21,8 @@ from tumble.kernels.spacecraft import (_commands, cmgs, damper, drag, environmen
                                       thrusters, wheels)
 from tumble.kernels.spacecraft._base import inline, lane, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
-                                               AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_WHEELS, J,
+                                               AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_TORQUE,
+                                               HELD_WHEELS, J,
                                                J_RATE, J_RATE_INV, PARTS, PERIOD, locator)
 
 #: The actuators (parts that carry momentum or exert torque on the hub), each ``kernel(lane, direct)`` of its
@@ -185,14 +186,15 @@ def _environment(python):
 
 @functools.lru_cache(maxsize=None)
 def assemble(ndim, python):
-    """Compile-time assembly for states of ``ndim``: ``(derivative, sample, discrete)``; ``python``: the
+    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, discrete)``; ``python``: the
     variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
     which then allocates nothing, is compiled without reference counting: the
     runtime tests of the parts split the refcount pairs of the model's arrays over branches that Numba's
     pruner cannot join, and counting them made the RK4 step 5.5 times slower).
     ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` of the member in lane ``j`` of the block
     ``y`` (or of the state vector ``y``, ``ndim`` 1) into ``out`` and, when ``store``, its diagnostics into
-    ``aux``; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
+    ``aux``; ``sense(model, t, y, j)`` lets the flight software's sensors whose sample time is the step end ``t``
+    read the truth; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
     PWPF triggers); ``discrete(model)`` is True when a part present updates after every step (without a
     zero-order hold, which samples at its own times). Cached, so that the right-hand side, the projection and
     the diagnostics share it."""
@@ -210,7 +212,8 @@ def assemble(ndim, python):
     sample_parts, discrete = _sample_all(actuators)
     field, gravity, external = _environment(python)
     has_fsw, where_fsw = locator("flight_software")
-    fsw_step, fsw_delayed = flight_software.kernel(access)
+    has_table, where_table = locator("environment_table")
+    fsw_sense, fsw_step, fsw_pend, fsw_due = flight_software.kernel(access)
 
     @inline
     def controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
@@ -275,8 +278,35 @@ def assemble(ndim, python):
             put3(aux, AUX_ACTUATOR, j, x1, x2, x3)
             put3(aux, AUX_EXTERNAL, j, e1, e2, e3)
 
-    # Counted: the flight software's filter allocates its matrices; a sample runs once per sample time
-    # (or step), not per evaluation of the right-hand side.
+    # Counted: the flight software's filter allocates its matrices; the sensors read once per step, the
+    # filter once per sample time, not per evaluation of the right-hand side.
+    @inline
+    def sun(model, p, t):
+        """The Sun's direction (inertial, unit) and the fraction of it seen at ``t``: the environment table's, or
+        the flight software's fixed ``sun_direction``, always seen."""
+        d = model.data
+        if has_table(model):
+            tp, _, _, _ = where_table(model)
+            row, f = environment_table.interval(d, tp, t)
+            s1, s2, s3 = environment_table.direction(d, row, f, environment_table.SUN_DIRECTION)
+            return s1, s2, s3, environment_table.linear(d, row, f, environment_table.SHADOW)
+        o = p + flight_software.SUN_DIRECTION
+        return d[o], d[o + 1], d[o + 2], 1.0
+
+    @njit
+    def sense(model, t, y, j):
+        """The flight software's sensors whose sample time is the step end ``t`` read the truth, and a pending
+        command whose delay ends at ``t`` goes to the hold."""
+        if has_fsw(model):
+            p, _, s, _ = where_fsw(model)
+            b1, b2, b3 = field(model, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
+            s1, s2, s3, light = sun(model, p, t)
+            fsw_sense(model, p, s, t, y, j, b1, b2, b3, s1, s2, s3, light)
+            if fsw_due(model, p, t):  # the command computed one delay ago starts acting
+                _, _, held_at, _ = where_hold(model)
+                for i in range(6):
+                    put(y, held_at + HELD_TORQUE + i, j, at(y, s + flight_software.PENDING + i, j))
+
     @njit
     def sample(model, t, y, j):
         if has_hold(model):
@@ -285,15 +315,16 @@ def assemble(ndim, python):
             b1, b2, b3 = field(model, t, qw, qx, qy, qz)
             if has_fsw(model):  # the laws read the flight software's estimate, not the truth
                 p, _, s, _ = where_fsw(model)
-                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], y, j, b1, b2, b3)
+                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], t, y, j)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
             h1, h2, h3 = momenta(model, y, j)
             u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
                                                       H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
             if has_fsw(model):
                 p, _, s, _ = where_fsw(model)
-                u1, u2, u3, m1, m2, m3 = fsw_delayed(model, p, s, y, j, u1, u2, u3, m1, m2, m3)
+                if fsw_pend(model, p, s, y, j, u1, u2, u3, m1, m2, m3):  # acts after the delay: the held stays
+                    u1, u2, u3, m1, m2, m3, source = held(model, y, j)
             hold(model, t, y, j, u1, u2, u3, m1, m2, m3, source)
         sample_parts(model, t, y, j)
 
-    return derivative, sample, discrete
+    return derivative, sense, sample, discrete
