@@ -25,7 +25,8 @@ error control includes the tangents; its step size carries over from one
 ``tₙ`` to the next) or ``rk4`` (fixed step that lands on each ``tₙ``). The run
 advances one interval ``[tₙ₋₁, tₙ]`` at a time and the tangent vectors are
 re-orthonormalised in place between intervals. A batch of initial states (a
-chaos map over a grid) runs in one call, in parallel over the cores.
+chaos map over a grid) runs in one call, in parallel over the cores from
+:data:`PARALLEL_MEMBERS` members on.
 """
 
 from __future__ import annotations
@@ -40,9 +41,14 @@ from tumble import attitude, integrate
 from tumble._inertia import principal_axes
 from tumble._validate import ValidationError, as_array, output_times
 from tumble.integrate import MAX_STEPS, Run, SolverError
+from tumble.integrate._fixed import LANES
 from tumble.kernels.tangent import TangentModel
 
 __all__ = ["LyapunovExponents", "lyapunov_exponents"]
+
+#: The smallest batch run in parallel over the cores: the run starts a parallel region for every interval
+#: between re-orthonormalisations, which a smaller batch does not repay (a block of lanes per region).
+PARALLEL_MEMBERS = LANES
 
 #: ``rtol`` and ``atol`` of an adaptive method when not given.
 TOLERANCE = 1e-10
@@ -103,7 +109,8 @@ def lyapunov_exponents(body, gravity=None, *, omega0, q0=None, t, count: int = 1
     model, y0, single = _initial(body, gravity, omega0, q0, int(count))
     if integrate.method(method).adaptive:  # the tolerances of the tangents when not given
         rtol, atol = (TOLERANCE if rtol is None else rtol), (TOLERANCE if atol is None else atol)
-    run = Run(model, y0, t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
+    run = Run(model, y0, t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
+              parallel=y0.shape[0] >= PARALLEL_MEMBERS)
     logs = np.zeros((t.size, y0.shape[0], count))
     interval = np.empty((2, *y0.shape))
     for n in range(1, t.size):

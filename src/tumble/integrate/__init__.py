@@ -138,10 +138,12 @@ class Run:
     ``options`` are the solver options (``dt``, ``rtol``, ``atol``, ``max_steps``): those the method reads,
     checked against its rules, defaults filled in (:meth:`Method.resolve`); with ``overwrite_y0``, a
     C-ordered float64 ``y0`` is integrated in place instead of copied (as ``scipy.linalg``'s ``overwrite_a``).
+    ``parallel=False`` runs the batch on one core: for a caller that advances many short chunks, where
+    starting a parallel region for each would cost more than it saves.
     """
 
     def __init__(self, model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, overwrite_y0: bool = False,
-                 **options: Any) -> None:
+                 parallel: bool = True, **options: Any) -> None:
         self.method = check_method(method, model.provides, f"a {type(model).__name__}")
         self.options = self.method.resolve(options)
         self.model = model
@@ -153,7 +155,7 @@ class Run:
         self.reached = 0
         # one body, or a model that calls back into Python: no parallel region (its start-up costs more than
         # a short run, and callbacks need the GIL)
-        self.serial = bool(model.calls_python) or self.y.shape[0] == 1
+        self.serial = not parallel or bool(model.calls_python) or self.y.shape[0] == 1
 
     def advance(self, hi: int, out: np.ndarray) -> None:
         """Advance the states to ``t[hi]``; ``out`` (hi − reached + 1, N, n) receives them at ``t[reached]``
