@@ -12,7 +12,7 @@ The exact motions (tumble.analytic):
   torque run here: with no torque the exact-flow splittings are the exact motion, and show no order.
 * ``"free body"``: the torque-free asymmetric body, :func:`tumble.analytic.torque_free` (Jacobi elliptic
   functions); the error is the largest of ``|ΔR(q)|`` and ``|Δω|`` at t = 4 s. The methods that need a
-  torque-free body run here.
+  torque-free body run here, and dop853.
 
 A method's steps ``dt`` halve from run to run; the measured order is the slope of the log-log fit of the
 error against the step. An adaptive method runs with tolerances so loose (``rtol = atol = 1e3``) that every
@@ -36,7 +36,9 @@ from tumble.analysis import lyapunov_exponents
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 # The measured order is within ± 0.2 of the declared one (diffrax's test allows ± 0.9). Measured (this file's
-# rows): rk4 4.00, dop853 8.1, cf4 4.00, splitting2 2.00, splitting4 4.00, exact_split2 2.00, exact_split4 4.00.
+# rows): rk4 4.13, dop853 8.03, cf4 4.06, splitting2 2.000, splitting4 4.003, exact_split2 1.989, exact_split4 3.992
+# (the heavy top's axis error at 4 s converges to the asymptotic ratio from above: rk4 log2 ratios 4.52, 4.35,
+# 4.22 from dt = 0.05 s; and dop853's there stays near 8.5 up to the rounding floor, so it runs on the free body).
 ORDER_TOL = 0.2
 # The closed form (method="exact") against analytic.torque_free, which evaluate the same elliptic functions:
 # rounding (measured 2e-16).
@@ -53,7 +55,7 @@ HALVING = [0.2, 0.1, 0.05, 0.025]  # dt, s
 LOOSE = 1e3  # rtol = atol of an adaptive method: each step lands on the next output time
 ROWS = {  # method: (exact motion, steps dt, s)
     "rk4": ("heavy top", [0.0125, 0.00625, 0.003125, 0.0015625]),
-    "dop853": ("heavy top", [0.4, 0.2, 0.1, 0.05]),
+    "dop853": ("free body", [0.8, 0.4, 0.2]),  # at 0.1 s its error is rounding
     "cf4": ("heavy top", [0.0125, 0.00625, 0.003125, 0.0015625]),
     "splitting2": ("free body", HALVING),
     "splitting4": ("free body", [0.4, 0.2, 0.1, 0.05]),
@@ -107,7 +109,6 @@ def test_measured_order_is_the_declared_order(name):
     errors = np.array([error(m, dt) for dt in steps])
     assert (errors > 1e-13).all()  # above rounding: the fit measures truncation
     measured = np.polyfit(np.log(steps), np.log(errors), 1)[0]
-    print(name, errors, measured)
     assert abs(measured - m.order) <= ORDER_TOL, measured
 
 
@@ -149,8 +150,13 @@ def test_a_fixed_step_run_counts_its_declared_evaluations_per_step():
         assert traj.info["n_rhs"] == 10 * integrate.METHODS[name].evaluations
 
 
+# dop853 carries its step size and count from chunk to chunk, so a run advanced one output interval at a time
+# takes the same steps; each chunk evaluates its first stage again, at the projected state (one run reuses the
+# last stage, at the state before projection): the states agree to rounding (measured 1.2e-15).
+TOL_CHUNKS = 1e-14
+
+
 def test_a_run_advanced_in_chunks_is_the_run_made_at_once():
-    # dop853 carries its step size from chunk to chunk: the same steps, bit for bit
     kernel = tumble.RigidBody(np.diag([1.0, 2.0, 3.0])).compile(None, 0.0)
     y0 = np.array([[1.0, 0.0, 0.0, 0.0, 0.1, 1.0, 0.1]])
     t = np.linspace(0.0, 5.0, 6)
@@ -159,8 +165,10 @@ def test_a_run_advanced_in_chunks_is_the_run_made_at_once():
     chunks = np.empty_like(whole.states)
     for k in range(1, t.size):
         run.advance(k, chunks[k - 1:k + 1])
-    np.testing.assert_array_equal(chunks, whole.states)
-    assert run.solution(chunks).statistics() == whole.statistics()
+    np.testing.assert_allclose(chunks, whole.states, rtol=0, atol=TOL_CHUNKS)
+    chunked = run.solution(chunks)
+    assert (chunked.n_steps, chunked.n_rejected) == (whole.n_steps, whole.n_rejected)
+    assert chunked.n_rhs == whole.n_rhs + t.size - 2  # a first stage per chunk after the first
 
 
 # -- documentation tables read against the registry --------------------------------------------------

@@ -133,7 +133,8 @@ class Run:
 
     ``y`` (N, n) holds the states at ``t[reached]``; between chunks a caller may change them in place (an
     analysis that re-orthonormalises tangent vectors). The method's driver carries its step size and step
-    count from one chunk to the next, so a run advanced in chunks is the run made at once.
+    count from one chunk to the next, so a run advanced in chunks takes the steps of the run made at once
+    (DOP853 evaluates its first stage again at each chunk: the states agree to rounding).
 
     ``options`` are the solver options (``dt``, ``rtol``, ``atol``, ``max_steps``): those the method reads,
     checked against its rules, defaults filled in (:meth:`Method.resolve`); with ``overwrite_y0``, a

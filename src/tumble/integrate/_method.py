@@ -12,7 +12,7 @@ A method is advanced by a :class:`Driver`: the fixed-step driver
 DOP853 driver, or the closed form of ``exact``. A driver advances a batch of
 states in place from one output time to a later one, so that the engine can
 run a method in chunks of output times (progress, analyses that act on the
-state between output times) exactly as in one run.
+state between output times), taking the steps of one run.
 """
 
 from __future__ import annotations
