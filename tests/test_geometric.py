@@ -88,25 +88,26 @@ def reference(body, t, torque=None, omega0=OMEGA0, q0=Q0):
 # -- registry ------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("name, order, torque", [("splitting2", 2, False), ("splitting4", 4, False),
-                                                 ("cf4", 4, True)])
-def test_methods_are_registered_with_order_and_torque_support(name, order, torque):
+@pytest.mark.parametrize("name, torque", [("splitting2", False), ("splitting4", False), ("cf4", True)])
+def test_methods_are_registered_with_their_torque_support(name, torque):
     m = integrate.METHODS[name]
-    assert (m.name, m.order, m.adaptive, "torque_free" not in m.needs) == (name, order, False, torque)
+    assert (m.name, m.adaptive, "torque_free" not in m.needs) == (name, False, torque)
     assert m.description and m.conserves
 
 
 # -- order ---------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("method, torque, order, dts", [
-    ("splitting2", "none", 2, [0.2, 0.1, 0.05, 0.025, 0.0125]),
-    ("splitting4", "none", 4, [0.4, 0.2, 0.1, 0.05, 0.025]),
-    ("cf4", "none", 4, [0.2, 0.1, 0.05, 0.025, 0.0125]),
-    ("cf4", "ConstantInertial", 4, [0.2, 0.1, 0.05, 0.025, 0.0125]),
-    ("cf4", "Gravity", 4, [0.1, 0.05, 0.025, 0.0125]),
+@pytest.mark.parametrize("method, torque, dts", [
+    ("splitting2", "none", [0.2, 0.1, 0.05, 0.025, 0.0125]),
+    ("splitting4", "none", [0.4, 0.2, 0.1, 0.05, 0.025]),
+    ("cf4", "none", [0.2, 0.1, 0.05, 0.025, 0.0125]),
+    ("cf4", "ConstantInertial", [0.2, 0.1, 0.05, 0.025, 0.0125]),
+    ("cf4", "Gravity", [0.1, 0.05, 0.025, 0.0125]),
 ])
-def test_measured_order(method, torque, order, dts):
+def test_measured_order_under_each_torque(method, torque, dts):
+    # the declared order (tests/test_methods.py measures every method's on an exact motion)
+    order = integrate.METHODS[method].order
     t = np.array([0.0, 4.0])
     body = tumble.RigidBody(FULL)
     torque = TORQUES[torque]

@@ -1,6 +1,6 @@
 """Lyapunov exponents of heavy tops (tumble.analysis.lyapunov_exponents): integrable tops, a chaotic top, spectrum.
 
-Every test runs the one compiled specialisation of the tangent kernel (dop853 and rk4 are chosen at run time).
+The tangent kernel runs through the engine (tumble.integrate.Run), with the drivers tumble.simulate uses.
 """
 
 import numpy as np

@@ -49,7 +49,12 @@ held in registers (a 7-tuple), which the fixed-step RK4 and CF4 then run fused
     members(model, b0, b1) -> model         the kernel of members b0 … b1−1 alone (its rows 0 … b1−b0−1),
                                             contiguous copies, so that a block reads lane j's row j
 
-(:func:`implemented` tells an overload whether a kernel type gives one.)
+(:func:`implemented` tells an overload whether a kernel type gives one.) Such a
+kernel's class also declares, as a static method, whether compiled code of a
+Numba type of it may call a Python function (known when a call is typed; the
+fused passes over the lanes then keep reference counts)::
+
+    may_call_python(numba_type) -> bool
 
 A kernel also tells Python whether it calls back into the interpreter
 (``calls_python``): the integrators then run its batch on one core.

@@ -132,8 +132,11 @@ KINDS: dict[str, Callable[[], tuple[Model, dict[str, Any]]]] = {
 
 
 def _options(method: str) -> SolverOptions:
-    """The solver options of the paths: tight tolerances for dop853, a 10 ms step for fixed-step methods."""
-    return {"rtol": 1e-10, "atol": 1e-12} if method == "dop853" else {} if method == "exact" else {"dt": 0.01}
+    """The solver options of the paths: a 10 ms step for a method that reads ``dt``, the declared defaults of
+    the others (:data:`tumble.integrate.METHODS`)."""
+    from tumble import integrate
+
+    return {"dt": 0.01} if "dt" in integrate.METHODS[method].options else {}
 
 
 def kind_path(kind: str, method: str) -> Callable[[], None]:

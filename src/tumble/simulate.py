@@ -39,9 +39,6 @@ if TYPE_CHECKING:
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
 
-#: Solver options when not given (those the method reads).
-DEFAULTS = {"rtol": 1e-10, "atol": 1e-12, "max_steps": integrate.MAX_STEPS}
-
 
 class SolverOptions(TypedDict, total=False):
     """The solver options of :func:`simulate` as keyword arguments (``**options``): those the method reads.
@@ -252,21 +249,10 @@ def _describe(torque) -> str:
 
 
 def _solver_options(model: Model | None, method, given: dict) -> tuple[integrate.Method, dict]:
-    """The :class:`~tumble.integrate.Method` and the options it reads (defaults filled in); an option given
-    that the method does not read is refused."""
-    method = str(method)
-    if method not in integrate.METHODS:
-        raise ValidationError(f"method: must be one of {sorted(integrate.METHODS)}, got {method!r}")
-    m = integrate.METHODS[method]
-    for name, value in given.items():
-        if value is not None and name not in m.options:
-            reads = f"it reads {', '.join(m.options)}" if m.options else "it has no options"
-            raise ValidationError(f"{name}: method {method!r} does not use {name} ({reads})")
-    options = {name: DEFAULTS[name] if given[name] is None and name in DEFAULTS else given[name]
-               for name in m.options}
-    integrate.check_options(method, dt=options.get("dt"), rtol=options.get("rtol"), atol=options.get("atol"),
-                            max_steps=options.get("max_steps"))
-    return m, {name: (int(v) if name == "max_steps" else float(v)) for name, v in options.items()}
+    """The :class:`~tumble.integrate.Method` and the options it reads (its defaults filled in, checked by its
+    rules, :meth:`~tumble.integrate.Method.resolve`); an option given that the method does not read is refused."""
+    m = integrate.method(method)
+    return m, m.resolve(given)
 
 
 def _initial_values(model: Model, given: Mapping) -> tuple[dict[str, np.ndarray], int | None]:

@@ -18,34 +18,40 @@ zero (the flow preserves volume) and comes in pairs ``±λ`` (``(λ, 0, 0, 0, 0,
 give zeros). For an integrable top (Euler, Lagrange, Kovalevskaya) tangent
 vectors grow at most linearly in time, so ``λ₁(t) ≈ ln(a t)/t → 0``.
 
-The state and the tangents are integrated together by ``dop853`` (adaptive;
-its error control includes the tangents) or ``rk4`` (fixed step that lands on
-each ``tₙ``), the engine's own schemes, compiled once for the tangent kernel.
-A batch of initial states (a chaos map over a grid) runs in one call, in
-parallel over the cores (threads over shares of the batch).
+The state and the tangents are integrated together through the engine
+(:class:`tumble.integrate.Run`, the driver :func:`tumble.simulate` uses), by
+any method whose needs the tangent kernel provides: ``dop853`` (adaptive; its
+error control includes the tangents; its step size carries over from one
+``tₙ`` to the next) or ``rk4`` (fixed step that lands on each ``tₙ``). The run
+advances one interval ``[tₙ₋₁, tₙ]`` at a time and the tangent vectors are
+re-orthonormalised in place between intervals. A batch of initial states (a
+chaos map over a grid) runs in one call, in parallel over the cores from
+:data:`PARALLEL_MEMBERS` members on.
 """
 
 from __future__ import annotations
 
 import math
-import os
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
 
-from tumble import attitude
+from tumble import attitude, integrate
 from tumble._inertia import principal_axes
-from tumble._protocol import state_size
 from tumble._validate import ValidationError, as_array, output_times
-from tumble.integrate import MAX_STEPS, SolverError, _dop853, _fixed, _rk4, check_options
+from tumble.integrate import MAX_STEPS, Run, SolverError
+from tumble.integrate._fixed import LANES
 from tumble.kernels.tangent import TangentModel
 
 __all__ = ["LyapunovExponents", "lyapunov_exponents"]
 
-#: The methods that integrate the tangent equations.
-LYAPUNOV_METHODS = ("dop853", "rk4")
+#: The smallest batch run in parallel over the cores: the run starts a parallel region for every interval
+#: between re-orthonormalisations, which a smaller batch does not repay (a block of lanes per region).
+PARALLEL_MEMBERS = LANES
+
+#: ``rtol`` and ``atol`` of an adaptive method when not given.
+TOLERANCE = 1e-10
 
 #: Seed of the fixed random orthonormal basis whose first ``count`` columns are the initial tangent vectors
 #: (a generic direction: a coordinate axis may lie in an invariant subspace of a symmetric top).
@@ -87,39 +93,29 @@ def lyapunov_exponents(body, gravity=None, *, omega0, q0=None, t, count: int = 1
     t       : (n + 1,) increasing times, s: ``t[0]`` the start, then the re-orthonormalisation times
     count   : the number of exponents, 1 (the largest) to 6 (the full spectrum)
     method  : ``"dop853"`` (``rtol``, ``atol``: default 1e-10; the error control includes the tangents) or
-              ``"rk4"`` (``dt``, s)
+              ``"rk4"`` (``dt``, s): the methods of :data:`tumble.integrate.METHODS` that need no more than a
+              right-hand side
     max_steps : the most steps of one member over the whole run
 
     Returns :class:`LyapunovExponents`. The initial tangent vectors are the
     first ``count`` columns of a fixed random orthogonal 6×6 matrix (seed
     :data:`TANGENT_SEED`).
     """
-    if method not in LYAPUNOV_METHODS:
-        raise ValidationError(f"method: must be one of {list(LYAPUNOV_METHODS)}, got {method!r}")
-    given = {"dt": dt, "rtol": rtol, "atol": atol}
-    read = ("rtol", "atol") if method == "dop853" else ("dt",)
-    for name, value in given.items():
-        if value is not None and name not in read:
-            raise ValidationError(f"{name}: method {method!r} does not read it")
-    rtol, atol = (1e-10 if rtol is None else rtol), (1e-10 if atol is None else atol)
-    check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or not 1 <= count <= 6:
         raise ValidationError(f"count: must be a whole number from 1 to 6, got {count!r}")
     t = output_times(t)
     if t.size < 2:
         raise ValidationError("t: give the start and at least one re-orthonormalisation time")
     model, y0, single = _initial(body, gravity, omega0, q0, int(count))
-    if method == "rk4":
-        m, h = _fixed.landing_steps(t, dt, max_steps)
-    else:
-        m, h = np.zeros(t.size - 1, dtype=np.int64), np.zeros(t.size - 1)
+    if integrate.method(method).adaptive:  # the tolerances of the tangents when not given
+        rtol, atol = (TOLERANCE if rtol is None else rtol), (TOLERANCE if atol is None else atol)
+    run = Run(model, y0, t, method=method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps,
+              parallel=y0.shape[0] >= PARALLEL_MEMBERS)
     logs = np.zeros((t.size, y0.shape[0], count))
-    status = np.zeros(y0.shape[0])
-    _run(model, y0, t, method == "dop853", m, h, float(rtol), float(atol), float(max_steps), logs, status)
-    bad = np.flatnonzero(status != _dop853.OK)
-    if bad.size:
-        raise SolverError(f"body {int(bad[0])}: dop853 stopped (status {int(status[bad[0]])}: step too small or "
-                          "max_steps reached); loosen rtol/atol or raise max_steps")
+    interval = np.empty((2, *y0.shape))
+    for n in range(1, t.size):
+        run.advance(n, interval)
+        _orthonormalise(run.y, int(count), logs[n - 1], logs[n])
     if not np.isfinite(logs).all():
         raise SolverError("the tangent vectors stopped being finite: re-orthonormalise more often (denser t)")
     exponents = logs[1:] / (t[1:] - t[0])[:, None, None]
@@ -158,56 +154,24 @@ def _initial(body, gravity, omega0, q0, count):
     return model, y0, single
 
 
-def _run(model, y0, t, adaptive, m, h, rtol, atol, max_steps, logs, status):
-    """:func:`_spectra` on the members of the batch, in contiguous shares, one thread per core."""
-    args = (model, y0, t, adaptive, m, h, rtol, atol, max_steps, _dop853.tableau(), _rk4.SCHEME, logs, status)
-    shares = np.array_split(np.arange(y0.shape[0]), min(y0.shape[0], os.cpu_count() or 1))
-    if len(shares) == 1:
-        _spectra(0, y0.shape[0], *args)
-        return
-    with ThreadPoolExecutor(len(shares)) as pool:
-        for done in [pool.submit(_spectra, int(s[0]), int(s[-1]) + 1, *args) for s in shares]:
-            done.result()
-
-
-@njit(cache=True, nogil=True)
-def _spectra(first, last, model, y0, t, adaptive, m, h, rtol, atol, max_steps, tab, scheme, logs, status):
-    """``logs[n, b, j]``: the sums of ``ln R_jj`` up to ``t[n]`` of the members ``first ≤ b < last``;
-    ``status[b]``: dop853's status (compiled without the GIL, so that threads share the batch: a parallel
-    ``prange`` region would double the compile time of this kernel)."""
-    for b in range(first, last):
-        status[b] = _path(model, b, y0[b].copy(), t, adaptive, m, h, rtol, atol, max_steps, tab, scheme,
-                          logs[:, b, :])
-
-
 @njit(cache=True)
-def _path(model, b, y, t, adaptive, m, h, rtol, atol, max_steps, tab, scheme, logs):
-    n = state_size(model)
-    out = np.empty((2, n))
-    pair = np.empty(2)
-    stats = np.zeros(5)
-    for s in range(1, t.shape[0]):
-        pair[0], pair[1] = t[s - 1], t[s]
-        if adaptive:
-            _dop853.dop853_path(model, b, y, pair, rtol, atol, max_steps, tab, out, stats)
-            if stats[3] != _dop853.OK:
-                return stats[3]
-        else:
-            _fixed.fixed_path(scheme, model, b, y, pair, m[s - 1:s], h[s - 1:s], out)
-        for j in range(model.count):  # modified Gram–Schmidt on the tangent vectors
+def _orthonormalise(y, count, before, after):
+    """Modified Gram–Schmidt on the tangent vectors ``δⱼ = y[b, 6 + 6j : 12 + 6j]`` of every member ``b``, in
+    place: ``after[b, j] = before[b, j] + ln R_jj``, the running sums of the logarithms of the diagonal of ``R``."""
+    for b in range(y.shape[0]):
+        for j in range(count):
             sj = 6 + 6 * j
             for k in range(j):
                 sk = 6 + 6 * k
                 dot = 0.0
                 for i in range(6):
-                    dot += y[sj + i] * y[sk + i]
+                    dot += y[b, sj + i] * y[b, sk + i]
                 for i in range(6):
-                    y[sj + i] -= dot * y[sk + i]
+                    y[b, sj + i] -= dot * y[b, sk + i]
             norm = 0.0
             for i in range(6):
-                norm += y[sj + i] * y[sj + i]
+                norm += y[b, sj + i] * y[b, sj + i]
             norm = math.sqrt(norm)
             for i in range(6):
-                y[sj + i] /= norm
-            logs[s, j] = logs[s - 1, j] + math.log(norm)
-    return 0.0
+                y[b, sj + i] /= norm
+            after[b, j] = before[b, j] + math.log(norm)

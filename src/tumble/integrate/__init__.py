@@ -25,35 +25,42 @@ times (the fixed-step ones land on them, see :mod:`._fixed`), and runs a
 batch of bodies in parallel over the cores (``numba.prange``) unless the
 model calls back into Python.
 
-Each method declares what it needs from the compiled model (``Method.needs``,
-capability names of :data:`tumble._protocol.CAPABILITIES`), as diffrax solvers
-declare the terms they accept; each compiled model says what it provides
-(its ``provides`` property). :func:`check_method` is the one check, with one
-message naming the method, what it misses and the methods that would work.
-The engine imports no particular model.
+Each method file declares its methods (:class:`Method`: name, order, options
+with their defaults and rules, evaluations per step, driver, and what it needs
+from the compiled model, capability names of
+:data:`tumble._protocol.CAPABILITIES`, as diffrax solvers declare the terms
+they accept); :data:`METHODS` is built from those declarations and
+:func:`method` is the one place a name is checked. Each compiled model says
+what it provides (its ``provides`` property); :func:`check_method` is the one
+check, with one message naming the method, what it misses and the methods that
+would work. The engine imports no particular model.
 
 :func:`solve` is the one entry point used by :func:`tumble.simulate`, which
-runs every model.
+runs every model; :class:`Run` is the same run advanced chunk by chunk of
+output times, for an analysis that acts on the states between them
+(:func:`tumble.analysis.lyapunov_exponents`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 
 from tumble._protocol import CAPABILITIES
-from tumble._validate import ValidationError, readonly, require_memory, require_positive
-from tumble.integrate import _dop853, _exact, _exactsplit, _fixed, _liegroup, _rk4, _splitting
-from tumble.integrate._fixed import MAX_STEPS
+from tumble._validate import ValidationError, readonly, require_memory
+from tumble.integrate import _dop853, _exact, _exactsplit, _liegroup, _rk4, _splitting
+from tumble.integrate._method import MAX_STEPS, MAX_STEPS_LIMIT, Driver, Method, Option
 
-__all__ = ["MAX_STEPS", "METHODS", "Diverged", "Method", "Solution", "SolverError", "check_method", "check_options",
-           "solve"]
+__all__ = ["MAX_STEPS", "MAX_STEPS_LIMIT", "METHODS", "Diverged", "Driver", "Method", "Option", "Run", "Solution",
+           "SolverError", "check_method", "method", "solve"]
 
-#: The largest ``max_steps`` accepted: step counts stay exact whole float64 numbers and fit an int64.
-MAX_STEPS_LIMIT = 2**53
+#: Every method by name, as the method files declare them (their ``METHODS``), in the order of the table above.
+#: Adding a method is its file and its entry here (and its row in the order test, tests/test_methods.py).
+METHODS: dict[str, Method] = {m.name: m for module in (_rk4, _dop853, _liegroup, _splitting, _exactsplit, _exact)
+                              for m in module.METHODS}
 
 
 class SolverError(RuntimeError):
@@ -70,124 +77,32 @@ class Diverged(SolverError):
         self.index, self.member, self.states, self.method = index, member, states, method
 
 
-@dataclass(frozen=True)
-class Method:
-    """An integration method: its name, order, step policy, what it keeps and what it needs.
-
-    conserves : what the method keeps exactly, up to rounding (in words)
-    needs     : the capabilities it needs from the compiled model (:data:`tumble._protocol.CAPABILITIES`)
-    stepper   : False for a closed form that needs no step (``"exact"``)
-    """
-
-    name: str
-    order: int
-    adaptive: bool
-    description: str
-    conserves: str = "|q| = 1 by projection"
-    needs: frozenset = frozenset({"rhs"})
-    stepper: bool = True
-
-    @property
-    def options(self) -> tuple[str, ...]:
-        """The solver options this method reads (the others are refused by :func:`tumble.simulate`)."""
-        if self.adaptive:
-            return ("rtol", "atol", "max_steps")
-        return ("dt", "max_steps") if self.stepper else ()
-
-
-_FREE_INVARIANTS = "|L|, L_N and |q| = 1 (exact rotations; energy error bounded, symplectic)"
-
-_SPLIT_INVARIANTS = ("symplectic for a torque from a potential (heavy top): energy error bounded, the momentum "
-                     "about g kept to rounding; torque-free: the exact motion")
-
-METHODS = {
-    "rk4": Method("rk4", _rk4.ORDER, False, "classical Runge–Kutta, fixed step dt"),
-    "dop853": Method("dop853", _dop853.ORDER, True, "Dormand–Prince 8(5,3), adaptive rtol/atol"),
-    "cf4": Method("cf4", _liegroup.ORDER, False,
-                  "commutator-free Lie-group method CF4 (Celledoni–Marthinsen–Owren 2003), fixed step dt",
-                  conserves="|q| = 1 without projection (exact rotations)", needs=frozenset({"rhs", "body_rate"})),
-    "splitting2": Method("splitting2", _splitting.ORDERS["splitting2"], False,
-                         "Lie–Poisson splitting of the free body into exact rotations, Strang, fixed step dt",
-                         conserves=_FREE_INVARIANTS, needs=frozenset({"torque_free"})),
-    "splitting4": Method("splitting4", _splitting.ORDERS["splitting4"], False,
-                         "Lie–Poisson splitting of the free body into exact rotations, Blanes–Moan S6, "
-                         "fixed step dt", conserves=_FREE_INVARIANTS, needs=frozenset({"torque_free"})),
-    "exact_split2": Method("exact_split2", _exactsplit.ORDERS["exact_split2"], False,
-                           "exact free flow composed with torque kicks, Strang, fixed step dt",
-                           conserves=_SPLIT_INVARIANTS, needs=frozenset({"free_flow"})),
-    "exact_split4": Method("exact_split4", _exactsplit.ORDERS["exact_split4"], False,
-                           "exact free flow composed with torque kicks, Blanes–Moan S6, fixed step dt",
-                           conserves=_SPLIT_INVARIANTS, needs=frozenset({"free_flow"})),
-    "exact": Method("exact", 0, False, "closed-form torque-free motion (tumble.analytic.torque_free), no steps",
-                    conserves="T, |L|, L_N and |q| = 1 to rounding (the exact flow)",
-                    needs=frozenset({"free_flow", "torque_free"}), stepper=False),
-}
-
-# Fixed-step methods: (compiled scheme, right-hand-side evaluations per step).
-_SCHEMES = {
-    "rk4": (_rk4.SCHEME, 4),
-    "cf4": (_liegroup.SCHEME, 4),
-    "splitting2": (_splitting.STRANG, 0),
-    "splitting4": (_splitting.BLANES_MOAN, 0),
-    "exact_split2": (_exactsplit.STRANG, 4),       # torque evaluations: one RK4 kick per step
-    "exact_split4": (_exactsplit.BLANES_MOAN, 24),  # six
-}
-
 # Output samples per chunk when progress is reported.
 _CHUNKS = 100
 
 
-def check_options(method: str, *, dt: Any, rtol: Any, atol: Any, max_steps: Any) -> Method:
-    """Validate the options that ``method`` reads; returns the :class:`Method`.
-
-    Options the method does not read are not looked at here (:func:`tumble.simulate`
-    refuses them when they are given). The options are taken as given (``Any``): this is where a value that
-    is not a positive number, or a ``max_steps`` that is not a whole number, is refused.
-    """
-    if method not in METHODS:
-        raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
-    m = METHODS[method]
-    if m.stepper:
-        _check_max_steps(max_steps)
-    if m.adaptive:
-        require_positive(rtol, "rtol")
-        require_positive(atol, "atol")
-        if rtol < 1e-15:
-            raise ValidationError(f"rtol: must be >= 1e-15 (float64 cannot do better), got {rtol}")
-    elif m.stepper:
-        if dt is None:
-            raise ValidationError(f"dt: method {method!r} has a fixed step: give dt > 0 (s)")
-        require_positive(dt, "dt")
-    return m
+def method(name: Any) -> Method:
+    """The :class:`Method` called ``name``: the one check of a method's name (a
+    :class:`~tumble.ValidationError` naming ``method`` lists the valid names)."""
+    if not isinstance(name, str) or name not in METHODS:
+        raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {name!r}")
+    return METHODS[name]
 
 
-def _check_max_steps(max_steps) -> None:
-    """Refuse a ``max_steps`` that is not a whole number from 1 to :data:`MAX_STEPS_LIMIT`."""
-    whole = (isinstance(max_steps, (int, float, np.integer, np.floating)) and not isinstance(max_steps, bool)
-             and float(max_steps).is_integer())
-    if whole and max_steps < 1:
-        raise ValidationError(f"max_steps: must be >= 1, got {max_steps!r}")
-    if not whole or max_steps > MAX_STEPS_LIMIT:
-        raise ValidationError(f"max_steps: must be a whole number from 1 to 2**53 = {MAX_STEPS_LIMIT}, "
-                              f"got {max_steps!r}")
-
-
-def check_method(method: str, provides: Collection[str], who: str) -> Method:
-    """Refuse ``method`` unless the model provides every capability it needs; returns the :class:`Method`.
+def check_method(name: str, provides: Collection[str], who: str) -> Method:
+    """Refuse the method ``name`` unless the model provides every capability it needs; returns the
+    :class:`Method`.
 
     ``provides`` is the set of capabilities of the compiled model and ``who``
     names the model in the message (e.g. ``"a SloshBody"``), which lists what
     the method misses and the methods that would work.
     """
-    if method not in METHODS:
-        raise ValidationError(f"method: must be one of {sorted(METHODS)}, got {method!r}")
-    m = METHODS[method]
+    m = method(name)
     missing = m.needs - set(provides)
     if missing:
         needs = " and ".join(CAPABILITIES[c] for c in sorted(missing))
-        working = ", ".join(repr(name) for name, other in METHODS.items() if other.needs <= set(provides))
-        raise ValidationError(f"method: {method!r} needs {needs}, which {who} is not; "
-                              f"methods for it: {working}")
+        working = ", ".join(repr(other.name) for other in METHODS.values() if other.needs <= set(provides))
+        raise ValidationError(f"method: {name!r} needs {needs}, which {who} is not; methods for it: {working}")
     return m
 
 
@@ -211,12 +126,65 @@ class Solution:
         return {"n_steps": self.n_steps, "n_rejected": self.n_rejected, "n_rhs": self.n_rhs}
 
 
-def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float | None = None, rtol: float | None = None,
-          atol: float | None = None, max_steps: int = MAX_STEPS, progress: Callable[[int, int], None] | None = None,
-          device: str = "cpu", overwrite_y0: bool = False) -> Solution:
+class Run:
+    """A run of the method ``method`` on the compiled ``model`` (:mod:`tumble._protocol`) from the states
+    ``y0`` (N, n) at ``t[0]`` through the output times ``t`` (s, strictly increasing), advanced chunk by
+    chunk of output times, as scipy's ``OdeSolver.step``.
+
+    ``y`` (N, n) holds the states at ``t[reached]``; between chunks a caller may change them in place (an
+    analysis that re-orthonormalises tangent vectors). The method's driver carries its step size and step
+    count from one chunk to the next, so a run advanced in chunks takes the steps of the run made at once
+    (DOP853 evaluates its first stage again at each chunk: the states agree to rounding).
+
+    ``options`` are the solver options (``dt``, ``rtol``, ``atol``, ``max_steps``): those the method reads,
+    checked against its rules, defaults filled in (:meth:`Method.resolve`); with ``overwrite_y0``, a
+    C-ordered float64 ``y0`` is integrated in place instead of copied (as ``scipy.linalg``'s ``overwrite_a``).
+    ``parallel=False`` runs the batch on one core: for a caller that advances many short chunks, where
+    starting a parallel region for each would cost more than it saves.
+    """
+
+    def __init__(self, model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, overwrite_y0: bool = False,
+                 parallel: bool = True, **options: Any) -> None:
+        self.method = check_method(method, model.provides, f"a {type(model).__name__}")
+        self.options = self.method.resolve(options)
+        self.model = model
+        self.t = readonly(t)  # the form simulate's output times come in: the drivers compile once
+        self.y = (np.asarray if overwrite_y0 else np.array)(y0, dtype=np.float64, order="C")
+        # before anything runs: a fixed-step run needing more than max_steps is refused (_fixed.landing_steps)
+        self.plan = self.method.driver.plan(self.t, self.options)
+        self.stats = np.zeros((self.y.shape[0], 5))
+        self.reached = 0
+        # one body, or a model that calls back into Python: no parallel region (its start-up costs more than
+        # a short run, and callbacks need the GIL)
+        self.serial = not parallel or bool(model.calls_python) or self.y.shape[0] == 1
+
+    def advance(self, hi: int, out: np.ndarray) -> None:
+        """Advance the states to ``t[hi]``; ``out`` (hi − reached + 1, N, n) receives them at ``t[reached]``
+        … ``t[hi]``. A member that cannot go on (step too small, ``max_steps``) raises :class:`SolverError`."""
+        self.method.driver.advance(self.model, self.y, self.t, self.reached, hi, out, self.stats, self.plan,
+                                   self.serial)
+        _raise_on_failure(self.stats, self.t, self.options.get("max_steps"))
+        self.reached = hi
+
+    def total(self, k: int) -> int:
+        """Statistic ``k`` (0 steps, 1 rejected steps, 2 evaluations) summed over the members (a lone body's
+        own: no reduction to set up)."""
+        return int(self.stats[0, k] if self.stats.shape[0] == 1 else self.stats[:, k].sum())
+
+    def solution(self, states: np.ndarray) -> Solution:
+        """The :class:`Solution` of the run, with its sampled ``states``: a fixed-step method makes its
+        declared evaluations per step (counted here, not per body); an adaptive one counts its own."""
+        n_steps = self.total(0)
+        n_rhs = self.total(2) if self.method.adaptive else self.method.evaluations * n_steps
+        return Solution(states, n_steps, self.total(1), n_rhs)
+
+
+def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: Callable[[int, int], None] | None = None,
+          device: str = "cpu", overwrite_y0: bool = False, **options: Any) -> Solution:
     """Integrate the compiled ``model`` (:mod:`tumble._protocol`) for a batch of states ``y0`` (N, n) through ``t``.
 
-    ``t`` (s) must be strictly increasing (:func:`tumble._validate.output_times`).
+    ``t`` (s) must be strictly increasing (:func:`tumble._validate.output_times`); ``options`` are the
+    solver options the method reads (:class:`Run`).
     A model whose ``calls_python`` is true runs body after body on one core.
     ``progress(done, total)`` is called after each chunk of output samples.
     ``device="cuda"`` runs ``rk4`` on an NVIDIA GPU (models that provide ``"cuda"``).
@@ -230,65 +198,28 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float |
     instead of copied, as ``scipy.linalg``'s ``overwrite_a``: a caller that made ``y0`` for the run saves
     a copy (:func:`tumble.simulate`; 56 bytes per rigid body).
     """
-    m = check_method(method, model.provides, f"a {type(model).__name__}")
-    check_options(method, dt=dt, rtol=rtol, atol=atol, max_steps=max_steps)
-    y = (np.asarray if overwrite_y0 else np.array)(y0, dtype=np.float64, order="C")
-    t = readonly(t)  # the form simulate's output times come in: the drivers compile once
-    n_out = t.shape[0]
+    run = Run(model, y0, t, method=method, overwrite_y0=overwrite_y0, **options)
+    y, n_out = run.y, run.t.shape[0]
     require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
                    f"member(s) × {y.shape[1]} values")
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
 
-        states, n_steps = _cuda.solve_cuda(model, y, t, dt, max_steps)
+        states, n_steps = _cuda.solve_cuda(model, y, run.t, run.options["dt"], run.options["max_steps"])
         _raise_on_divergence(states, method)
-        return Solution(states, n_steps, 0, 4 * n_steps)
-    steps = _fixed.landing_steps(t, cast(float, dt), max_steps) if method in _SCHEMES else None  # dt checked
+        return Solution(states, n_steps, 0, run.method.evaluations * n_steps)
     out = np.empty((n_out, y.shape[0], y.shape[1]))
-    stats = np.zeros((y.shape[0], 5))
     bounds = [0, n_out - 1]
-    if progress is not None and n_out > 2 and m.stepper:
+    if progress is not None and n_out > 2 and run.method.stepper:
         bounds = np.unique(np.linspace(0, n_out - 1, min(_CHUNKS, n_out - 1) + 1).astype(int)).tolist()
     for lo, hi in zip(bounds[:-1], bounds[1:]):
-        chunk = None if steps is None else (steps[0][lo:hi], steps[1][lo:hi])
-        _run_chunk(method, model, y, t[lo:hi + 1], out[lo:hi + 1], stats,
-                   steps=chunk, rtol=rtol, atol=atol, max_steps=max_steps, serial=model.calls_python)
-        _raise_on_failure(stats, t, max_steps)  # first: a body that gave up left its later rows unwritten
+        run.advance(hi, out[lo:hi + 1])
         _raise_on_divergence(out, method, lo, hi)
         if progress is not None:
             progress(hi + 1, n_out)
     if n_out == 1:
         out[0] = y
-    def total(k):  # statistic k summed over the members (a lone body's own: no reduction to set up)
-        return int(stats[0, k] if stats.shape[0] == 1 else stats[:, k].sum())
-
-    n_steps = total(0)
-    # a fixed-step method: a set number of evaluations per step (counted here, not per body)
-    n_rhs = _SCHEMES[method][1] * n_steps if method in _SCHEMES else total(2)
-    return Solution(out, n_steps, total(1), n_rhs)
-
-
-def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps, serial):
-    # One body, or a model that calls back into Python: no parallel region
-    # (its start-up costs more than a short run, and callbacks need the GIL).
-    serial = serial or y.shape[0] == 1
-    if method == "exact":
-        _exact.run(model, y, t, out)
-    elif method in _SCHEMES:
-        scheme, _ = _SCHEMES[method]
-        m, h = steps
-        if y.shape[0] == 1:
-            _fixed.run_one(scheme, model, y, t, m, h, out, stats)
-        elif serial:
-            for k in range(-(-y.shape[0] // _fixed.LANES)):
-                _fixed.run_block(scheme, model, k, y, t, m, h, out, stats)
-        else:
-            _fixed.run_batch(scheme, model, y, t, m, h, out, stats)
-    elif serial:
-        for b in range(y.shape[0]):
-            _dop853.dop853_path(model, b, y[b], t, rtol, atol, max_steps, _dop853.tableau(), out[:, b], stats[b])
-    else:
-        _dop853.dop853_batch(model, y, t, rtol, atol, max_steps, _dop853.tableau(), out, stats)
+    return run.solution(out)
 
 
 def _raise_on_divergence(states, method, lo=0, hi=None):

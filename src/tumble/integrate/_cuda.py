@@ -45,7 +45,8 @@ from numba.extending import overload, register_jitable
 from tumble import torques
 from tumble.dynamics import rigid_rates
 from tumble._validate import ValidationError
-from tumble.integrate._fixed import MAX_STEPS, landing_steps
+from tumble.integrate._fixed import landing_steps
+from tumble.integrate._method import MAX_STEPS
 from tumble.integrate._rk4 import axpy, update
 
 #: Threads per block, a multiple of the warp (32). The kernel uses no shared

@@ -23,6 +23,7 @@ from numba import njit, prange
 
 from tumble._protocol import project, rhs, state_size
 from tumble.integrate._fixed import store
+from tumble.integrate._method import ADAPTIVE, Driver, Method
 
 ORDER = 8
 _STAGES = 12
@@ -242,3 +243,31 @@ def dop853_batch(model, y, t_out, rtol, atol, max_steps, tab, out, stats):
         b = np.int64(i)  # prange indices may be unsigned
         if stats[b, 3] == OK:
             dop853_path(model, b, y[b], t_out, rtol, atol, max_steps, tab, out[:, b, :], stats[b])
+
+
+class Adaptive(Driver):
+    """The driver of DOP853: each member's own steps, chosen by error control (:func:`dop853_path`); the
+    step size and the step count are carried in ``stats`` from one chunk of output times to the next."""
+
+    adaptive = True
+
+    def __repr__(self) -> str:
+        return "Adaptive(DOP853)"
+
+    def plan(self, t, options):
+        return options["rtol"], options["atol"], options["max_steps"], tableau()
+
+    def advance(self, model, y, t, lo, hi, out, stats, plan, serial) -> None:
+        rtol, atol, max_steps, tab = plan
+        t = t[lo:hi + 1]
+        if serial:
+            for b in range(y.shape[0]):
+                dop853_path(model, b, y[b], t, rtol, atol, max_steps, tab, out[:, b], stats[b])
+        else:
+            dop853_batch(model, y, t, rtol, atol, max_steps, tab, out, stats)
+
+
+METHODS = (
+    Method("dop853", order=ORDER, description="Dormand–Prince 8(5,3), adaptive rtol/atol", driver=Adaptive(),
+           evaluations=_STAGES, options=ADAPTIVE),
+)

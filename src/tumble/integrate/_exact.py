@@ -16,6 +16,7 @@ from numba import njit, prange
 from tumble._protocol import free_evaluate, free_setup
 from tumble._validate import ValidationError
 from tumble._vec import norm
+from tumble.integrate._method import Driver, Method, options
 
 #: Output times per task of the parallel loop: one task sets a body up (about a
 #: microsecond) and evaluates up to this many times, so that a single body with
@@ -68,3 +69,24 @@ def run(model, y, t, out):
         exact_task(model, y, t, out, 0)
     else:
         exact_batch(model, y, t, out)
+
+
+class ClosedForm(Driver):
+    """The driver of ``exact``: :func:`run` over the output times, no steps (and no options)."""
+
+    steps = False
+
+    def __repr__(self) -> str:
+        return "ClosedForm(free motion)"
+
+    def advance(self, model, y, t, lo, hi, out, stats, plan, serial) -> None:
+        run(model, y, t[lo:hi + 1], out)
+        y[...] = out[-1]
+
+
+METHODS = (
+    Method("exact", order=None, description="closed-form torque-free motion (tumble.analytic.torque_free), no steps",
+           driver=ClosedForm(), evaluations=0, options=options(),
+           needs=frozenset({"free_flow", "torque_free"}),
+           conserves="T, |L|, L_N and |q| = 1 to rounding (the exact flow)"),
+)

@@ -57,6 +57,7 @@ from numba import njit
 from tumble import _protocol
 from tumble._protocol import free_evaluate, free_setup, torque_acceleration, torque_free
 from tumble.integrate import _fixed
+from tumble.integrate._method import FIXED_STEP, Method
 from tumble.integrate._rk4 import weighted_sum
 from tumble.integrate._splitting import BLANES_MOAN as _S6
 
@@ -74,8 +75,6 @@ class ExactSplit(NamedTuple):
 
 STRANG = ExactSplit(np.array([0.5, 0.5]), np.array([1.0]))
 BLANES_MOAN = ExactSplit(_S6.a.copy(), _S6.b.copy())
-
-ORDERS = {"exact_split2": 2, "exact_split4": 4}
 
 
 
@@ -136,3 +135,18 @@ def _kick(model, b, t, tau, x):
     k4 = torque_acceleration(model, b, t, x, w1 + tau * k3[0], w2 + tau * k3[1], w3 + tau * k3[2])
     return (x[0], x[1], x[2], x[3], w1 + weighted_sum(tau, k1[0], k2[0], k3[0], k4[0]),
             w2 + weighted_sum(tau, k1[1], k2[1], k3[1], k4[1]), w3 + weighted_sum(tau, k1[2], k2[2], k3[2], k4[2]))
+
+
+_INVARIANTS = ("symplectic for a torque from a potential (heavy top): energy error bounded, the momentum about g "
+               "kept to rounding; torque-free: the exact motion")
+
+# evaluations: of the torque, one RK4 kick (4) per kick of a step: 1 (Strang) or 6 (S₆), merged across steps
+METHODS = (
+    Method("exact_split2", order=2, description="exact free flow composed with torque kicks, Strang, fixed step dt",
+           driver=_fixed.FixedSteps(STRANG), evaluations=4, options=FIXED_STEP,
+           needs=frozenset({"free_flow"}), conserves=_INVARIANTS),
+    Method("exact_split4", order=4,
+           description="exact free flow composed with torque kicks, Blanes–Moan S6, fixed step dt",
+           driver=_fixed.FixedSteps(BLANES_MOAN), evaluations=24, options=FIXED_STEP,
+           needs=frozenset({"free_flow"}), conserves=_INVARIANTS),
+)

@@ -1,7 +1,8 @@
 """Fixed-step integration: steps that land on every output time, blocks of bodies, batches.
 
-Every fixed-step method (``rk4``, ``splitting2``, ``splitting4``, ``cf4``)
-runs through the drivers below; a method is a *scheme*, a
+Every fixed-step method (``rk4``, ``cf4``, ``splitting2``, ``splitting4``,
+``exact_split2``, ``exact_split4``) runs through the drivers below
+(:class:`FixedSteps`, the :class:`~._method.Driver` its file declares); a method is a *scheme*, a
 :class:`typing.NamedTuple` (its coefficients, if any) that overloads two
 generic functions, in the same way as models overload the protocol of
 :mod:`tumble._protocol`::
@@ -22,16 +23,15 @@ computed once, before the run, as exact integers and checked against
 from __future__ import annotations
 
 import math
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit, prange
 from numba.extending import overload
 
 from tumble._validate import ValidationError
+from tumble.integrate._method import Driver
 
-#: Default ``max_steps``: the most steps per body of one run, for every method (about 10 s of ``rk4`` on a
-#: torque-free rigid body; a run past it is refused, before it starts for the fixed-step methods).
-MAX_STEPS = 10**8
 
 #: Bodies advanced together in one structure-of-arrays block (SIMD lanes × unrolling).
 LANES = 64
@@ -153,3 +153,32 @@ def run_batch(scheme, model, y, t_out, m, h, out, stats):
     """
     for k in prange((y.shape[0] + LANES - 1) // LANES):
         run_block(scheme, model, np.int64(k), y, t_out, m, h, out, stats)
+
+
+class FixedSteps(Driver):
+    """The driver of a fixed-step method: ``scheme`` advanced by steps that land on every output time.
+
+    Its plan is :func:`landing_steps` for the whole run (so a run that needs more than ``max_steps`` is
+    refused before it starts). A lone body runs on its state vector (:func:`run_one`); a batch runs in
+    blocks of :data:`LANES`, in parallel over the cores (:func:`run_batch`) unless ``serial``.
+    """
+
+    def __init__(self, scheme: NamedTuple) -> None:
+        self.scheme = scheme
+
+    def __repr__(self) -> str:
+        return f"FixedSteps({type(self.scheme).__name__})"
+
+    def plan(self, t, options) -> tuple[np.ndarray, np.ndarray]:
+        return landing_steps(t, options["dt"], options["max_steps"])
+
+    def advance(self, model: Any, y, t, lo, hi, out, stats, plan, serial) -> None:
+        m, h = plan[0][lo:hi], plan[1][lo:hi]
+        t = t[lo:hi + 1]
+        if y.shape[0] == 1:
+            run_one(self.scheme, model, y, t, m, h, out, stats)
+        elif serial:
+            for k in range(-(-y.shape[0] // LANES)):
+                run_block(self.scheme, model, k, y, t, m, h, out, stats)
+        else:
+            run_batch(self.scheme, model, y, t, m, h, out, stats)

@@ -13,7 +13,7 @@ SIMD lanes. ``rk4`` (:mod:`._rk4`) and ``cf4`` (:mod:`._liegroup`) run so.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, types
+from numba import njit
 
 from tumble._protocol import members, uniform
 from tumble.integrate._fixed import LANES as W  # lanes of a block: the stride of the buffer x
@@ -29,10 +29,10 @@ def workspace(model, Y):
 
 
 def counts_references(model) -> bool:
-    """Whether the passes over the lanes of ``model`` (a Numba type with ``point_rates``) need reference
-    counting: unless it has no torque program (its ``codes`` None, the torque-free rigid body)."""
-    codes = model.types[model.fields.index("codes")] if "codes" in model.fields else None
-    return not isinstance(codes, types.NoneType)
+    """Whether the passes over the lanes of ``model`` (the Numba type of a kernel with ``point_rates``) need
+    reference counting: when its kind declares that its compiled code may call a Python function, which
+    allocates (``may_call_python``, :mod:`tumble._protocol`; the rigid body: with a torque program)."""
+    return model.instance_class.may_call_python(model)
 
 
 def advance(point_step):
@@ -45,14 +45,14 @@ def advance(point_step):
     block's own kernel (:func:`tumble._protocol.members`), or row 0 of a uniform one: indices from 0,
     which LLVM reads as contiguous vectors (from ``b0`` it did not).
 
-    The passes over the lanes are one function, compiled without reference counting for a model without
-    a torque program (:func:`counts_references`), so that the copy compiled on its own is vectorised:
-    the step, IR-inlined, binds the model's arrays again in every call, and the increments and
-    decrements of their counts, split across the status branches of its helpers' calls, were still in
-    the lane loop when LLVM's one ``-O3`` round tried to vectorise it. The process that compiles a batch
-    runs that copy (docs/architecture.md): it ran 5× slower than one loading the cached code, and now
-    runs as fast. A torque program keeps the counts: its evaluator may call a Python function, which
-    allocates.
+    The passes over the lanes are one function, compiled without reference counting for a model whose
+    compiled code calls no Python function (:func:`counts_references`), so that the copy compiled on its
+    own is vectorised: the step, IR-inlined, binds the model's arrays again in every call, and the
+    increments and decrements of their counts, split across the status branches of its helpers' calls,
+    were still in the lane loop when LLVM's one ``-O3`` round tried to vectorise it. The process that
+    compiles a batch runs that copy (docs/architecture.md): it ran 5× slower than one loading the cached
+    code, and now runs as fast. A model whose code may call Python (the rigid body's torque program)
+    keeps the counts, since a Python function allocates.
     """
 
     def lane_steps(model, block, shared, t0, h, m, x, lanes):

@@ -45,9 +45,8 @@ from numba import njit
 from tumble import _protocol, _quat
 from tumble._protocol import body_rate, point_rates, project, quaternion_scale, rhs
 from tumble.integrate import _fixed, _fused
+from tumble.integrate._method import FIXED_STEP, Method
 from tumble.integrate._rk4 import weighted_sum
-
-ORDER = 4
 
 # Exponent weights of the two final exponentials (applied first: W1).
 _W1 = (3.0 / 12.0, 2.0 / 12.0, 2.0 / 12.0, -1.0 / 12.0)
@@ -224,3 +223,11 @@ def _combine(W, weights, h, j):
 
 
 _fused_advance = _fused.advance(point_step)
+
+
+METHODS = (
+    Method("cf4", order=4,
+           description="commutator-free Lie-group method CF4 (Celledoni–Marthinsen–Owren 2003), fixed step dt",
+           driver=_fixed.FixedSteps(SCHEME), evaluations=4, options=FIXED_STEP,
+           needs=frozenset({"rhs", "body_rate"}), conserves="|q| = 1 without projection (exact rotations)"),
+)

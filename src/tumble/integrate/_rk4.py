@@ -30,8 +30,7 @@ from numba.extending import register_jitable
 from tumble import _protocol
 from tumble._protocol import point_rates, project, quaternion_scale, rhs, state_size
 from tumble.integrate import _fixed, _fused
-
-ORDER = 4
+from tumble.integrate._method import FIXED_STEP, Method
 
 
 # Not inline="always": numba-cuda (0.68) binds the arguments of an IR-inlined register_jitable
@@ -85,7 +84,6 @@ class RK4(NamedTuple):
 SCHEME = RK4()
 
 
-
 @_protocol.implements(_fixed.workspace, RK4)
 def _rk4_workspace(scheme, model, b0, Y):
     if _protocol.implemented(point_rates, model):
@@ -125,3 +123,8 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
 
 
 _fused_advance = _fused.advance(point_step)
+
+METHODS = (
+    Method("rk4", order=4, description="classical Runge–Kutta (Kutta 1901), fixed step dt",
+           driver=_fixed.FixedSteps(SCHEME), evaluations=4, options=FIXED_STEP),
+)

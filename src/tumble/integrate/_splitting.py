@@ -64,6 +64,7 @@ from numba import njit
 from tumble import _protocol, _quat
 from tumble._protocol import inverse_moments
 from tumble.integrate import _fixed
+from tumble.integrate._method import FIXED_STEP, Method
 from tumble.integrate._liegroup import rotate_right, times_unit
 
 
@@ -94,7 +95,6 @@ def _blanes_moan_s6() -> tuple[np.ndarray, np.ndarray]:
 STRANG = Splitting(np.array([0.5, 0.5]), np.array([1.0]), AXES)
 BLANES_MOAN = Splitting(*_blanes_moan_s6(), AXES)
 
-ORDERS = {"splitting2": 2, "splitting4": 4}
 
 
 
@@ -215,3 +215,18 @@ def _sincos(x):
     sin = -sin if n >= 2.0 else sin
     cos = -cos if (n == 1.0) | (n == 2.0) else cos
     return sin, cos
+
+
+_INVARIANTS = "|L|, L_N and |q| = 1 (exact rotations; energy error bounded, symplectic)"
+
+# no right-hand side is evaluated: each step is 2 (Strang) or 12 (S₆) exact turns
+METHODS = (
+    Method("splitting2", order=2,
+           description="Lie–Poisson splitting of the free body into exact rotations, Strang, fixed step dt",
+           driver=_fixed.FixedSteps(STRANG), evaluations=0, options=FIXED_STEP,
+           needs=frozenset({"torque_free"}), conserves=_INVARIANTS),
+    Method("splitting4", order=4,
+           description="Lie–Poisson splitting of the free body into exact rotations, Blanes–Moan S6, fixed step dt",
+           driver=_fixed.FixedSteps(BLANES_MOAN), evaluations=0, options=FIXED_STEP,
+           needs=frozenset({"torque_free"}), conserves=_INVARIANTS),
+)

@@ -52,6 +52,13 @@ class RigidModel(NamedTuple):
         """True when the torque program calls a Python function (the batch then runs on one core)."""
         return torques.calls_python(self.codes)
 
+    @staticmethod
+    def may_call_python(numba_type) -> bool:
+        """Whether compiled code of a kernel of the Numba type ``numba_type`` may call a Python function,
+        known when a call is typed (:mod:`tumble._protocol`): with a torque program, whose codes are data,
+        it may; without one (``codes`` None), never."""
+        return not _torque_free(numba_type)
+
 
 def build(bodies, model) -> RigidModel:
     """The :class:`RigidModel` of a list of RigidBody (one, or one per batch member) under a torque model."""

@@ -14,6 +14,7 @@ import numpy as np
 from pydantic import BaseModel, Discriminator, Field, Tag, field_validator
 
 from tumble import attitude, integrate
+from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.scenario._errors import ScenarioError
 from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, _Quaternion, _Table, _Text,
@@ -342,9 +343,10 @@ class Solver(_Table):
     @field_validator("method")
     @classmethod
     def _known_method(cls, method):
-        if method not in integrate.METHODS:
-            raise ValueError(f"must be one of {', '.join(map(repr, integrate.METHODS))}, got {method!r}")
-        return method
+        try:
+            return integrate.method(method).name
+        except ValidationError as error:  # the rule, reported at solver.method
+            raise ValueError(error.rule) from None
 
     @field_validator("rtol", "atol", "dt")
     @classmethod
