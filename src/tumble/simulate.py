@@ -272,8 +272,9 @@ def simulate(
     progress : callable ``progress(done, total)``, optional
         Called as output samples are completed (the CLI draws a progress bar).
     device : {"cpu", "cuda"}
-        ``"cuda"``: ``method="rk4"`` batches of rigid bodies on an NVIDIA GPU,
-        one thread per body (compiled torque models only; ``docs/gpu.md``).
+        ``"cuda"``: ``method="rk4"`` or ``"cf4"`` on an NVIDIA GPU, one thread
+        per batch member, for every model whose compiled functions run there
+        (compiled torques and laws; ``docs/gpu.md``).
     store : path of a Zarr store (a directory that does not exist), optional
         Run the batch in chunks of members, each written to the store as it
         completes, and return the run as a lazily opened ``xarray.Dataset``
@@ -317,10 +318,12 @@ def simulate(
         kernel = model.compile(torque, float(times[0]))
         who = f"a {type(model).__name__}" + (f" under torque={torque!r}" if torque is not None else "")
         integrate.check_method(m.name, kernel.provides, who)
-        if device == "cuda" and (m.name != "rk4" or progress is not None or "cuda" not in kernel.provides):
-            raise ValidationError(f"device: 'cuda' runs method='rk4' on rigid bodies with compiled torques, without "
-                                  f"progress reporting; got method={m.name!r} on {who}"
-                                  + (" and a progress callback" if progress is not None else ""))
+        if device == "cuda":
+            from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
+
+            _cuda.check(kernel, m.name, who)
+            if progress is not None:
+                raise ValidationError("progress: device='cuda' reports no progress; got a progress callback")
         y0 = model.initial_states(kernel, values, float(times[0]))
         _check_memory(times.size, y0)
         try:

@@ -222,7 +222,7 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float |
     ``t`` (s) must be strictly increasing (:func:`tumble._validate.output_times`).
     A model whose ``calls_python`` is true runs body after body on one core.
     ``progress(done, total)`` is called after each chunk of output samples.
-    ``device="cuda"`` runs ``rk4`` on an NVIDIA GPU (models that provide ``"cuda"``).
+    ``device="cuda"`` runs ``rk4`` or ``cf4`` on an NVIDIA GPU (models that provide ``"cuda"``).
 
     Bounded before anything runs: a fixed-step run needing more than ``max_steps`` steps per body is
     refused (:func:`._fixed.landing_steps`), and so are states that would not fit in memory
@@ -243,9 +243,9 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float |
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
 
-        states, n_steps = _cuda.solve_cuda(model, y, t, dt, max_steps)
+        states, n_steps = _cuda.solve_cuda(model, y, t, dt, max_steps, method=method)
         _raise_on_divergence(states, method)
-        return Solution(states, n_steps, 0, 4 * n_steps)
+        return Solution(states, n_steps, 0, _SCHEMES[method][1] * n_steps)
     steps = _fixed.landing_steps(t, cast(float, dt), max_steps) if method in _SCHEMES else None  # dt checked
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     stats = np.zeros((y.shape[0], 5))

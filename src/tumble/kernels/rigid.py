@@ -52,6 +52,11 @@ class RigidModel(NamedTuple):
         """True when the torque program calls a Python function (the batch then runs on one core)."""
         return torques.calls_python(self.codes)
 
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this kernel cannot run on an NVIDIA GPU (a ValidationError message), or None: a Python torque."""
+        return _protocol.python_on_gpu("torque") if self.calls_python else None
+
 
 def build(bodies, model) -> RigidModel:
     """The :class:`RigidModel` of a list of RigidBody (one, or one per batch member) under a torque model."""

@@ -183,8 +183,41 @@ def _environment(python):
     return field, gravity, external
 
 
+# What the control law reads at a sample on a GPU, where no spacecraft carries flight software: the truth,
+# and the command acts at once.
+_truth = inline(lambda model, y, j, qw, qx, qy, qz, w1, w2, w3, b1, b2, b3: (qw, qx, qy, qz, w1, w2, w3))
+_at_once = inline(lambda model, y, j, u1, u2, u3, m1, m2, m3: (u1, u2, u3, m1, m2, m3))
+
+
+def _flight_software(access, device):
+    """``(estimate, delayed)`` at a sample: ``estimate(model, y, j, q, ω, B) -> (q̂, ω̂)``, what the control law
+    reads (the flight software's estimate, or the truth without one), and ``delayed(model, y, j, u, m) -> (u, m)``,
+    the command that acts now. The variant for a GPU (``device``) leaves the flight software out: its MEKF
+    allocates, and a spacecraft that carries it is refused there (``SpacecraftModel.gpu_refusal``)."""
+    if device:
+        return _truth, _at_once
+    has_fsw, where_fsw = locator("flight_software")
+    step, delayed_command = flight_software.kernel(access)
+
+    @inline
+    def estimate(model, y, j, qw, qx, qy, qz, w1, w2, w3, b1, b2, b3):
+        if has_fsw(model):  # the laws read the flight software's estimate, not the truth
+            p, _, s, _ = where_fsw(model)
+            qw, qx, qy, qz, w1, w2, w3 = step(model, p, s, model.data[PERIOD], y, j, b1, b2, b3)
+        return qw, qx, qy, qz, w1, w2, w3
+
+    @inline
+    def delayed(model, y, j, u1, u2, u3, m1, m2, m3):
+        if has_fsw(model):
+            p, _, s, _ = where_fsw(model)
+            u1, u2, u3, m1, m2, m3 = delayed_command(model, p, s, y, j, u1, u2, u3, m1, m2, m3)
+        return u1, u2, u3, m1, m2, m3
+
+    return estimate, delayed
+
+
 @functools.lru_cache(maxsize=None)
-def assemble(ndim, python):
+def assemble(ndim, python, device=False):
     """Compile-time assembly for states of ``ndim``: ``(derivative, sample, discrete)``; ``python``: the
     variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
     which then allocates nothing, is compiled without reference counting: the
@@ -194,7 +227,8 @@ def assemble(ndim, python):
     ``y`` (or of the state vector ``y``, ``ndim`` 1) into ``out`` and, when ``store``, its diagnostics into
     ``aux``; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
     PWPF triggers); ``discrete(model)`` is True when a part present updates after every step (without a
-    zero-order hold, which samples at its own times). Cached, so that the right-hand side, the projection and
+    zero-order hold, which samples at its own times); ``device``: the variant compiled for a GPU, without the
+    flight software (:func:`_flight_software`). Cached, so that the right-hand side, the projection and
     the diagnostics share it."""
     access = lane(ndim)
     at, put, put3 = access
@@ -210,7 +244,7 @@ def assemble(ndim, python):
     sample_parts, discrete = _sample_all(actuators)
     field, gravity, external = _environment(python)
     has_fsw, where_fsw = locator("flight_software")
-    fsw_step, fsw_delayed = flight_software.kernel(access)
+    estimate, delayed = _flight_software(access, device)
 
     @inline
     def controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
@@ -283,16 +317,12 @@ def assemble(ndim, python):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
             w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
             b1, b2, b3 = field(model, t, qw, qx, qy, qz)
-            if has_fsw(model):  # the laws read the flight software's estimate, not the truth
-                p, _, s, _ = where_fsw(model)
-                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], y, j, b1, b2, b3)
+            qw, qx, qy, qz, w1, w2, w3 = estimate(model, y, j, qw, qx, qy, qz, w1, w2, w3, b1, b2, b3)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
             h1, h2, h3 = momenta(model, y, j)
             u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
                                                       H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
-            if has_fsw(model):
-                p, _, s, _ = where_fsw(model)
-                u1, u2, u3, m1, m2, m3 = fsw_delayed(model, p, s, y, j, u1, u2, u3, m1, m2, m3)
+            u1, u2, u3, m1, m2, m3 = delayed(model, y, j, u1, u2, u3, m1, m2, m3)
             hold(model, t, y, j, u1, u2, u3, m1, m2, m3, source)
         sample_parts(model, t, y, j)
 
