@@ -60,6 +60,7 @@ import math
 
 import numpy as np
 from numba import cuda, njit, types
+from numba.core import config
 from numba.extending import overload, register_jitable
 
 from tumble import torques
@@ -201,7 +202,11 @@ def _advance_gpu(scheme, model, b, t0, h, m, y, work):
     return lambda scheme, model, b, t0, h, m, y, work: _fixed.advance(scheme, model, b, t0, h, m, y, work)
 
 
-@cuda.jit(cache=True, extensions=[_NoneAsNull()])
+# The CUDA simulator passes Python values as they are, and its jit takes no extensions.
+_LAUNCH_OPTIONS = {} if config.ENABLE_CUDASIM else {"extensions": [_NoneAsNull()]}
+
+
+@cuda.jit(cache=True, **_LAUNCH_OPTIONS)
 def _protocol_kernel(scheme, model, Y, t_out, m, h, out, work):
     """Thread ``b`` integrates member ``b`` of the compiled ``model`` from ``Y[b]`` (in place) through
     ``t_out`` with ``scheme``, ``m[k]`` steps of ``h[k]`` from ``t_out[k]`` to ``t_out[k+1]``; ``out[k, b]``
