@@ -152,6 +152,26 @@ def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
         out[k, b, 0], out[k, b, 1], out[k, b, 2], out[k, b, 3], out[k, b, 4], out[k, b, 5], out[k, b, 6] = y
 
 
+# ``max`` and ``min`` of two or three numbers, as Python's (the first of equals; ``b`` replaces ``a`` only when
+# strictly greater, or smaller), for code compiled for a GPU: Numba's generic overload takes ``*args``, which
+# the numba.cuda of Numba 0.68 does not compile ("Signature mismatch"); the kernels call them with numbers.
+_MAX = {2: lambda a, b: b if b > a else a, 3: lambda a, b, c: _larger(_larger(a, b), c)}
+_MIN = {2: lambda a, b: b if b < a else a, 3: lambda a, b, c: _smaller(_smaller(a, b), c)}
+_larger, _smaller = (register_jitable(_MAX[2]), register_jitable(_MIN[2]))
+
+
+@overload(max, target="cuda")
+def _max_gpu(*args):
+    if all(isinstance(a, types.Number) for a in args):
+        return _MAX.get(len(args))
+
+
+@overload(min, target="cuda")
+def _min_gpu(*args):
+    if all(isinstance(a, types.Number) for a in args):
+        return _MIN.get(len(args))
+
+
 class _NoneAsNull:
     """A ``numba.cuda`` kernel-argument extension: a field that is None in a kernel (a NamedTuple), such as a
     torque-free rigid body's ``codes``, passes as a null pointer, the argument Numba's None takes (an opaque
