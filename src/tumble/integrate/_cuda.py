@@ -160,13 +160,13 @@ _MIN = {2: lambda a, b: b if b < a else a, 3: lambda a, b, c: _smaller(_smaller(
 _larger, _smaller = (register_jitable(_MAX[2]), register_jitable(_MIN[2]))
 
 
-@overload(max, target="cuda")
+@overload(max, target="cuda", strict=False)
 def _max_gpu(*args):
     if all(isinstance(a, types.Number) for a in args):
         return _MAX.get(len(args))
 
 
-@overload(min, target="cuda")
+@overload(min, target="cuda", strict=False)
 def _min_gpu(*args):
     if all(isinstance(a, types.Number) for a in args):
         return _MIN.get(len(args))
