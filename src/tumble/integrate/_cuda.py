@@ -155,9 +155,18 @@ def _rk4_kernel(coefficients, P, codes, y0, t_out, m, h, out):
 # ``max`` and ``min`` of two or three numbers, as Python's (the first of equals; ``b`` replaces ``a`` only when
 # strictly greater, or smaller), for code compiled for a GPU: Numba's generic overload takes ``*args``, which
 # the numba.cuda of Numba 0.68 does not compile ("Signature mismatch"); the kernels call them with numbers.
-_MAX = {2: lambda a, b: b if b > a else a, 3: lambda a, b, c: _larger(_larger(a, b), c)}
-_MIN = {2: lambda a, b: b if b < a else a, 3: lambda a, b, c: _smaller(_smaller(a, b), c)}
-_larger, _smaller = (register_jitable(_MAX[2]), register_jitable(_MIN[2]))
+@register_jitable
+def _larger(a, b):
+    return b if b > a else a
+
+
+@register_jitable
+def _smaller(a, b):
+    return b if b < a else a
+
+
+_MAX = {2: _larger, 3: lambda a, b, c: _larger(_larger(a, b), c)}
+_MIN = {2: _smaller, 3: lambda a, b, c: _smaller(_smaller(a, b), c)}
 
 
 @overload(max, target="cuda", strict=False)
