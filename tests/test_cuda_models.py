@@ -25,6 +25,7 @@ from numba.core import config
 import tumble
 from tumble import torques
 from tumble.flexible import FlexibleBody, Mode
+from tumble.ins import GimbaledGyro
 from tumble.simulate import as_model
 from tumble.slosh import Pendulum, SloshBody
 from tumble.spacecraft import FlightSoftware, MRPFeedback, QuaternionPD, Spacecraft, pyramid_wheels
@@ -121,6 +122,14 @@ def test_what_cannot_run_on_a_gpu_is_refused_naming_the_part(make, message):
     torque = (lambda t, q, w: -w) if isinstance(model, FlexibleBody) else None
     with pytest.raises(tumble.ValidationError, match=message):
         tumble.simulate(model, OMEGA0[0], t=T, method="rk4", dt=DT, torque=torque, device="cuda")
+
+
+def test_a_model_kind_without_a_device_path_is_refused_naming_device():
+    gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
+                        outer_gimbal=1e-3, imbalance=0.01)
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a GimbaledGyro: its compiled "
+                                                     r"model does not run on a GPU$"):
+        tumble.simulate(gyro, t=T, method="rk4", dt=DT, spin=100.0, theta0=1.0, device="cuda")
 
 
 def test_methods_without_a_device_kernel_are_refused():
