@@ -217,7 +217,8 @@ def test_simulate_refuses_bad_device_settings():
     body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
     with pytest.raises(tumble.ValidationError, match="device"):
         tumble.simulate(body, [0.1, 1.0, 0.1], t=[0.0, 1.0], method="rk4", dt=0.1, device="tpu")
-    with pytest.raises(tumble.ValidationError, match="device: 'cuda' runs method='rk4'"):
+    with pytest.raises(tumble.ValidationError, match="device: 'cuda' runs the methods 'rk4', 'cf4'; got "
+                                                     "method='dop853'"):
         tumble.simulate(body, [0.1, 1.0, 0.1], t=[0.0, 1.0], device="cuda")
 
 

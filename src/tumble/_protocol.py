@@ -36,8 +36,11 @@ compiles::
                    the torque; the exact method and the exact-flow splittings
     "torque_free"  no torque at all: the state is [q_NP, ω_P] and
                    inverse_moments(model, b) -> (1/I₁, 1/I₂, 1/I₃); the Lie–Poisson splittings
-    "cuda"         the kernel's fields are those that tumble.integrate._cuda reads (a rigid
-                   body with a compiled torque program): rk4 on an NVIDIA GPU
+    "cuda"         every function above that the kernel provides also compiles for an NVIDIA GPU
+                   (numba.cuda): nothing calls Python or allocates; the fixed-step methods of
+                   tumble.integrate._cuda then run it there, one thread per batch member. A kernel
+                   that cannot says why in its ``gpu_refusal`` (a ValidationError message naming the
+                   part, or None)
 
 Two more are optional: a kernel whose state is ``[q_NP, ω_P]`` (7) and whose
 projection is ``q ← q/|q|`` may give its right-hand side on one body's state
@@ -95,7 +98,7 @@ def implemented(generic, numba_type) -> bool:
             and (generic, numba_type.instance_class) in _IMPLEMENTED)
 
 
-def implements(generic, cls, *, inline: bool = False, **jit_options):
+def implements(generic, cls, *, inline: bool = False, target: str = "generic", **jit_options):
     """Decorator: register a typing function as the overload of ``generic`` for the NamedTuple type ``cls``.
 
     The typing function receives the Numba types of a call whose first
@@ -108,14 +111,16 @@ def implements(generic, cls, *, inline: bool = False, **jit_options):
     compiled on its own, not inlined, is then compiled as it would be inlined.
     With Python's error model a division checks its divisor and may raise, and
     LLVM keeps such a loop scalar: the fused RK4 lanes ran 5× slower in the
-    process that compiled them than when loaded from the cache.
+    process that compiled them than when loaded from the cache. ``target="cuda"``
+    registers the implementation that code compiled for an NVIDIA GPU uses instead
+    (Numba prefers an overload of the target it compiles for over a generic one).
     """
     def register(typer):
         @functools.wraps(typer)
         def for_this_kernel(*args):
             return typer(*args) if is_type(args[0], cls) else None
 
-        overload(generic, inline="always" if inline else "never",
+        overload(generic, inline="always" if inline else "never", target=target,
                  jit_options={"cache": True, "error_model": "numpy", **jit_options})(for_this_kernel)
         _IMPLEMENTED.add((generic, cls))
         return typer
@@ -190,8 +195,14 @@ CAPABILITIES = {
     "body_rate": "the body rate of its attitude quaternion",
     "free_flow": "the closed-form motion of a free rigid body, with torque kicks",
     "torque_free": "a rigid body without torque",
-    "cuda": "an RK4 kernel for NVIDIA GPUs (device='cuda')",
+    "cuda": "compiled functions that run on an NVIDIA GPU (device='cuda')",
 }
+
+
+def python_on_gpu(field: str) -> str:
+    """The ``gpu_refusal`` of a kernel whose ``field`` (a torque, a control law) is a Python function."""
+    return (f"{field}: a Python function cannot run on the GPU (device='cuda'); use the compiled models "
+            "or device='cpu'")
 
 
 def free_setup(model, b, x):  # pragma: no cover - replaced by overloads in compiled code

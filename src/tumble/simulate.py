@@ -110,8 +110,9 @@ def simulate(
     progress : callable ``progress(done, total)``, optional
         Called as output samples are completed (the CLI draws a progress bar).
     device : {"cpu", "cuda"}
-        ``"cuda"``: ``method="rk4"`` batches of rigid bodies on an NVIDIA GPU,
-        one thread per body (compiled torque models only; ``docs/gpu.md``).
+        ``"cuda"``: ``method="rk4"`` or ``"cf4"`` on an NVIDIA GPU, one thread
+        per batch member, for every model whose compiled functions run there
+        (compiled torques and laws; ``docs/gpu.md``).
     store : path of a Zarr store, optional
         Deprecated (to be removed in 0.5): use
         :func:`tumble.sweeps.simulate_to_store`, which this then calls and
@@ -159,10 +160,12 @@ def simulate(
         kernel = model.compile(torque, float(times[0]))
         who = f"a {model.kind}" + (f" under torque={torque!r}" if torque is not None else "")
         integrate.check_method(m.name, kernel.provides, who)
-        if device == "cuda" and (m.name != "rk4" or progress is not None or "cuda" not in kernel.provides):
-            raise ValidationError(f"device: 'cuda' runs method='rk4' on rigid bodies with compiled torques, without "
-                                  f"progress reporting; got method={m.name!r} on {who}"
-                                  + (" and a progress callback" if progress is not None else ""))
+        if device == "cuda":
+            from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
+
+            _cuda.check(kernel, m.name, who)
+            if progress is not None:
+                raise ValidationError("progress: device='cuda' reports no progress; got a progress callback")
         y0 = model.initial_states(kernel, values, float(times[0]))
         grid, kept = _with_step_ends(times, model.step_ends(times, options.get("dt")))
         _check_memory(grid.size, y0)

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 from numba import njit, objmode
-from numba.extending import register_jitable
+from numba.extending import overload, register_jitable
 from numpy.typing import ArrayLike
 
 from tumble import _callback, _gravity, _quat
@@ -446,18 +446,43 @@ def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: 
     return t1, t2, t3
 
 
+def add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):  # pragma: no cover
+    """``(t1, t2, t3)`` plus the torque (N·m) of each Python callback of the torque program in row ``row``
+    of ``P``, added in the program's order.
+
+    Compiled per target: on the CPU it calls each callback; on an NVIDIA GPU
+    (``numba.cuda``) a program has no Python terms, since
+    :mod:`tumble.integrate._cuda` refuses one before it launches, and nothing is
+    added, so that every kernel that evaluates a torque program compiles for the GPU.
+    """
+    raise NotImplementedError("compiled code only")
+
+
+@overload(add_python_terms, target="cpu", jit_options={"cache": True})
+def _add_python_terms_cpu(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    def impl(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+        for k in range(0, codes.shape[0], 2):
+            if int(codes[k]) == _PYTHON:
+                a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, int(codes[k + 1]))
+                t1 += a
+                t2 += b
+                t3 += c
+        return t1, t2, t3
+
+    return impl
+
+
+@overload(add_python_terms, target="cuda")
+def _add_python_terms_gpu(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
+    return lambda t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes: (t1, t2, t3)
+
+
 @njit(cache=True)
 def evaluate(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2: float, w3: float, P: np.ndarray,
              row: int, codes: np.ndarray) -> tuple[float, float, float]:
     """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
 
-    The compiled terms (:func:`evaluate_compiled`), then the Python callbacks.
+    The compiled terms (:func:`evaluate_compiled`), then the Python callbacks (:func:`add_python_terms`).
     """
     t1, t2, t3 = evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
-    for k in range(0, codes.shape[0], 2):
-        if int(codes[k]) == _PYTHON:
-            a, b, c = _python_torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, int(codes[k + 1]))
-            t1 += a
-            t2 += b
-            t3 += c
-    return t1, t2, t3
+    return add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)

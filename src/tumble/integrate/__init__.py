@@ -187,7 +187,7 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     solver options the method reads (:class:`Run`).
     A model whose ``calls_python`` is true runs body after body on one core.
     ``progress(done, total)`` is called after each chunk of output samples.
-    ``device="cuda"`` runs ``rk4`` on an NVIDIA GPU (models that provide ``"cuda"``).
+    ``device="cuda"`` runs ``rk4`` or ``cf4`` on an NVIDIA GPU (models that provide ``"cuda"``).
 
     Bounded before anything runs: a fixed-step run needing more than ``max_steps`` steps per body is
     refused (:func:`._fixed.landing_steps`), and so are states that would not fit in memory
@@ -205,7 +205,8 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
 
-        states, n_steps = _cuda.solve_cuda(model, y, run.t, run.options["dt"], run.options["max_steps"])
+        states, n_steps = _cuda.solve_cuda(model, y, run.t, run.options["dt"], run.options["max_steps"],
+                                           method=run.method.name)
         _raise_on_divergence(states, method)
         return Solution(states, n_steps, 0, run.method.evaluations * n_steps)
     out = np.empty((n_out, y.shape[0], y.shape[1]))

@@ -97,10 +97,13 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     if _protocol.implemented(point_rates, model):
         return _fused_advance(Y, model)  # one step of a lane in registers (_fused)
 
+    # flat views: each stage update is one loop over state × lanes (contiguous, vectorised); one body's state
+    # vector is its own (no new view: a function compiled for a GPU returns none)
+    flat = _itself if Y.ndim == 1 else _raveled
+
     def impl(scheme, model, b0, t0, h, m, Y, work):
         k1, k2, k3, k4, tmp = work
-        # flat views: each stage update is one loop over state × lanes (contiguous, vectorised)
-        y_, k1_, k2_, k3_, k4_, tmp_ = Y.ravel(), k1.ravel(), k2.ravel(), k3.ravel(), k4.ravel(), tmp.ravel()
+        y_, k1_, k2_, k3_, k4_, tmp_ = flat(Y), flat(k1), flat(k2), flat(k3), flat(k4), flat(tmp)
         # a compile-time constant for one body, so LLVM unrolls the stage loops
         size = state_size(model) if Y.ndim == 1 else Y.size
         for s in range(m):
@@ -121,6 +124,9 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
 
     return impl
 
+
+_itself = njit(inline="always")(lambda a: a)
+_raveled = njit(inline="always")(lambda a: a.ravel())
 
 _fused_advance = _fused.advance(point_step)
 

@@ -59,6 +59,11 @@ class RigidModel(NamedTuple):
         it may; without one (``codes`` None), never."""
         return not _torque_free(numba_type)
 
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this kernel cannot run on an NVIDIA GPU (a ValidationError message), or None: a Python torque."""
+        return _protocol.python_on_gpu("torque") if self.calls_python else None
+
 
 def build(bodies, model) -> RigidModel:
     """The :class:`RigidModel` of a list of RigidBody (one, or one per batch member) under a torque model."""

@@ -21,6 +21,7 @@ invariants of the exact flow).
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -51,13 +52,19 @@ class SloshModel(NamedTuple):
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate; ``"cuda"``
+        without a Python torque function."""
+        return frozenset({"rhs", "body_rate", *(() if self.calls_python else ("cuda",))})
 
     @property
     def calls_python(self) -> bool:
         """True when the torque program calls a Python function (the batch then runs on one core)."""
         return torques.program_calls_python(self)
+
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this kernel cannot run on an NVIDIA GPU (a ValidationError message), or None: a Python torque."""
+        return _protocol.python_on_gpu("torque") if self.calls_python else None
 
 
 @njit(cache=True)
@@ -106,7 +113,7 @@ def derivative(model, t, y, out):
 def project_state(y):
     """Normalise ``q`` and ``s`` of one state vector and remove the component of ``ν`` along ``s``."""
     _protocol.normalize_quaternion(y)
-    scale = 1.0 / np.sqrt(y[7] * y[7] + y[8] * y[8] + y[9] * y[9])
+    scale = 1.0 / math.sqrt(y[7] * y[7] + y[8] * y[8] + y[9] * y[9])  # math: a scalar function on a GPU too
     y[7], y[8], y[9] = y[7] * scale, y[8] * scale, y[9] * scale
     along = y[10] * y[7] + y[11] * y[8] + y[12] * y[9]
     y[10], y[11], y[12] = y[10] - along * y[7], y[11] - along * y[8], y[12] - along * y[9]

@@ -105,8 +105,23 @@ class SpacecraftModel(collections.namedtuple("SpacecraftModel", CORE_FIELDS + PA
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate; ``"cuda"``
+        without a part that cannot run on a GPU (:attr:`gpu_refusal`)."""
+        return frozenset({"rhs", "body_rate", *(() if self.gpu_refusal else ("cuda",))})
+
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this spacecraft cannot run on an NVIDIA GPU (a ValidationError message naming the part), or
+        None: a Python control law or torque function, or the flight software, whose MEKF allocates its
+        matrices at every sample."""
+        if any(getattr(self, kind) != ABSENT for kind in _PYTHON):
+            return _protocol.python_on_gpu("controller")
+        if torques.calls_python(self.torque_codes):
+            return _protocol.python_on_gpu("torque")
+        if self.flight_software != ABSENT:
+            return ("flight_software: the flight software's MEKF allocates its matrices at every sample, which "
+                    "code on the GPU cannot (device='cuda'); use device='cpu'")
+        return None
 
     @property
     def calls_python(self) -> bool:
@@ -173,29 +188,38 @@ def _spacecraft_rhs(model, b0, t, Y, OUT):
     return impl
 
 
-@_protocol.implements(_protocol.project, SpacecraftModel)
-def _spacecraft_project(model, b0, t, Y):
-    _, sense, sample, discrete = _assemble(Y.ndim, _python(model))
-    has_hold, _ = locator("hold")
-    if Y.ndim == 1:
-        normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
-    else:
-        normalize, lanes = _protocol.normalize_quaternions, inline(lambda Y: Y.shape[1])
+def _project(device):
+    """The typing function of ``project`` for a spacecraft: ``device``, the variant compiled for a GPU,
+    without the flight software (refused there: ``gpu_refusal``)."""
 
-    def impl(model, b0, t, Y):
-        normalize(Y)
-        for j in range(lanes(Y)):  # the flight software's sensors read at their own sample times
-            sense(model, t, Y, j)
-        if has_hold(model):  # a zero-order hold samples at t₀ + k·period
-            period, start = model.data[PERIOD], model.data[START]
-            k = round((t - start) / period)
-            if abs(t - start - k * period) <= SAMPLE_TOLERANCE * period:
+    def typer(model, b0, t, Y):
+        _, sense, sample, discrete = _assemble(Y.ndim, _python(model), device)
+        has_hold, _ = locator("hold")
+        if Y.ndim == 1:
+            normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
+        else:
+            normalize, lanes = _protocol.normalize_quaternions, inline(lambda Y: Y.shape[1])
+
+        def impl(model, b0, t, Y):
+            normalize(Y)
+            for j in range(lanes(Y)):  # the flight software's sensors read at their own sample times
+                sense(model, t, Y, j)
+            if has_hold(model):  # a zero-order hold samples at t₀ + k·period
+                period, start = model.data[PERIOD], model.data[START]
+                k = round((t - start) / period)
+                if abs(t - start - k * period) <= SAMPLE_TOLERANCE * period:
+                    for j in range(lanes(Y)):
+                        sample(model, t, Y, j)
+            elif discrete(model):  # parts with discrete states update after every step
                 for j in range(lanes(Y)):
                     sample(model, t, Y, j)
-        elif discrete(model):  # parts with discrete states update after every step
-            for j in range(lanes(Y)):
-                sample(model, t, Y, j)
-    return impl
+        return impl
+
+    return typer
+
+
+_protocol.implements(_protocol.project, SpacecraftModel)(_project(device=False))
+_protocol.implements(_protocol.project, SpacecraftModel, target="cuda")(_project(device=True))
 
 
 @_protocol.implements(_protocol.state_size, SpacecraftModel)

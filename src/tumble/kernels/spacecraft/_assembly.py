@@ -184,8 +184,19 @@ def _environment(python):
     return field, gravity, external
 
 
+# On a GPU no spacecraft carries flight software (its MEKF allocates; refused: ``SpacecraftModel.gpu_refusal``):
+# the laws read the truth, a command acts at once, and no sensor reads.
+_truth = inline(lambda model, t, y, j, qw, qx, qy, qz, w1, w2, w3: (qw, qx, qy, qz, w1, w2, w3))
+_not_pending = inline(lambda model, y, j, u1, u2, u3, m1, m2, m3: False)
+
+
+@njit
+def _no_sensing(model, t, y, j):
+    pass
+
+
 @functools.lru_cache(maxsize=None)
-def assemble(ndim, python):
+def assemble(ndim, python, device=False):
     """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, discrete)``; ``python``: the
     variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
     which then allocates nothing, is compiled without reference counting: the
@@ -196,8 +207,8 @@ def assemble(ndim, python):
     ``aux``; ``sense(model, t, y, j)`` lets the flight software's sensors whose sample time is the step end ``t``
     read the truth; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
     PWPF triggers); ``discrete(model)`` is True when a part present updates after every step (without a
-    zero-order hold, which samples at its own times). Cached, so that the right-hand side, the projection and
-    the diagnostics share it."""
+    zero-order hold, which samples at its own times); ``device``: the variant compiled for a GPU, without the
+    flight software. Cached, so that the right-hand side, the projection and the diagnostics share it."""
     access = lane(ndim)
     at, put, put3 = access
     direct = _commands.make_direct(access)
@@ -293,19 +304,38 @@ def assemble(ndim, python):
         o = p + flight_software.SUN_DIRECTION
         return d[o], d[o + 1], d[o + 2], 1.0
 
-    @njit
-    def sense(model, t, y, j):
-        """The flight software's sensors whose sample time is the step end ``t`` read the truth, and a pending
-        command whose delay ends at ``t`` goes to the hold."""
-        if has_fsw(model):
-            p, _, s, _ = where_fsw(model)
-            b1, b2, b3 = field(model, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
-            s1, s2, s3, light = sun(model, p, t)
-            fsw_sense(model, p, s, t, y, j, b1, b2, b3, s1, s2, s3, light)
-            if fsw_due(model, p, t):  # the command computed one delay ago starts acting
-                _, _, held_at, _ = where_hold(model)
-                for i in range(6):
-                    put(y, held_at + HELD_TORQUE + i, j, at(y, s + flight_software.PENDING + i, j))
+    if device:
+        sense, estimate, pending = _no_sensing, _truth, _not_pending
+    else:
+        @njit
+        def sense(model, t, y, j):
+            """The flight software's sensors whose sample time is the step end ``t`` read the truth, and a pending
+            command whose delay ends at ``t`` goes to the hold."""
+            if has_fsw(model):
+                p, _, s, _ = where_fsw(model)
+                b1, b2, b3 = field(model, t, at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j))
+                s1, s2, s3, light = sun(model, p, t)
+                fsw_sense(model, p, s, t, y, j, b1, b2, b3, s1, s2, s3, light)
+                if fsw_due(model, p, t):  # the command computed one delay ago starts acting
+                    _, _, held_at, _ = where_hold(model)
+                    for i in range(6):
+                        put(y, held_at + HELD_TORQUE + i, j, at(y, s + flight_software.PENDING + i, j))
+
+        @inline
+        def estimate(model, t, y, j, qw, qx, qy, qz, w1, w2, w3):
+            """What the laws read at a sample: the flight software's estimate, or the truth without one."""
+            if has_fsw(model):
+                p, _, s, _ = where_fsw(model)
+                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], t, y, j)
+            return qw, qx, qy, qz, w1, w2, w3
+
+        @inline
+        def pending(model, y, j, u1, u2, u3, m1, m2, m3):
+            """Whether the command waits for the flight software's computation delay (the held stays)."""
+            if has_fsw(model):
+                p, _, s, _ = where_fsw(model)
+                return fsw_pend(model, p, s, y, j, u1, u2, u3, m1, m2, m3)
+            return False
 
     @njit
     def sample(model, t, y, j):
@@ -313,17 +343,13 @@ def assemble(ndim, python):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
             w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
             b1, b2, b3 = field(model, t, qw, qx, qy, qz)
-            if has_fsw(model):  # the laws read the flight software's estimate, not the truth
-                p, _, s, _ = where_fsw(model)
-                qw, qx, qy, qz, w1, w2, w3 = fsw_step(model, p, s, model.data[PERIOD], t, y, j)
+            qw, qx, qy, qz, w1, w2, w3 = estimate(model, t, y, j, qw, qx, qy, qz, w1, w2, w3)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
             h1, h2, h3 = momenta(model, y, j)
             u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
                                                       H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
-            if has_fsw(model):
-                p, _, s, _ = where_fsw(model)
-                if fsw_pend(model, p, s, y, j, u1, u2, u3, m1, m2, m3):  # acts after the delay: the held stays
-                    u1, u2, u3, m1, m2, m3, source = held(model, y, j)
+            if pending(model, y, j, u1, u2, u3, m1, m2, m3):  # acts after the delay: the held stays
+                u1, u2, u3, m1, m2, m3, source = held(model, y, j)
             hold(model, t, y, j, u1, u2, u3, m1, m2, m3, source)
         sample_parts(model, t, y, j)
 

@@ -1,0 +1,181 @@
+"""Every model kind on the GPU (tumble.integrate._cuda's protocol kernel), without a GPU.
+
+Each case runs ``tumble.simulate(..., device="cuda")`` under Numba's CUDA
+simulator (``NUMBA_ENABLE_CUDASIM=1``, read when Numba is imported: in a child
+process) and compares it with the CPU's run bit for bit: the simulator rounds
+as the CPU does (no fused multiply–adds), and each thread's steps are the
+method's own compiled ``advance``. So the simulator checks the driver (launch,
+landing on the output times, each member's rows of the workspace, the model's
+transfer, the output) and the front door. That the same kernel compiles for a
+GPU, calls no Python and allocates nothing, it cannot see: the PTX tests below
+compile it for sm_90 with NVVM, where the CUDA toolkit is installed.
+"""
+
+import os
+import runpy
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from numba.core import config
+
+import tumble
+from tumble import torques
+from tumble.flexible import FlexibleBody, Mode
+from tumble.ins import GimbaledGyro
+from tumble.simulate import as_model
+from tumble.slosh import Pendulum, SloshBody
+from tumble.spacecraft import FlightSoftware, MRPFeedback, QuaternionPD, Spacecraft, pyramid_wheels
+
+INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])  # kg·m², body axes
+TARGET = [np.cos(0.2), 0.0, np.sin(0.2), 0.0]
+T = np.array([0.0, 0.02, 0.06, 0.12])  # 2, 4 and 6 steps of DT (a sampled controller needs whole steps)
+DT = 0.01
+OMEGA0 = np.array([[0.3, 1.0, -0.4], [-0.5, 0.2, 0.9]])  # two members, rad/s, body axes
+TORQUE = torques.ConstantBody([0.05, -0.02, 0.1]) + torques.ConstantInertial([0.0, 0.03, -0.01])
+
+
+def cases():
+    """name -> (model, method, torque, initial state): one of each model kind, two members each."""
+    flexible = FlexibleBody(INERTIA, [Mode(3.0, 0.02, [0.3, 0.5, 0.2]), Mode(7.0, 0.01, [0.1, -0.4, 0.6])])
+    slosh = SloshBody(tumble.RigidBody(INERTIA, mass=10.0), Pendulum(mass=2.0, length=0.5, hinge=[0.3, -0.2, 0.4],
+                                                                       damping=0.1))
+    wheels_mrp = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02),
+                            controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
+    held_pd = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02, max_torque=0.1),
+                         controller=QuaternionPD(0.2, 0.8, target=TARGET), control_period=0.02)
+    rigid = [tumble.RigidBody(INERTIA), tumble.RigidBody(np.diag([1.0, 2.0, 2.5]))]
+    wheel_speeds = {"wheel_speeds0": [[10.0, -5.0, 3.0, 0.0], [0.0, 20.0, -8.0, 4.0]]}
+    return {
+        "flexible, rk4": (flexible, "rk4", TORQUE, {"eta0": [[0.1, -0.05], [0.0, 0.2]], "eta_rate0": [0.3, 0.0]}),
+        "flexible, cf4": (flexible, "cf4", None, {"eta0": [[0.1, -0.05], [0.0, 0.2]]}),
+        "slosh, rk4": (slosh, "rk4", TORQUE, {"direction0": [[0.0, 0.0, -1.0], [0.3, 0.1, -1.0]],
+                                              "rate0": [0.2, -0.1, 0.0]}),
+        "spacecraft: wheels, MRP feedback, rk4": (wheels_mrp, "rk4", None, wheel_speeds),
+        "spacecraft: wheels, sampled PD, cf4": (held_pd, "cf4", TORQUE, wheel_speeds),
+        "rigid, one body each, cf4": (rigid, "cf4", TORQUE, {}),
+    }
+
+
+def _run(device, name):
+    model, method, torque, state = cases()[name]
+    traj = tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, device=device, **state)
+    return {"q": traj.q, "omega": traj.omega, **{k: traj.info[k] for k in ("n_steps", "n_rhs")}}
+
+
+# In the child, with the simulator on: each case's GPU run into one .npz.
+_CHILD = """
+import sys
+import numpy as np
+import runpy
+module = runpy.run_path(sys.argv[1])
+out = {}
+for i, name in enumerate(module["cases"]()):
+    for key, value in module["_run"]("cuda", name).items():
+        out[f"{i}/{key}"] = value
+np.savez(sys.argv[2], **out)
+"""
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    """name -> the simulated GPU run's arrays and statistics, every case in one child process."""
+    out = tmp_path_factory.mktemp("cuda_models") / "gpu.npz"
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(tumble.__file__).parents[1]), env.get("PYTHONPATH", "")])
+    subprocess.run([sys.executable, "-c", _CHILD, __file__, str(out)], env=env, check=True, timeout=900)
+    with np.load(out) as runs:
+        return {name: {key: runs[f"{i}/{key}"] for key in ("q", "omega", "n_steps", "n_rhs")}
+                for i, name in enumerate(cases())}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(cases()))
+def test_simulated_gpu_equals_cpu(simulated, name):
+    gpu, cpu = simulated[name], _run("cpu", name)
+    np.testing.assert_array_equal(gpu["q"], cpu["q"])
+    np.testing.assert_array_equal(gpu["omega"], cpu["omega"])
+    assert int(gpu["n_steps"]) == cpu["n_steps"] == 2 * 12  # two members, 2 + 4 + 6 steps each
+    assert int(gpu["n_rhs"]) == cpu["n_rhs"] == 4 * 2 * 12
+    # the members differ, and they moved: the comparison sees each one's own path
+    assert np.abs(cpu["omega"][-1, 0] - cpu["omega"][-1, 1]).max() > 1e-2
+    assert np.abs(cpu["omega"][-1] - cpu["omega"][0]).max() > 1e-4
+
+
+@pytest.mark.parametrize(("make", "message"), [
+    (lambda: Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), control_period=0.1,
+                        controller=QuaternionPD(0.2, 0.8, target=TARGET),
+                        flight_software=FlightSoftware(1e-5, 1e-8, star_tracker_sigma=5e-5)),
+     r"^flight_software: the flight software's MEKF allocates its matrices at every sample, which code on the "
+     r"GPU cannot \(device='cuda'\); use device='cpu'$"),
+    (lambda: Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), controller=lambda t, q, w, h: -w),
+     r"^controller: a Python function cannot run on the GPU \(device='cuda'\)"),
+    (lambda: FlexibleBody(INERTIA, [Mode(3.0, 0.02, [0.3, 0.5, 0.2])]),
+     r"^torque: a Python function cannot run on the GPU \(device='cuda'\)"),
+])
+def test_what_cannot_run_on_a_gpu_is_refused_naming_the_part(make, message):
+    # refused before anything is compiled or launched, with or without a GPU
+    model = make()
+    torque = (lambda t, q, w: -w) if isinstance(model, FlexibleBody) else None
+    with pytest.raises(tumble.ValidationError, match=message):
+        tumble.simulate(model, OMEGA0[0], t=T, method="rk4", dt=DT, torque=torque, device="cuda")
+
+
+def test_a_model_kind_without_a_device_path_is_refused_naming_device():
+    gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
+                        outer_gimbal=1e-3, imbalance=0.01)
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a GimbaledGyro: its compiled "
+                                                     r"model does not run on a GPU$"):
+        tumble.simulate(gyro, t=T, method="rk4", dt=DT, spin=100.0, theta0=1.0, device="cuda")
+
+
+def test_methods_without_a_device_kernel_are_refused():
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' runs the methods 'rk4', 'cf4'; "
+                                                     r"got method='splitting2'$"):
+        tumble.simulate(tumble.RigidBody(INERTIA), OMEGA0[0], t=T, method="splitting2", dt=DT, device="cuda")
+
+
+def _nvvm_available():
+    if config.ENABLE_CUDASIM:
+        return False
+    from numba.cuda.cudadrv import nvvm
+
+    return nvvm.is_available()
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "spacecraft: wheels, MRP feedback, rk4",
+                                  "spacecraft: wheels, sampled PD, cf4", "rigid, one body each, cf4"])
+def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
+    """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""
+    from numba import cuda, typeof
+    from numba.cuda import dispatcher
+
+    from tumble.integrate import _cuda
+
+    # numba.cuda compiles the @njit callees for the current device; without one, name its compute capability
+    if not hasattr(dispatcher, "get_current_device"):
+        pytest.skip("this numba.cuda does not look up the device where these tests expect")
+    monkeypatch.setattr(dispatcher, "get_current_device", lambda: SimpleNamespace(compute_capability=(9, 0)))
+    model, method, torque, state = cases()[name]
+    kernel = as_model(model).compile(torque, 0.0)
+    scheme = _cuda.SCHEMES[method]
+    n = _state_size(kernel)
+    work = tuple(np.zeros((2, *w.shape)) for w in _cuda._workspace_of_one(scheme, kernel, np.zeros(n)))
+    signature = tuple(typeof(a) for a in (scheme, kernel, np.zeros((2, n)), T, np.zeros(3, np.int64), T[1:],
+                                          np.zeros((4, 2, n)), work))
+    ptx, _ = cuda.compile_ptx(_cuda._protocol_kernel.py_func, signature, cc=(9, 0))
+    assert ptx.count(".entry") == 1
+    assert "fma.rn.f64" in ptx  # NVVM's contraction: the GPU's results differ from the CPU's in the last bits
+
+
+def _state_size(kernel):
+    from numba import njit
+
+    from tumble._protocol import state_size
+
+    return njit(lambda k: state_size(k))(kernel)
