@@ -67,7 +67,8 @@ from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
 from tumble.kernels import flexible as _kernel
 from tumble.simulate import Model, Outputs, StateField
-from tumble.trajectory import Extra, Trajectory, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Extra, Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

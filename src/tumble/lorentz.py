@@ -245,7 +245,7 @@ def demo_lorentz(out_dir: str | os.PathLike[str]) -> dict:
     """
     import os
 
-    from tumble.trajectory import write_atomic
+    from tumble._files import write_atomic
 
     if not os.path.isdir(out_dir):
         raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")

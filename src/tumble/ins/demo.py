@@ -31,7 +31,7 @@ from tumble.ins.increments import from_trajectory
 from tumble.ins.sensors import Imu, SensorErrors
 from tumble.ins.strapdown import ALGORITHMS, strapdown
 from tumble.simulate import simulate
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
 
 __all__ = ["CONING_RANGES", "DEMO_GYRO", "DEMO_GYRO_ERRORS", "demo_coning", "demo_gyroscope", "demo_ins"]
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from tumble.robot.chain import load
 from tumble.simulate import simulate
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
 
 __all__ = ["demo_robot"]
 

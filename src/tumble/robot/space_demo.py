@@ -34,7 +34,7 @@ from tumble.robot.link import Link
 from tumble.robot.space import space_manipulator
 from tumble.robot.tree import RobotTree
 from tumble.simulate import simulate
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
 
 __all__ = ["demo_space_arm", "space_arm", "reference"]
 

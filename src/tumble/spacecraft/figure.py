@@ -21,7 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import attitude
-from tumble.trajectory import Trajectory, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

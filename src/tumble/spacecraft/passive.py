@@ -54,7 +54,8 @@ from tumble.spacecraft import damper as _damper
 from tumble.spacecraft.model import Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.torques import GravityGradient
-from tumble.trajectory import Trajectory, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -10,7 +10,7 @@ import numpy as np
 
 from tumble import attitude
 from tumble._validate import ValidationError
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
 from tumble.variable import diver
 from tumble.variable.human import Human
 

@@ -29,7 +29,7 @@ from tumble._validate import ValidationError, require_positive
 from tumble.analysis import lyapunov_exponents, poincare_section
 from tumble.analytic import omega_at_energy, upward_vertical
 from tumble.torques import Gravity
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -19,7 +19,8 @@ from numpy.typing import ArrayLike
 from tumble._validate import ValidationError, require_positive
 from tumble.analytic._heavy_top import HeavyTop, axis_motion, measure_nutation
 from tumble.simulate import simulate
-from tumble.trajectory import Trajectory, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
