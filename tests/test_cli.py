@@ -309,7 +309,7 @@ def test_cli_does_not_import_back():
     # The demo table and the scenario package are read by the CLI; neither imports it (no cycle).
     kinds = ", ".join(f"tumble.scenario.{kind}" for kind in ("rigid", "spacecraft", "flexible", "slosh", "variable",
                                                              "human", "gyroscope", "robot"))
-    code = f"import sys, tumble._demos, tumble.scenario, {kinds}; print('tumble.cli' in sys.modules)"
+    code = f"import sys, tumble.viz.demos, tumble.scenario, {kinds}; print('tumble.cli' in sys.modules)"
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr

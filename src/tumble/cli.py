@@ -4,7 +4,7 @@
     tumble demo racket [-o racket.nc] [--plot racket.png] [--duration 20]
     tumble demo polhode [-o polhode.png]
     tumble demo top [-o DIRECTORY] [--duration 1.5]
-    tumble demo NAME [-o DIRECTORY]        (the demos of tumble._demos.DEMOS: diver, flexible, ...)
+    tumble demo NAME [-o DIRECTORY]        (the demos of tumble.viz.demos.DEMOS: diver, flexible, ...)
     tumble robot torques ROBOT_FILE --q ...
     tumble examples list | tumble examples copy DIRECTORY
     tumble sweep SCENARIO.toml -o out.zarr [--samples N] [--scheduler ADDR] [--workers N] [--plot out.png]
@@ -40,7 +40,7 @@ import tumble
 from tumble import examples as _examples
 from tumble import scenario as scenarios
 from tumble._cli_errors import exit_codes as _exit_codes
-from tumble._demos import DEMOS, Demo
+from tumble.viz.demos import DEMOS, Demo
 from tumble._files import check_distinct, check_output, write_atomic_all
 from tumble._validate import ValidationError, require_memory, require_positive
 from tumble.analysis import flip_times, intermediate_rate
@@ -251,7 +251,7 @@ def top(
 
 
 def _demo_command(demo: Demo) -> Callable[..., None]:
-    """The ``tumble demo NAME`` command of a row of :data:`tumble._demos.DEMOS`: call its function on the
+    """The ``tumble demo NAME`` command of a row of :data:`tumble.viz.demos.DEMOS`: call its function on the
     output directory, print its rows and the files it wrote."""
     module, function = demo.target.split(":")
 
