@@ -51,7 +51,7 @@ def test_an_edit_of_an_inlined_kernel_recompiles_its_callers_and_an_edit_of_the_
     assert edited.stdout.splitlines()[-1] == "[2.0, 0.0, 0.0]"
 
     # the CLI is no part of any compiled function: editing it loads everything from the cache
-    with open(root / "tumble" / "cli.py", "a") as cli:
+    with open(root / "tumble" / "cli" / "main.py", "a") as cli:
         cli.write("\n# an edit\n")
     unchanged = _run(root, cache)
     assert unchanged.stdout.splitlines()[-1] == "[2.0, 0.0, 0.0]"

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 import tumble
 from tumble import ValidationError, robot
-from tumble.robot.cli import app
+from tumble.cli.robot import app
 
 from helpers import read_by
 
