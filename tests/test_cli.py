@@ -221,7 +221,7 @@ def test_info_on_a_file_that_is_not_a_trajectory_exits_2(tmp_path):
 
 
 def test_demo_of_an_extension_writes_its_figure_and_prints_its_numbers(tmp_path):
-    from tumble.ins.demo import demo_coning
+    from tumble.viz.ins import demo_coning
 
     result = invoke("demo", "coning", "-o", tmp_path)
     assert result.exit_code == 0, result.output

@@ -17,6 +17,14 @@ MOVED = [
     ("tumble.spacecraft.passive", "demo_gravity_gradient", "tumble.viz.passive"),
     ("tumble.spacecraft.passive", "explorer1_figure", "tumble.viz.passive"),
     ("tumble.spacecraft.budget", "demo_budget", "tumble.viz.budget"),
+    ("tumble.ins", "allan_figure", "tumble.viz.ins"),
+    ("tumble.ins", "demo_ins", "tumble.viz.ins"),
+    ("tumble.ins.allan", "allan_figure", "tumble.viz.ins"),
+    ("tumble.ins.demo", "demo_coning", "tumble.viz.ins"),
+    ("tumble.ins.demo", "DEMO_GYRO", "tumble.viz.ins"),
+    ("tumble.ins.demo", "CONING_RANGES", "tumble.ins.coning"),
+    ("tumble.robot.cli", "app", "tumble.cli.robot"),
+    ("tumble._cli_errors", "exit_codes", "tumble.cli.errors"),
 ]
 
 
@@ -33,7 +41,7 @@ def test_an_unknown_name_is_still_an_attribute_error():
 
 
 MODEL_MODULES = ["flexible.py", "slosh.py", "lorentz.py", "spacecraft/passive.py", "spacecraft/budget.py",
-                 "spacecraft/__init__.py", "spacecraft/figure.py"]
+                 "spacecraft/__init__.py", "spacecraft/figure.py", "ins/allan.py", "ins/__init__.py"]
 
 
 @pytest.mark.parametrize("path", MODEL_MODULES)

@@ -111,7 +111,8 @@ def demo_estimation(out_dir: str | os.PathLike[str], *, runs: int = 40, duration
     paths written."""
     from matplotlib.figure import Figure
 
-    from tumble.ins.demo import _check_dir, _save
+    from tumble.viz._output import out_directory as _check_dir
+    from tumble.viz._output import save_png as _save
 
     out_dir = _check_dir(out_dir)
     traj = monte_carlo(runs, duration=duration, seed=seed)

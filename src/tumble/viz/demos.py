@@ -92,7 +92,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "gyro": Demo(
-        "tumble.ins.demo:demo_gyroscope",
+        "tumble.viz.ins:demo_gyroscope",
         """A mechanical gyroscope: precession under a torque, nutation, and drift from imbalance and friction.
 
         A rotor on a pivot simulated with Euler's equations (docs/ins.md): precession rate
@@ -110,7 +110,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "coning": Demo(
-        "tumble.ins.demo:demo_coning",
+        "tumble.viz.ins:demo_coning",
         """The classic coning test of strapdown attitude algorithms (alpha = 0.01 rad, Omega = 2 pi rad/s).
 
         Drift rate about the cone axis of the uncompensated, one-, two- and three-sample
@@ -122,7 +122,7 @@ DEMOS: dict[str, Demo] = {
                    for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
     ),
     "ins": Demo(
-        "tumble.ins.demo:demo_ins",
+        "tumble.viz.ins:demo_ins",
         """End to end: a tumbling body, a gyro with errors, strapdown integration, attitude error.
 
         The exact torque-free motion is sampled by a 200 Hz gyro (error-free, angle random walk only,
