@@ -24,6 +24,9 @@ MOVED = [
     ("tumble.ins.demo", "DEMO_GYRO", "tumble.viz.ins"),
     ("tumble.ins.demo", "CONING_RANGES", "tumble.ins.coning"),
     ("tumble.robot.cli", "app", "tumble.cli.robot"),
+    ("tumble.robot.demo", "demo_robot", "tumble.viz.robot"),
+    ("tumble.robot.space_demo", "space_arm", "tumble.viz.space_arm"),
+    ("tumble.variable.demo", "figure_dive", "tumble.viz.diver"),
     ("tumble._cli_errors", "exit_codes", "tumble.cli.errors"),
 ]
 

@@ -36,7 +36,7 @@ class Demo:
 
 DEMOS: dict[str, Demo] = {
     "diver": Demo(
-        "tumble.variable.demo:demo_diver",
+        "tumble.viz.diver:demo_diver",
         """A diver's twisting somersaults: a segment model (de Leva 1996) whose arms move in flight.
 
         Runs the three experiments of docs/diver.md: (a) a layout somersault that acquires twist
@@ -227,7 +227,7 @@ DEMOS: dict[str, Demo] = {
                    for name, value in s["largest_exponent"].items()],
     ),
     "space-arm": Demo(
-        "tumble.robot.space_demo:demo_space_arm",
+        "tumble.viz.space_arm:demo_space_arm",
         """A two-link arm on a free-floating hub swings through a commanded manoeuvre, and the hub turns.
 
         The hub (100 kg) is the floating base of the arm (no gravity, no external force); a PD law drives
