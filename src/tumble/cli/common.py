@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import typer
@@ -14,6 +15,9 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 
 from tumble._files import check_distinct, check_output
 from tumble.trajectory import Trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["check_outputs", "png", "print_rows", "progress_bar", "stderr", "summary", "text", "written"]
 
@@ -45,7 +49,7 @@ def progress_bar(description: str, *, enabled: bool,
         yield lambda done, total, what=description: bar.update(task, completed=done, total=total, description=what)
 
 
-def png(figure, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:
+def png(figure: Figure, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:
     """The write of ``figure`` as a PNG file at ``path`` for :func:`~tumble._files.write_atomic_all`; none
     without a path."""
     return [] if path is None else [(path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))]

@@ -40,7 +40,7 @@ _BAD_INPUT = (RecursionError, OverflowError, UnicodeDecodeError, ZeroDivisionErr
 
 
 @contextmanager
-def exit_codes(*inputs) -> Iterator[None]:
+def exit_codes(*inputs: str | os.PathLike[str]) -> Iterator[None]:
     """Run a command's body: every error exits with code 2 and a bug with 1, each as ``error:`` lines on
     stderr; ``inputs`` (paths) name the file a reader's own exception came from."""
     source = f"{os.fspath(inputs[0])}: " if inputs else ""

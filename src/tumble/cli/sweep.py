@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -12,6 +12,9 @@ from tumble._files import write_atomic_all
 from tumble._validate import ValidationError
 from tumble.cli.common import check_outputs, png, print_rows, progress_bar, written
 from tumble.cli.errors import exit_codes
+
+if TYPE_CHECKING:
+    import xarray
 
 __all__ = ["info_store", "sweep_command"]
 
@@ -72,7 +75,7 @@ def sweep_command(
                  ("wrote", written(output, plot))])
 
 
-def sweep_rows(ds) -> list[tuple[str, str]]:
+def sweep_rows(ds: xarray.Dataset) -> list[tuple[str, str]]:
     """Rows: samples and chunks, and each scalar outcome's percentiles."""
     settings = ds.attrs["tumble_sweep"]
     done = int(ds["done"].sum())

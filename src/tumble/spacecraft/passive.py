@@ -153,7 +153,7 @@ class GravityGradientStability(NamedTuple):
     roll_yaw_frequencies: np.ndarray
 
 
-def roll_yaw_conditions(kr, ky):
+def roll_yaw_conditions(kr: np.ndarray, ky: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The roll/yaw stability conditions on arrays of (k_R, k_Y): (b, c, stable) of s⁴ + b s² + c."""
     b = 1.0 + 3.0 * kr + kr * ky
     c = 4.0 * kr * ky
