@@ -49,10 +49,13 @@ def progress_bar(description: str, *, enabled: bool,
         yield lambda done, total, what=description: bar.update(task, completed=done, total=total, description=what)
 
 
-def png(figure: Figure, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:
+def png(figure: Figure | None, path: Path | None) -> list[tuple[Path, Callable[[str], None]]]:
     """The write of ``figure`` as a PNG file at ``path`` for :func:`~tumble._files.write_atomic_all`; none
-    without a path."""
-    return [] if path is None else [(path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))]
+    without a path (the figure is then not drawn: None)."""
+    if path is None:
+        return []
+    assert figure is not None, "a figure is drawn for every path asked"
+    return [(path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))]
 
 
 def text(text: str) -> Callable[[str], None]:

@@ -39,7 +39,7 @@ stability only, lost to dissipation.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -153,8 +153,8 @@ class GravityGradientStability(NamedTuple):
     roll_yaw_frequencies: np.ndarray
 
 
-def roll_yaw_conditions(kr: np.ndarray, ky: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The roll/yaw stability conditions on arrays of (k_R, k_Y): (b, c, stable) of s⁴ + b s² + c."""
+def roll_yaw_conditions(kr: np.ndarray | np.floating, ky: np.ndarray | np.floating) -> tuple[Any, Any, Any]:
+    """The roll/yaw stability conditions on (arrays of) (k_R, k_Y): (b, c, stable) of s⁴ + b s² + c, of their shape."""
     b = 1.0 + 3.0 * kr + kr * ky
     c = 4.0 * kr * ky
     with np.errstate(invalid="ignore"):
