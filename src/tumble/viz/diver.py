@@ -9,10 +9,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tumble import attitude
-from tumble._validate import ValidationError
 from tumble._files import write_atomic
 from tumble.variable import diver
 from tumble.variable.human import Human
+from tumble.viz._output import out_directory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -39,8 +39,7 @@ def demo_diver(out_dir: str | os.PathLike[str]) -> dict:
     of (c), the rule-of-thumb comparison of (b), and the paths written.
     ``out_dir`` must be an existing directory.
     """
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     human = Human.de_leva()
     twisting = diver.twisting_somersault(human)
     sweep = diver.twist_rule_sweep(np.radians(RULE_TILTS_DEG), human)

@@ -15,9 +15,9 @@ import numpy as np
 
 import tumble
 from tumble._files import write_atomic
-from tumble._validate import ValidationError
 from tumble.flexible import DEMO_BODY, slew_angle, slew_torque
 from tumble.trajectory import Trajectory
+from tumble.viz._output import out_directory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -42,8 +42,7 @@ def demo_flexible(out_dir: str | os.PathLike[str]) -> dict:
     the manoeuvre, the final pointing error of the rigid body (arcsec), the largest total
     angular momentum left after the manoeuvre (N·m·s) and the paths written.
     """
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     fbody = DEMO_BODY
     T = _DEMO_SLEW["duration"]
     torque = slew_torque([0.0, 0.0, 1.0], inertia=fbody.body.inertia[2, 2], **_DEMO_SLEW)

@@ -14,9 +14,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble._files import write_atomic
-from tumble._validate import ValidationError
 from tumble.limits import SPEED_OF_LIGHT
 from tumble.lorentz import SpinningMatter
+from tumble.viz._output import out_directory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -55,8 +55,7 @@ def demo_lorentz(out_dir: str | os.PathLike[str]) -> dict:
     moment of inertia (and angular momentum) and of the kinetic energy (:meth:`tumble.lorentz.SpinningMatter.corrections`),
     and the path written.
     """
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     star = NEUTRON_STAR
     omega = 2.0 * math.pi / star["period"]
     summary: dict[str, Any] = {"omega": omega, "rim_speed": omega * star["radius"] / SPEED_OF_LIGHT}

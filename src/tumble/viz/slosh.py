@@ -14,9 +14,9 @@ import numpy as np
 
 import tumble
 from tumble._files import write_atomic
-from tumble._validate import ValidationError
 from tumble.slosh import DEMO_BODY, flat_spin_energy, growth_time_constant, nutation_angle, steady_spin_eigenvalues
 from tumble.trajectory import Trajectory
+from tumble.viz._output import out_directory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -41,8 +41,7 @@ def demo_slosh(out_dir: str | os.PathLike[str]) -> dict:
     sample, the final energy and the flat-spin energy it tends to (:func:`~tumble.slosh.flat_spin_energy`, J),
     and the paths written.
     """
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     sbody = DEMO_BODY
     t = np.linspace(0.0, _DEMO_DURATION, int(4 * _DEMO_DURATION) + 1)
     trajectory = tumble.simulate(sbody, [_DEMO_WOBBLE, 0.0, _DEMO_SPIN], t=t, direction0=[1.0, 0.0, 0.0],

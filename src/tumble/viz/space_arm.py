@@ -27,7 +27,6 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble._validate import ValidationError
 from tumble.body import RigidBody
 from tumble.robot.chain import SerialChain
 from tumble.robot.link import Link
@@ -35,6 +34,7 @@ from tumble.robot.space import space_manipulator
 from tumble.robot.tree import RobotTree
 from tumble.simulate import simulate
 from tumble._files import write_atomic
+from tumble.viz._output import out_directory
 
 __all__ = ["demo_space_arm", "space_arm", "reference"]
 
@@ -85,8 +85,7 @@ def demo_space_arm(out_dir: str | os.PathLike[str]) -> dict:
     error (rad), the largest total angular (N m s) and linear (N s) momentum, the steps taken and the
     paths written.
     """
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     t = np.linspace(0.0, DURATION, _SAMPLES)
     run = simulate(space_arm(), q0=[0.0, 0.0], t=t, torque=_law, method="dop853", rtol=_TOLERANCE,
                    atol=_TOLERANCE)
