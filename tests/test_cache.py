@@ -51,7 +51,7 @@ def test_an_edit_of_an_inlined_kernel_recompiles_its_callers_and_an_edit_of_the_
     assert edited.stdout.splitlines()[-1] == "[2.0, 0.0, 0.0]"
 
     # the CLI is no part of any compiled function: editing it loads everything from the cache
-    with open(root / "tumble" / "cli.py", "a") as cli:
+    with open(root / "tumble" / "cli" / "main.py", "a") as cli:
         cli.write("\n# an edit\n")
     unchanged = _run(root, cache)
     assert unchanged.stdout.splitlines()[-1] == "[2.0, 0.0, 0.0]"
@@ -121,6 +121,8 @@ def test_the_layers_left_out_of_the_key_compile_nothing_and_no_compiled_module_i
     for path in covered:
         reached = {name for name in _module_level_imports(path)
                    if any(name == module or name.startswith(module + ".") for module in left_out_modules)}
+        if path == SRC / "__init__.py":  # `import tumble` fills Trajectory's table of views (Python functions only)
+            reached -= {"tumble.viz", "tumble.viz.trajectory"}
         assert not reached, f"{path.relative_to(SRC)} imports {reached}: they must be in the key"
 
 

@@ -221,7 +221,7 @@ def test_info_on_a_file_that_is_not_a_trajectory_exits_2(tmp_path):
 
 
 def test_demo_of_an_extension_writes_its_figure_and_prints_its_numbers(tmp_path):
-    from tumble.ins.demo import demo_coning
+    from tumble.viz.ins import demo_coning
 
     result = invoke("demo", "coning", "-o", tmp_path)
     assert result.exit_code == 0, result.output
@@ -309,7 +309,7 @@ def test_cli_does_not_import_back():
     # The demo table and the scenario package are read by the CLI; neither imports it (no cycle).
     kinds = ", ".join(f"tumble.scenario.{kind}" for kind in ("rigid", "spacecraft", "flexible", "slosh", "variable",
                                                              "human", "gyroscope", "robot"))
-    code = f"import sys, tumble._demos, tumble.scenario, {kinds}; print('tumble.cli' in sys.modules)"
+    code = f"import sys, tumble.viz.demos, tumble.scenario, {kinds}; print('tumble.cli' in sys.modules)"
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env)
     assert done.returncode == 0, done.stderr

@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 import tumble
 from tumble import attitude
 from tumble.variable import diver
-from tumble.variable.demo import demo_diver
+from tumble.viz.diver import demo_diver
 from tumble.variable.human import DE_LEVA_MALE, Human, Motion
 
 HUMAN = Human.de_leva()

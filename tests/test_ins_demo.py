@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from tumble.ins import demo_coning, demo_gyroscope, demo_ins
+from tumble.viz.ins import demo_coning, demo_gyroscope, demo_ins
 from tumble._validate import ValidationError
 
 

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble.ins import (FLICKER_FACTOR, Coning, Imu, Increments, SensorErrors, allan_deviation, allan_figure,
+from tumble.ins import (FLICKER_FACTOR, Coning, Imu, Increments, SensorErrors, allan_deviation,
                         from_trajectory, gauss_markov_adev)
+from tumble.viz.ins import allan_figure
 from tumble._validate import ValidationError
 
 # Recovery of N and B from the Allan deviation of a simulated gyro (issue: 10 %).

@@ -10,7 +10,7 @@ import tumble
 from tumble import attitude
 from tumble.ins import (ALGORITHMS, Coning, Increments, drift_law, from_trajectory, measure_drift, read_csv,
                         strapdown, write_csv)
-from tumble.ins.demo import CONING_RANGES
+from tumble.ins.coning import CONING_RANGES
 from tumble._validate import ValidationError
 
 EXAMPLE_CSV = tumble.examples.directory() / "ins" / "coning_gyro.csv"

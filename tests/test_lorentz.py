@@ -128,7 +128,7 @@ def test_the_warning_states_the_size_of_the_neglected_correction():
 
 
 def test_neutron_star_demo(tmp_path):
-    from tumble.lorentz import NEUTRON_STAR, demo_lorentz
+    from tumble.viz.lorentz import NEUTRON_STAR, demo_lorentz
 
     summary = demo_lorentz(tmp_path)
     omega = 2.0 * math.pi / 1.4e-3

@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 import tumble
 from tumble import ValidationError, robot
-from tumble.robot.cli import app
+from tumble.cli.robot import app
 
 from helpers import read_by
 
@@ -221,7 +221,7 @@ def test_gravity_is_the_chains(puma):
 @pytest.mark.slow  # compiles dop853 for the chain model (shared with the power-balance test)
 def test_demo_writes_its_files_and_keeps_the_energy(tmp_path):
     """The Panda falling for 2 s: energy E ≈ 94 J kept to a measured 6e-12 J (tolerance 1e-10 J, see above)."""
-    from tumble.robot.demo import demo_robot
+    from tumble.viz.robot import demo_robot
 
     summary = demo_robot(tmp_path, tumble.examples.directory() / "robots" / "panda.urdf")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["robot_fall.nc", "robot_fall.png"]

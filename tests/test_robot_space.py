@@ -99,7 +99,7 @@ def test_space_manipulator_matches_the_planar_lagrangian_and_keeps_its_momentum(
 def test_space_arm_demo_turns_the_hub_as_zero_momentum_requires(tmp_path):
     from scipy.interpolate import CubicHermiteSpline
 
-    from tumble.robot import space_demo as demo
+    from tumble.viz import space_arm as demo
 
     summary = demo.demo_space_arm(tmp_path)
     run = tumble.load(tmp_path / "space_arm.nc")

@@ -296,7 +296,7 @@ def test_the_cli_prints_the_torque_about_a_huge_axis(tmp_path):
     """``tumble robot torques`` on ``<axis xyz="1e200 1e200 0">``: the torque about (1, 1, 0)/√2, not 0."""
     from typer.testing import CliRunner
 
-    from tumble.robot.cli import app
+    from tumble.cli.robot import app
 
     body = link("base") + link("a", 1.0, xyz="0.3 0 0.2") + joint("j1", "base", "a", axis="{axis}")
     taus = []

@@ -179,7 +179,7 @@ def test_the_cli_repairs_tiago_on_request_and_says_so():
     ``--inertia clip``: one ``warning:`` line per repair message on stderr, the torques on stdout."""
     from typer.testing import CliRunner
 
-    from tumble.robot.cli import app
+    from tumble.cli.robot import app
 
     path = str(ERD / "tiago_description/robots/tiago_no_hand.urdf")
     with pytest.warns(UrdfRepairWarning):

@@ -16,7 +16,7 @@ from tumble import flexible, robot, slosh
 from tumble.body import RigidBody
 from tumble.cli import app
 from tumble.ins import GimbaledGyro
-from tumble.ins.demo import DEMO_GYRO
+from tumble.viz.ins import DEMO_GYRO
 from tumble.scenario import ScenarioError, load, parse
 from tumble.variable import Human, Motion, VariableBody, diver
 

@@ -11,6 +11,7 @@ import tumble
 from tumble import attitude, slosh, torques
 from tumble._validate import ValidationError
 from tumble.slosh import Pendulum, SloshBody
+from tumble.viz.slosh import demo_slosh
 
 from helpers import read_by
 
@@ -175,7 +176,7 @@ def test_documented_example_runs():
 
 
 def test_demo_nutation_grows_while_momentum_stays_and_energy_falls(tmp_path):
-    summary = slosh.demo_slosh(tmp_path)
+    summary = demo_slosh(tmp_path)
     traj = tumble.load(summary["nc"])
     assert traj.extras["pendulum_direction"].data.shape == (traj.t.size, 3)
     assert (tmp_path / "slosh.png").stat().st_size > 0

@@ -10,8 +10,9 @@ import pytest
 from typer.testing import CliRunner
 
 from tumble.cli import app
-from tumble.spacecraft.budget import (DEMO_EPOCH, SOURCES, SmallSat, demo_budget, demo_orbit, eclipse_fraction,
-                                      momentum_budget, smad_estimates)
+from tumble.spacecraft.budget import (DEMO_EPOCH, SOURCES, SmallSat, demo_orbit, eclipse_fraction, momentum_budget,
+                                      smad_estimates)
+from tumble.viz.budget import demo_budget
 from tumble.spacecraft.environment_table import Environment
 from tumble.spacecraft.orbit import Orbit
 

@@ -18,7 +18,7 @@ import tumble
 from tumble import ValidationError
 from tumble.spacecraft import (ConstantTorque, FlightSoftware, QuaternionPD, ReactionWheel, Sampling, Spacecraft,
                               pyramid_wheels)
-from tumble.spacecraft import estimation_demo as demo
+from tumble.viz import estimation as demo
 
 PERFECT = FlightSoftware(gyro_arw=1e-5, gyro_rrw=1e-8, star_tracker_sigma=5e-5, delay=0, sensor_noise=False)
 #: Measured: 2.2e-16 in q, 4.4e-17 rad/s in ω over 40 s (the estimate equals the truth to round-off).
@@ -56,7 +56,7 @@ def test_knowledge_error_stays_inside_three_sigma(monte_carlo):
 
 
 def test_control_error_is_the_loops_response_to_the_estimators_errors(monte_carlo):
-    """In fine pointing the closed loop is linear (:func:`~tumble.spacecraft.estimation_demo.loop_response`):
+    """In fine pointing the closed loop is linear (:func:`~tumble.viz.estimation.loop_response`):
     driven from t = 100 s by the recorded knowledge error and rate error ω̂ − ω, its response reproduces the
     simulated control error: measured relative RMS difference 3.2e-5 (the neglected terms are second order).
     The control error is thus the estimator's errors through the loop, and its spectrum theirs shaped by the
@@ -298,10 +298,10 @@ def test_a_step_that_misses_a_sensors_clock_is_refused():
 
 
 def test_a_sweep_over_noise_seeds_and_gyro_biases_is_the_runs_it_stands_for():
-    """``tumble.sweep`` with an integer seed dispersion (:class:`~tumble.sweep.NoiseSeed`) and a vector bias
-    dispersion (:class:`~tumble.sweep.Normal` of shape (3,)): each of its 8 samples equals the direct
+    """``tumble.sweep`` with an integer seed dispersion (:class:`~tumble.sweeps.NoiseSeed`) and a vector bias
+    dispersion (:class:`~tumble.sweeps.Normal` of shape (3,)): each of its 8 samples equals the direct
     :func:`tumble.simulate` of the seed and bias it drew, bit for bit."""
-    from tumble.sweep import NoiseSeed, Normal
+    from tumble.sweeps import NoiseSeed, Normal
 
     t = _times(20.0)
     ds = tumble.sweep(demo.spacecraft(), {"sensor_seed0": NoiseSeed(), "gyro_bias0": Normal(np.zeros(3), 1e-5)},

@@ -8,6 +8,7 @@ import pytest
 import tumble
 from tumble.scenario import load_scenario
 from tumble.spacecraft import passive
+from tumble.viz.passive import gravity_gradient_stability_figure
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.torques import GravityGradient
 
@@ -133,7 +134,7 @@ def test_gravity_gradient_stability_refuses_non_principal_axes():
 
 
 def test_stability_figure_places_the_spacecraft():
-    fig = passive.gravity_gradient_stability_figure(LAGRANGE)
+    fig = gravity_gradient_stability_figure(LAGRANGE)
     (star,) = [line for line in fig.axes[0].lines if line.get_marker() == "*"]
     assert (star.get_xdata()[0], star.get_ydata()[0]) == (2 / 3, 0.5)
     assert "Lagrange" in star.get_label()

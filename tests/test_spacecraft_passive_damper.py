@@ -11,6 +11,7 @@ from tumble.scenario import ScenarioError, load_scenario, parse_scenario
 from tumble.spacecraft import Spacecraft
 from tumble.spacecraft import damper as d
 from tumble.spacecraft import passive
+from tumble.viz.passive import demo_explorer1
 
 # A scaled Explorer 1: prolate hub (spin axis z the minor axis), damper 2 % of
 # the transverse moment, tuned for the spin (time constant 87 s instead of
@@ -204,7 +205,7 @@ atol = 1e-12
 @pytest.mark.slow
 def test_demo_explorer1_writes_its_files_and_numbers(tmp_path):
     """The demo on the first 900 s of the Explorer 1 run (the nutation still growing: 0.5° → 4.5°)."""
-    summary = passive.demo_explorer1(tmp_path, passive.Explorer1(duration=900.0))
+    summary = demo_explorer1(tmp_path, passive.Explorer1(duration=900.0))
     assert (tmp_path / "explorer1.png").stat().st_size > 0
     traj = tumble.load(tmp_path / "explorer1.nc")
     assert traj.extras["damper_omega"].data.shape == (1801, 3)
@@ -213,4 +214,4 @@ def test_demo_explorer1_writes_its_files_and_numbers(tmp_path):
     assert summary["momentum_drift"] < 1e-10  # measured 1.7e-12 (1e5 steps at rtol 1e-12)
     assert summary["max_energy_increase"] < 0.0
     with pytest.raises(tumble.ValidationError, match="out_dir"):
-        passive.demo_explorer1(tmp_path / "missing")
+        demo_explorer1(tmp_path / "missing")

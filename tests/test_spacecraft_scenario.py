@@ -13,7 +13,7 @@ from tumble.body import RigidBody
 from tumble.scenario import ScenarioError, load, parse, run_scenario
 from tumble.spacecraft import (CMGCluster, MRPFeedback, QuaternionPD, ReactionWheel, Spacecraft, SphericalDamper,
                                WheelTorques, pyramid_wheels)
-from tumble.spacecraft.figure import spacecraft_figure
+from tumble.viz.spacecraft import spacecraft_figure
 
 from helpers import assert_same_run
 

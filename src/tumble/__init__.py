@@ -28,6 +28,7 @@ from tumble.integrate import SolverError  # noqa: E402
 from tumble.limits import RigidityWarning  # noqa: E402
 from tumble.simulate import Model, as_model, simulate  # noqa: E402
 from tumble.trajectory import Trajectory, load  # noqa: E402
+from tumble.viz import trajectory as _views  # noqa: E402, F401 - fills Trajectory's figure, page and tables
 
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:

@@ -52,26 +52,23 @@ right-hand side: :mod:`tumble.kernels.flexible`); the trajectory's totals are
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-import tumble
 from tumble import attitude, dynamics, torques
+from tumble._moved import moved
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.body import RigidBody
 from tumble.kernels import flexible as _kernel
 from tumble.simulate import Model, Outputs, StateField
-from tumble.trajectory import Extra, Trajectory, write_atomic
+from tumble.trajectory import Extra, Trajectory
 
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+__all__ = ["Mode", "FlexibleBody", "energy", "momentum_body", "slew_torque"]
 
-__all__ = ["Mode", "FlexibleBody", "energy", "momentum_body", "slew_torque", "demo_flexible"]
+__getattr__ = moved(__name__, {"demo_flexible": "tumble.viz.flexible", "slew_figure": "tumble.viz.flexible"})
 
 
 @dataclass(frozen=True)
@@ -289,18 +286,12 @@ def slew_torque(axis: ArrayLike, angle: float, *, duration: float, inertia: floa
     return torques.Tabulated(start + knots, np.outer(shape * peak, axis / norm))
 
 
-# --- demonstration -------------------------------------------------------------
-
 #: The demo spacecraft: 3000 kg·m² about the slew axis z, a solar array with two modes about z.
 DEMO_BODY = FlexibleBody(
     body=RigidBody(np.diag([2000.0, 1500.0, 3000.0])),
     modes=(Mode(frequency=2 * math.pi * 0.2, damping=0.003, participation=np.array([0.0, 0.0, 25.0])),
            Mode(frequency=2 * math.pi * 1.1, damping=0.005, participation=np.array([0.0, 0.0, 8.0]))),
 )
-_DEMO_SLEW = dict(angle=math.radians(30.0), duration=40.0, ramp=0.4)  # rad, s, s
-_DEMO_SETTLE = 60.0  # s simulated after the manoeuvre
-_DEMO_TOLERANCE = 1e-11  # rtol = atol of the demo runs
-_ARCSEC = math.radians(1.0 / 3600.0)
 
 
 def slew_angle(q: np.ndarray) -> np.ndarray:
@@ -308,75 +299,3 @@ def slew_angle(q: np.ndarray) -> np.ndarray:
     return 2.0 * np.arctan2(q[..., 3], q[..., 0])
 
 
-def demo_flexible(out_dir: str | os.PathLike[str]) -> dict:
-    """A 30° rest-to-rest slew of :data:`DEMO_BODY` (40 s, bang-bang with 0.4 s ramps), flexible vs rigid.
-
-    Integrates with dop853 (rtol = atol = 1e-11) through the manoeuvre and 60 s after it,
-    writes ``out_dir/flexible.nc`` (the flexible trajectory with its modal coordinates) and
-    ``out_dir/flexible.png`` (:func:`slew_figure`) and ``out_dir/flexible.html`` (the offline viewer,
-    :mod:`tumble.viewer`) atomically and returns a summary: the peak
-    torque (N·m), the residual modal amplitudes after the manoeuvre (kg^½·m), the pointing
-    jitter (peak and RMS, arcsec) and rate jitter (peak, arcsec/s) of the flexible hub after
-    the manoeuvre, the final pointing error of the rigid body (arcsec), the largest total
-    angular momentum left after the manoeuvre (N·m·s) and the paths written.
-    """
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
-    fbody = DEMO_BODY
-    T = _DEMO_SLEW["duration"]
-    torque = slew_torque([0.0, 0.0, 1.0], inertia=fbody.body.inertia[2, 2], **_DEMO_SLEW)
-    t = np.linspace(0.0, T + _DEMO_SETTLE, int(20 * (T + _DEMO_SETTLE)) + 1)
-    flexible = tumble.simulate(fbody, np.zeros(3), t=t, torque=torque, method="dop853", rtol=_DEMO_TOLERANCE,
-                               atol=_DEMO_TOLERANCE)
-    rigid = tumble.simulate(fbody.body, np.zeros(3), t=t, torque=torque, method="dop853", rtol=_DEMO_TOLERANCE,
-                            atol=_DEMO_TOLERANCE)
-    assert flexible.q is not None and flexible.omega is not None and rigid.q is not None  # both have an attitude
-
-    after = t >= T
-    error = (slew_angle(flexible.q) - _DEMO_SLEW["angle"])[after] / _ARCSEC
-    eta = flexible.modal_coordinate[after]
-    summary = {
-        "peak_torque": float(np.abs(torque.torque).max()),
-        "residual_modal_amplitude": np.abs(eta).max(axis=0).tolist(),
-        "jitter_peak_arcsec": float(np.abs(error).max()),
-        "jitter_rms_arcsec": float(np.sqrt(np.mean((error - error.mean()) ** 2))),
-        "rate_jitter_peak_arcsec_per_s": float(np.abs(flexible.omega[after, 2]).max() / _ARCSEC),
-        "rigid_pointing_error_arcsec": float(abs(slew_angle(rigid.q[-1]) - _DEMO_SLEW["angle"]) / _ARCSEC),
-        "residual_momentum": float(np.linalg.norm(flexible.momentum_body[after], axis=-1).max()),
-    }
-    figure = slew_figure(flexible, rigid, T, _DEMO_SLEW["angle"])
-    nc_path, png_path = os.path.join(out_dir, "flexible.nc"), os.path.join(out_dir, "flexible.png")
-    html_path = os.path.join(out_dir, "flexible.html")
-    flexible.save(nc_path)
-    write_atomic(png_path, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120))
-    flexible.to_html(html_path, model=fbody)
-    return {**summary, "nc": nc_path, "png": png_path, "html": html_path}
-
-
-def slew_figure(flexible: Trajectory, rigid: Trajectory, end: float, target: float) -> Figure:
-    """Four panels: slew angle and rate (flexible vs rigid), modal coordinates, and the pointing error
-    from the ``target`` angle (rad) after the manoeuvre ends at ``end`` (s)."""
-    from matplotlib.figure import Figure
-
-    assert flexible.q is not None and flexible.omega is not None, "the flexible hub's trajectory has an attitude"
-    assert rigid.q is not None and rigid.omega is not None, "the rigid body's trajectory has an attitude"
-    fig = Figure(figsize=(10, 7), layout="constrained")
-    (a, b), (c, d) = fig.subplots(2, 2)
-    t = flexible.t
-    a.plot(t, np.degrees(slew_angle(rigid.q)), "k--", label="rigid")
-    a.plot(t, np.degrees(slew_angle(flexible.q)), label="flexible hub")
-    a.set(xlabel="t (s)", ylabel="angle about z (deg)", title="(a) slew angle")
-    b.plot(t, np.degrees(rigid.omega[:, 2]), "k--", label="rigid")
-    b.plot(t, np.degrees(flexible.omega[:, 2]), label="flexible hub")
-    b.set(xlabel="t (s)", ylabel="ω_z (deg/s)", title="(b) body rate")
-    eta = flexible.modal_coordinate
-    for k in range(eta.shape[1]):
-        c.plot(t, eta[:, k], label=f"mode {k + 1}")
-    c.set(xlabel="t (s)", ylabel="η (kg^½ m)", title="(c) modal coordinates")
-    after = t >= end
-    d.plot(t[after], (slew_angle(flexible.q[after]) - target) / _ARCSEC)
-    d.set(xlabel="t (s)", ylabel="pointing error (arcsec)", title="(d) jitter after the manoeuvre")
-    for ax in (a, b, c):
-        ax.axvline(end, color="0.6", lw=0.8)
-        ax.legend()
-    return fig

@@ -26,23 +26,25 @@ has ``q``, ``omega`` and ``inertia`` set to ``None``. Without totals the
 invariants are those of a rigid body (kinetic energy ``T = ½ ω·Iω``, angular
 momentum ``L = I ω``), derived on demand with :mod:`tumble.dynamics`. A
 trajectory converts to an :class:`xarray.Dataset`, saves to NetCDF-4
-atomically and plots with matplotlib's object-oriented API. The layout is
-described in ``docs/trajectory.md``.
+atomically and reads back validated (:func:`load`). Its figure, viewer page,
+notebook view and table are drawn by :mod:`tumble.viz.trajectory`. The layout
+is described in ``docs/trajectory.md``.
 """
 
 from __future__ import annotations
 
-import datetime
 import operator
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import TYPE_CHECKING, Any, Final, NamedTuple, cast
+from typing import TYPE_CHECKING, Any, NamedTuple, cast
 
 import numpy as np
 
+from . import _netcdf
 from ._files import require_regular, write_atomic
+from ._netcdf import CONVENTIONS, UNIT_Q_TOL
 from ._validate import ValidationError, as_array
 from .attitude import rotate
 from .dynamics import angular_momentum, kinetic_energy
@@ -52,22 +54,14 @@ if TYPE_CHECKING:
     import xarray
     from matplotlib.figure import Figure
 
-__all__ = ["Extra", "Trajectory", "load", "write_atomic"]
+__all__ = ["CONVENTIONS", "UNIT_Q_TOL", "VIEWS", "Extra", "Trajectory", "load", "write_atomic"]
 
-CONVENTIONS = (
-    "quaternion: Hamilton, scalar-first [w,x,y,z], body->inertial; omega in body axes; SI units"
-)
-_ENGINE: Final = "h5netcdf"  # NetCDF-4 (HDF5) reader and writer used by save() and load()
-_INFO_PREFIX = "solver_"  # global attributes of the NetCDF file that hold Trajectory.info
-_EXTRA_ATTR = "tumble_extra"  # variable attribute that marks a Trajectory.extras entry in a dataset
-_TOTAL_ATTR = "tumble_total"  # variable attribute that marks a model's total (energy, momentum_body)
 _TOTALS = {"energy": 0, "momentum_body": 1}  # the totals a model may give, and their trailing axes
-_AXES = ["x", "y", "z"]
-_COMPONENTS = ["w", "x", "y", "z"]
-# Panel (b) of plot() shows |drift| on a symlog scale, linear below this value
-# (under float64's rounding, 2.2e-16) and logarithmic above: exact zeros stay
-# on the plot and every drift above rounding gets its own decade.
-_DRIFT_LINTHRESH = 1e-16
+#: The views of a trajectory drawn above the result type, by name: ``plot``, ``to_html``, ``notebook_html`` and
+#: ``to_dataframe``, the functions of :mod:`tumble.viz.trajectory`, which fills this table when ``import tumble``
+#: loads it. The methods of the same names read it, so that this module imports nothing above it (no figure, no
+#: viewer, no pandas: ``docs/architecture.md``).
+VIEWS: dict[str, Callable[..., Any]] = {}
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -93,12 +87,8 @@ def _check_info(info: Any) -> dict:
             continue
         if not isinstance(key, str) or not key:
             raise ValidationError(f"info: keys must be non-empty strings, got {key!r}")
-        if isinstance(value, (bool, np.bool_)) or not isinstance(
-            value, (int, float, str, np.integer, np.floating)
-        ):
-            raise ValidationError(
-                f"info[{key!r}]: must be a float, an int or a string, got {type(value).__name__}"
-            )
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, str, np.integer, np.floating)):
+            raise ValidationError(f"info[{key!r}]: must be a float, an int or a string, got {type(value).__name__}")
         out[key] = value.item() if isinstance(value, np.generic) else value
     return out
 
@@ -435,254 +425,53 @@ class Trajectory:
     # -- xarray and NetCDF ------------------------------------------------------------
 
     def to_xarray(self) -> xarray.Dataset:
-        """Return the trajectory as an :class:`xarray.Dataset`.
-
-        Dimensions ``time``, ``body`` (batches only), ``axis`` (x, y, z),
-        ``axis2`` (x, y, z: the column index of ``inertia``) and ``component``
-        (w, x, y, z). Every variable has ``units`` and ``description``
-        attributes, and ``frame`` where it has one. Global attributes:
-        ``conventions``, ``method``, ``solver_<key>`` for each entry of
-        ``info``, ``tumble_version`` and ``created`` (ISO 8601, UTC). The
-        dataset shares this trajectory's read-only arrays.
-        """
-        import xarray as xr
-
-        lead = ("time",) if self.batch_size is None else ("time", "body")
-
-        def variable(dims, data, units, description, frame=None, **marks):
-            attrs = {"units": units, "description": description, **marks}
-            if frame is not None:
-                attrs["frame"] = frame
-            return xr.Variable(dims, data, attrs)
-
-        data_vars: dict[str, xr.Variable] = {}
-        if self.q is not None:
-            assert self.inertia is not None  # with q (checked in __post_init__)
-            inertia_dims = ("axis", "axis2") if self.inertia.ndim == 2 else ("body", "axis", "axis2")
-            data_vars.update(
-                omega=variable(lead + ("axis",), self.omega, "rad/s",
-                               "angular velocity of the body relative to inertial space", "body"),
-                q=variable(lead + ("component",), self.q, "1",
-                           "attitude: unit Hamilton quaternion, scalar first, v_I = q v_B q*", "body->inertial"),
-                inertia=variable(inertia_dims, self.inertia, "kg m2", "inertia tensor about the centre of mass",
-                                 "body"),
-            )
-        totals = {_TOTAL_ATTR: 1} if "energy" in self.totals else {}
-        data_vars["energy"] = variable(
-            lead, self.energy, "J",
-            "energy of the whole system" if totals else "rotational kinetic energy T = 1/2 omega.I omega", **totals)
-        if self.q is not None or "momentum_body" in self.totals:
-            totals = {_TOTAL_ATTR: 1} if "momentum_body" in self.totals else {}
-            data_vars["momentum_body"] = variable(
-                lead + ("axis",), self.momentum_body, "N m s",
-                "angular momentum of the whole system" if totals else "angular momentum L = I omega", "body",
-                **totals)
-        if self.q is not None:
-            data_vars["momentum_inertial"] = variable(lead + ("axis",), self.momentum_inertial, "N m s",
-                                                      "angular momentum L_I = R(q) L_B", "inertial")
-        for name, extra in self.extras.items():
-            if name in data_vars:
-                raise ValidationError(f"extras[{name!r}]: the name is taken by a trajectory variable")
-            data_vars[name] = xr.Variable(lead + extra.dims, extra.data, {
-                "units": extra.units, "description": extra.description, _EXTRA_ATTR: 1})
-        coords = {
-            "time": ("time", self.t, {"units": "s", "description": "output time"}),
-            "axis": ("axis", _AXES),
-            "axis2": ("axis2", _AXES),
-            "component": ("component", _COMPONENTS),
-        }
-        if self.batch_size is not None:
-            coords["body"] = ("body", np.arange(self.batch_size), {"description": "index in the batch"})
-        attrs = {
-            "conventions": CONVENTIONS,
-            "method": self.method,
-            "model": self.model,
-            **{_INFO_PREFIX + key: value for key, value in self.info.items()},
-            "tumble_version": _tumble_version(),
-            "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        }
-        return xr.Dataset(data_vars, coords, attrs)
+        """Return the trajectory as an :class:`xarray.Dataset` that shares its read-only arrays: dimensions
+        ``time``, ``body`` (batches only), ``axis``, ``axis2`` and ``component``; units, descriptions and frames
+        as attributes (:func:`tumble._netcdf.dataset`, ``docs/trajectory.md``)."""
+        return _netcdf.dataset(self)
 
     @classmethod
     def from_xarray(cls, ds: xarray.Dataset) -> Trajectory:
-        """Rebuild a trajectory from a dataset made by :meth:`to_xarray`.
-
-        Reads ``time``, ``q``, ``omega`` and ``inertia`` exactly (the rigid-body
-        invariants are recomputed), the model's totals, ``method``, ``model``,
-        the ``solver_*`` attributes (into ``info``) and the extras.
-        """
-        attitude = [name for name in ("q", "omega", "inertia") if name in ds.variables]
-        if "time" not in ds.variables or (len(attitude) < 3 and (attitude or "energy" not in ds.variables)):
-            missing = [name for name in ("time", "q", "omega", "inertia") if name not in ds.variables]
-            raise ValidationError(f"ds: not a tumble trajectory (missing {', '.join(missing)})")
-        ds = ds.sel(axis=_AXES, axis2=_AXES, component=_COMPONENTS)
-        info = {
-            key[len(_INFO_PREFIX):]: value
-            for key, value in ds.attrs.items()
-            if key.startswith(_INFO_PREFIX)
-        }
-
-        def values(name, *tail):
-            return ds[name].transpose("time", ..., *tail).values if name in ds.variables else None
-
-        return cls(
-            t=ds["time"].values,
-            q=values("q", "component"),
-            omega=values("omega", "axis"),
-            inertia=ds["inertia"].transpose(..., "axis", "axis2").values if attitude else None,
-            method=str(ds.attrs.get("method", "")),
-            info=info,
-            extras={
-                str(name): Extra(var.values, tuple(str(d) for d in var.dims[1 + ("body" in var.dims):]),
-                                 str(var.attrs.get("units", "1")), str(var.attrs.get("description", "")))
-                for name, var in ds.data_vars.items()
-                if var.attrs.get(_EXTRA_ATTR) == 1
-            },
-            totals={name: values(name, *(("axis",) * _TOTALS[name])) for name in _TOTALS
-                    if name in ds.variables and ds[name].attrs.get(_TOTAL_ATTR) == 1},
-            model=str(ds.attrs.get("model", "")),
-        )
+        """Rebuild a trajectory from a dataset made by :meth:`to_xarray`: ``time``, ``q``, ``omega`` and ``inertia``
+        exactly (the rigid-body invariants are recomputed), the totals, ``method``, ``model``, ``info``, the extras."""
+        fields = _netcdf.fields(ds)
+        fields["extras"] = {name: Extra(*extra) for name, extra in fields["extras"].items()}
+        return cls(**fields)
 
     def save(self, path: str | os.PathLike) -> None:
-        """Write the trajectory to ``path`` as NetCDF-4 (HDF5, via h5netcdf), atomically.
-
-        The file is written under a temporary name in the same directory and
-        renamed onto ``path`` only when complete (:func:`write_atomic`), so an
-        interrupted save leaves any previous file at ``path`` untouched. Read it
-        back with :func:`tumble.load`.
-        """
+        """Write the trajectory to ``path`` as NetCDF-4 (HDF5, via h5netcdf), atomically: under a temporary name
+        in the same directory, renamed onto ``path`` only when complete (:func:`write_atomic`), so an interrupted
+        save leaves any previous file at ``path`` untouched. Read it back with :func:`tumble.load`."""
         write_atomic(path, self._write_netcdf)
 
     def _write_netcdf(self, path: str) -> None:
-        """Write the NetCDF-4 file to ``path`` in place, not atomically: the writer that :meth:`save` hands
-        to :func:`write_atomic`, and that a command writing several files hands to
-        :func:`tumble._files.write_atomic_all`. Every numeric variable carries HDF5's Fletcher-32 checksum,
-        verified on each read, so that a damaged byte of the data is refused, not read as another number.
+        """Write the NetCDF-4 file to ``path`` in place, not atomically: the writer that :meth:`save` hands to
+        :func:`write_atomic`, and a command writing several files to :func:`tumble._files.write_atomic_all`
+        (:func:`tumble._netcdf.write`: checksummed variables, made in memory)."""
+        _netcdf.write(self, path)
 
-        The file is made in memory and written with plain file I/O, so that a full disk is one
-        :class:`OSError` (``ENOSPC``): HDF5 writing to the disk itself left its file open after the error,
-        and the process died of SIGSEGV when the garbage collector closed it.
-        """
-        ds = self.to_xarray()
-        checksums = {name: {"fletcher32": True} for name, var in ds.variables.items() if var.dtype.kind in "fiu"}
-        contents = ds.to_netcdf(engine=_ENGINE, encoding=checksums)
-        with open(path, "wb") as fh:
-            fh.write(contents)
-
-    # -- viewer ------------------------------------------------------------------------
-
-    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
-        """Write the offline 3-D viewer of this trajectory to ``path``: one self-contained HTML file, atomically.
-
-        ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``) and what the page shows:
-        :func:`tumble.viewer.write_html` (``docs/viewer.md``).
-        """
-        from tumble.viewer import write_html
-
-        write_html(self, path, **options)
-
-    def _repr_html_(self) -> str:
-        """A notebook cell's view: the table of the run (model, method, samples, time span, solver statistics,
-        largest drifts of energy and angular momentum), then the viewer (an ``<iframe>``;
-        :func:`tumble.viewer.notebook_html`) where the trajectory can be drawn without its model."""
-        from tumble.viz._notebook import summary_html
-        from tumble.viewer import notebook_html
-
-        return summary_html(self) + (notebook_html(self) or "")
-
-    def to_dataframe(self) -> pandas.DataFrame:
-        """The samples as a pandas DataFrame indexed by ``t`` (s), or by ``(t, body)`` for a batch.
-
-        Columns ``q_w … q_z``, ``omega_x … omega_z`` (rad/s, body axes), ``energy`` (J),
-        ``momentum_body_x …`` (N m s, body axes) and one per component of each extra
-        (:func:`tumble.viz._notebook.to_dataframe`). pandas comes with xarray; it is imported on the first call.
-        """
-        from tumble.viz._notebook import to_dataframe
-
-        return to_dataframe(self)
-
-    # -- figure ------------------------------------------------------------------------
+    # -- views: figure, page, notebook, table (tumble.viz.trajectory) -------------------
 
     def plot(self, *, title: str | None = None) -> Figure:
-        """Return a matplotlib figure of the trajectory (nothing is shown or saved).
+        """A matplotlib figure of the trajectory, nothing shown or saved (:func:`tumble.viz.trajectory.plot`):
+        (a) body rates (rad/s, body axes), (b) relative drifts of the energy and |L| (symlog scale), (c) direction
+        of the inertial angular momentum; body 0 of a batch. Save it atomically with :func:`write_atomic`."""
+        return VIEWS["plot"](self, title=title)
 
-        Panels, against time (s): (a) body rates ω_x, ω_y, ω_z (rad/s, body
-        axes); (b) absolute values of the relative drifts of the energy and
-        |L| (symlog scale, linear below 1e-16, so exact zeros show); (c)
-        direction of the inertial angular momentum, ``L_I / |L_I|`` (inertial
-        axes). A model without an attitude (a robot) shows its first two
-        vector extras in (a) and (c) (joint coordinates and rates).
-        For a batch, body 0 is plotted and the title says so.
-        Save the figure with ``fig.savefig(path)``, or atomically with
-        :func:`write_atomic`.
-        """
-        from matplotlib.figure import Figure
+    def to_html(self, path: str | os.PathLike, **options: Any) -> None:
+        """Write the offline 3-D viewer of this trajectory to ``path``: one self-contained HTML file, atomically;
+        ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``): :func:`tumble.viewer.write_html`."""
+        VIEWS["to_html"](self, path, **options)
 
-        traj = self if self.batch_size is None else self.member(0)
-        if title is None:
-            title = f"tumble trajectory ({self.method or 'unknown method'})"
-        if self.batch_size is not None:
-            title += f" — body 0 of {self.batch_size}"
+    def _repr_html_(self) -> str:
+        """A notebook cell's view: the table of the run, then the viewer (an ``<iframe>``) where the trajectory
+        can be drawn without its model (:func:`tumble.viz.trajectory.notebook_html`)."""
+        return VIEWS["notebook_html"](self)
 
-        fig = Figure(figsize=(8.0, 9.0), layout="constrained")
-        ax_rate, ax_drift, ax_direction = fig.subplots(3, 1, sharex=True)
-        vectors = [(name, e) for name, e in traj.extras.items() if len(e.dims) == 1]
-        if traj.omega is not None:
-            for k, name in enumerate(_AXES):
-                ax_rate.plot(traj.t, traj.omega[:, k], label=rf"$\omega_{name}$")
-            ax_rate.set_title("(a) body rates", loc="left")
-            ax_rate.set_ylabel("ω, body axes (rad/s)")
-        else:  # no attitude (a robot): its first sampled vector, e.g. the joint coordinates
-            _plot_extra(ax_rate, traj.t, *vectors[0], "(a)")
-
-        ax_drift.plot(traj.t, np.abs(traj.energy_drift), label=r"$|E - E_0|/E_0$")
-        if traj.q is not None or "momentum_body" in traj.totals:
-            ax_drift.plot(traj.t, np.abs(traj.momentum_norm_drift), label=r"$||L| - |L_0||/|L_0|$")
-        ax_drift.set_yscale("symlog", linthresh=_DRIFT_LINTHRESH)
-        ax_drift.set_ylim(bottom=0.0)
-        ax_drift.set_title(
-            f"(b) drift of energy and momentum (symlog scale, linear below {_DRIFT_LINTHRESH:g})", loc="left"
-        )
-        ax_drift.set_ylabel("|relative drift| (1)")
-
-        if traj.q is not None:
-            momentum = traj.momentum_inertial
-            norm = np.linalg.norm(momentum, axis=-1, keepdims=True)
-            direction = np.divide(momentum, norm, out=np.zeros_like(momentum), where=norm > 0)
-            for k, name in enumerate(_AXES):
-                ax_direction.plot(traj.t, direction[:, k], label=rf"$L_{name}/|L|$")
-            ax_direction.set_title("(c) direction of the angular momentum", loc="left")
-            ax_direction.set_ylabel("$L_I/|L_I|$, inertial axes (1)")
-        else:
-            _plot_extra(ax_direction, traj.t, *vectors[1], "(c)")
-        ax_direction.set_xlabel("time t (s)")
-
-        for ax in (ax_rate, ax_drift, ax_direction):
-            ax.grid(True, alpha=0.3)
-            ax.legend(loc="best", fontsize="small")
-        fig.suptitle(title)
-        return fig
-
-
-def _plot_extra(ax, t, name: str, extra: Extra, panel: str) -> None:
-    """One line per component of a vector extra (n, m) against time, labelled with its dimension."""
-    dim = extra.dims[0]
-    for k in range(extra.data.shape[-1]):
-        ax.plot(t, extra.data[:, k], label=f"{dim} {k}")
-    ax.set_title(f"{panel} {name.replace('_', ' ')}", loc="left")
-    ax.set_ylabel(f"{name} ({extra.units})")
-
-
-def _tumble_version() -> str:
-    """``tumble.__version__``."""
-    from tumble._version import __version__
-
-    return __version__
-
-
-#: Largest ``||q| − 1|`` a trajectory file may hold: every method keeps ``|q| = 1`` to ~1e-13 over 1e8 steps
-#: (rounding, 1e-16 per step, adds like a random walk); a file past it was altered or damaged.
-UNIT_Q_TOL = 1e-9
+    def to_dataframe(self) -> pandas.DataFrame:
+        """The samples as a pandas DataFrame indexed by ``t`` (s), or by ``(t, body)`` for a batch; one column per
+        component of ``q``, ``omega``, the invariants and each extra (:func:`tumble.viz.trajectory.to_dataframe`)."""
+        return VIEWS["to_dataframe"](self)
 
 
 def load(path: str | os.PathLike) -> Trajectory:
@@ -692,7 +481,7 @@ def load(path: str | os.PathLike) -> Trajectory:
     device: reading it could block for ever), variables larger than the memory can hold (checked from the
     header, before reading them), any file the NetCDF/HDF5 readers cannot read, variables that do not hold
     real numbers (complex, strings), units other than those :meth:`save` writes (``time`` excepted: any unit
-    of time, read in seconds, see :func:`_time_in_seconds`), extras that are not finite, and contents that
+    of time, read in seconds), extras that are not finite, and contents that
     break the rules of construction (shapes, finite values) or of physics: ``||q| − 1| ≤``
     :data:`UNIT_Q_TOL`, an inertia tensor that is symmetric, positive semi-definite and meets the triangle
     inequality (:func:`tumble._inertia.principal_axes`), and an energy and angular momentum within float64's
@@ -702,8 +491,8 @@ def load(path: str | os.PathLike) -> Trajectory:
     require_regular(path)
     try:
         with np.errstate(all="ignore"):
-            traj = Trajectory.from_xarray(_checked_dataset(_read_dataset(path)))
-            _check_physics(traj)
+            traj = Trajectory.from_xarray(_netcdf.read(path))
+            _netcdf.check_physics(traj)
     except ValidationError as exc:  # the file named first; the field's own error stays as the cause
         raise ValidationError(f"{name}: {exc}") from exc
     except MemoryError:
@@ -713,87 +502,3 @@ def load(path: str | os.PathLike) -> Trajectory:
             raise
         raise ValidationError(f"{name}: not a readable tumble trajectory ({type(exc).__name__}: {exc})") from None
     return traj
-
-
-def _read_dataset(path: str | os.PathLike) -> xarray.Dataset:
-    """The variables of the NetCDF file ``path``, loaded once their size is known to fit in memory; times
-    left as the numbers stored (their units are read by :func:`_time_in_seconds`)."""
-    import h5py
-    import xarray as xr
-
-    from ._validate import require_memory
-
-    # Every object's header and attributes read first, in a file that is closed on any error: h5netcdf leaves
-    # a file it fails to open to the garbage collector, which prints "Exception ignored ..." tracebacks.
-    with h5py.File(path, "r") as f:
-        dict(f.attrs)
-        f.visititems(lambda name, obj: dict(obj.attrs))
-    with xr.open_dataset(path, engine=_ENGINE, decode_times=False, decode_timedelta=False,
-                         phony_dims="access") as lazy:
-        nbytes = sum(var.size * var.dtype.itemsize for var in lazy.variables.values())
-        require_memory(nbytes, "variables", f"the {len(lazy.variables)} variable(s) it declares")
-        return lazy.load()
-
-
-#: The units :meth:`Trajectory.to_xarray` writes; a file that says other units for them is refused.
-_UNITS = {"q": "1", "omega": "rad/s", "inertia": "kg m2", "energy": "J", "momentum_body": "N m s",
-          "momentum_inertial": "N m s"}
-#: Seconds per unit of time, by the UDUNITS names a NetCDF file may give (``time:units``).
-_SECONDS = {**dict.fromkeys(("s", "sec", "secs", "second", "seconds"), 1.0),
-            **dict.fromkeys(("ms", "msec", "millisecond", "milliseconds"), 1e-3),
-            **dict.fromkeys(("us", "microsecond", "microseconds"), 1e-6),
-            **dict.fromkeys(("min", "minute", "minutes"), 60.0),
-            **dict.fromkeys(("h", "hr", "hour", "hours"), 3600.0),
-            **dict.fromkeys(("d", "day", "days"), 86400.0)}
-_LABELS = {"axis", "axis2", "component"}  # the coordinates of names (x, y, z; w, x, y, z)
-
-
-def _checked_dataset(ds: xarray.Dataset) -> xarray.Dataset:
-    """``ds`` with its times in seconds, once every variable holds real numbers (no complex part to drop,
-    no strings), tumble's own variables say tumble's units, and every extra is finite."""
-    from ._validate import require_finite
-
-    for name, var in ds.variables.items():
-        if name in _LABELS:
-            continue
-        if var.dtype.kind not in "fiu":
-            raise ValidationError(f"{name}: must hold real numbers, got {var.dtype} values")
-        units = var.attrs.get("units")
-        if name in _UNITS and units is not None and str(units) != _UNITS[name]:
-            raise ValidationError(f"{name}: units must be {_UNITS[name]!r} (as tumble writes them), got {units!r}")
-        if var.attrs.get(_EXTRA_ATTR) == 1:
-            require_finite(var.values, str(name))
-    if "time" not in ds.variables:
-        return ds
-    return ds.assign_coords(time=("time", _time_in_seconds(ds["time"]), ds["time"].attrs))
-
-
-def _time_in_seconds(time: xarray.DataArray) -> np.ndarray:
-    """The output times in seconds: the stored numbers times the seconds of their ``units`` (``"s"`` when
-    absent); CF's ``"UNIT since EPOCH"`` gives the times from the epoch (the origin of a trajectory's times
-    is its own). Units that are not a unit of time are refused."""
-    units = str(time.attrs.get("units", "s"))
-    unit = units.partition(" since ")[0].strip()
-    if unit not in _SECONDS:
-        raise ValidationError(f"time: units must be a unit of time ({', '.join(sorted(set(_SECONDS)))}, "
-                              f"optionally 'UNIT since EPOCH'), got {units!r}")
-    seconds = np.asarray(time.values, dtype=np.float64)
-    return seconds if _SECONDS[unit] == 1.0 else seconds * _SECONDS[unit]
-
-
-def _check_physics(traj: Trajectory) -> None:
-    """Refuse what a run cannot make: ``||q| − 1| >`` :data:`UNIT_Q_TOL`, an inertia that is not physical,
-    an energy or angular momentum past float64's range."""
-    from ._inertia import principal_axes
-    from ._validate import require_finite
-
-    if traj.q is not None:
-        error = np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0)
-        if error.max(initial=0.0) > UNIT_Q_TOL:
-            k = tuple(int(i) for i in np.unravel_index(np.argmax(error), error.shape))
-            raise ValidationError(f"q: must be unit quaternions (||q| - 1| <= {UNIT_Q_TOL:g}), "
-                                  f"|q{list(k)}| = {np.linalg.norm(traj.q[k]):.17g}")
-        principal_axes(traj.inertia, "inertia", definite=False)
-    require_finite(traj.energy, "energy")
-    if traj.q is not None or "momentum_body" in traj.totals:
-        require_finite(traj.momentum_body, "momentum_body")

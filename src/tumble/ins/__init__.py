@@ -9,22 +9,21 @@
 ``from_trajectory``               exact increments of a true motion; ``read_csv`` / ``write_csv``
 ``SensorErrors``, ``Imu``         bias, ARW N, bias instability B, RRW K, scale factor,
                                   misalignment, quantization (IEEE Std 952-1997), seeded
-``allan_deviation``               overlapping Allan deviation, N / B / K fits, ``allan_figure``
+``allan_deviation``               overlapping Allan deviation, N / B / K fits
 ``strapdown``                     rotation-vector attitude integration with none / one- / two- /
                                   three-sample coning compensation, velocity with sculling
 ``Coning``, ``drift_law``,        the classic coning motion (closed form) and the coning drift
 ``measure_drift``                 of each algorithm, predicted and measured
-``demo_ins``, ``demo_coning``,    demonstrations that write figures and return their numbers
-``demo_gyroscope``
 ================================  ==============================================================
 
 Conventions as everywhere in tumble: SI units, attitude ``q`` scalar-first
-body → inertial, rates and increments in body axes. See ``docs/ins.md``.
+body → inertial, rates and increments in body axes. See ``docs/ins.md``; the figures and
+demos are :mod:`tumble.viz.ins`.
 """
 
-from tumble.ins.allan import FLICKER_FACTOR, AllanDeviation, allan_deviation, allan_figure, gauss_markov_adev
+from tumble._moved import moved
+from tumble.ins.allan import FLICKER_FACTOR, AllanDeviation, allan_deviation, gauss_markov_adev
 from tumble.ins.coning import Coning, drift_law, measure_drift
-from tumble.ins.demo import demo_coning, demo_gyroscope, demo_ins
 from tumble.ins.gimbal import GimbaledGyro
 from tumble.ins.gyroscope import Gyroscope
 from tumble.ins.increments import Increments, from_trajectory, read_csv, write_csv
@@ -43,10 +42,6 @@ __all__ = [
     "Navigation",
     "SensorErrors",
     "allan_deviation",
-    "allan_figure",
-    "demo_coning",
-    "demo_gyroscope",
-    "demo_ins",
     "drift_law",
     "from_trajectory",
     "gauss_markov_adev",
@@ -55,3 +50,6 @@ __all__ = [
     "strapdown",
     "write_csv",
 ]
+
+# The figure and the demos moved to tumble.viz.ins: the old names warn and work for one release.
+__getattr__ = moved(__name__, dict.fromkeys(("allan_figure", "demo_coning", "demo_gyroscope", "demo_ins"), "tumble.viz.ins"))

@@ -1,4 +1,4 @@
-"""Allan deviation of gyro (or accelerometer) data, its noise terms and a figure.
+"""Allan deviation of gyro (or accelerometer) data and its noise terms (the figure: :func:`tumble.viz.ins.allan_figure`).
 
 The overlapping Allan variance of a rate record ``Ω_k`` sampled at ``dt``
 (s), for a cluster time ``τ = m dt``, from the integrated angle
@@ -27,17 +27,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble._moved import moved
 from tumble._validate import ValidationError, as_array, require_positive
 
-if TYPE_CHECKING:
-    from matplotlib.figure import Figure
+__all__ = ["FLICKER_FACTOR", "AllanDeviation", "allan_deviation", "gauss_markov_adev"]
 
-__all__ = ["FLICKER_FACTOR", "AllanDeviation", "allan_deviation", "allan_figure", "gauss_markov_adev"]
+__getattr__ = moved(__name__, {"allan_figure": "tumble.viz.ins"})
 
 #: ``σ(τ) / B`` on the flat part of the Allan deviation of bias instability: √(2 ln 2 / π).
 FLICKER_FACTOR = math.sqrt(2.0 * math.log(2.0) / math.pi)
@@ -132,32 +131,3 @@ def gauss_markov_adev(tau: ArrayLike, sigma: float, correlation_time: float) -> 
     return np.sqrt(2.0 * sigma**2 / x * (1.0 - (3.0 - 4.0 * np.exp(-x) + np.exp(-2.0 * x)) / (2.0 * x)))
 
 
-def allan_figure(curves: dict, *, white_noise: float | None = None, bias_instability: float | None = None,
-                 units: str = "rad/s", title: str | None = None) -> Figure:
-    """Log-log figure of Allan deviations: ``curves`` maps a label to an :class:`AllanDeviation`.
-
-    With ``white_noise`` (N) and ``bias_instability`` (B) the model lines
-    ``N/√τ`` and ``0.664 B`` are drawn dashed. Returns a matplotlib Figure
-    (object-oriented API; save it with ``tumble.trajectory.write_atomic``).
-    """
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(6.4, 4.4), layout="constrained")
-    ax = figure.add_subplot()
-    tau_all = np.concatenate([c.tau for c in curves.values()])
-    for label, curve in curves.items():
-        lines = ax.loglog(curve.tau, curve.sigma, marker=".", lw=1)
-        lines[0].set_label(label if len(lines) == 1 else f"{label} (x, y, z)")
-    span = np.geomspace(tau_all.min(), tau_all.max(), 50)
-    if white_noise is not None:
-        ax.loglog(span, white_noise / np.sqrt(span), "k--", lw=0.8, label=f"N/√τ, N = {white_noise:.3g}")
-    if bias_instability is not None:
-        ax.axhline(FLICKER_FACTOR * bias_instability, color="k", ls=":", lw=0.8,
-                   label=f"0.664 B, B = {bias_instability:.3g}")
-    ax.set_xlabel("cluster time τ (s)")
-    ax.set_ylabel(f"Allan deviation σ(τ) ({units})")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    if title:
-        ax.set_title(title)
-    return figure

@@ -40,7 +40,8 @@ from numpy.typing import ArrayLike
 from tumble import attitude
 from tumble._files import read_input
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.trajectory import Trajectory, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Trajectory
 
 __all__ = ["Increments", "from_trajectory", "read_csv", "write_csv"]
 

@@ -44,6 +44,7 @@ from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import TabulatedTorque, Torque, build_torque
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
+from tumble.viz.flexible import slew_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -51,7 +52,7 @@ if TYPE_CHECKING:
 __all__ = ["FlexibleScenario"]
 
 # A run whose attitude keeps |q_x|, |q_y| below this is a rotation about body z, the axis of
-# flexible.slew_figure (a tilt ε changes the angle about z by O(ε²)).
+# viz.flexible.slew_figure (a tilt ε changes the angle about z by O(ε²)).
 _ABOUT_Z = 1e-9
 
 
@@ -110,7 +111,7 @@ class FlexibleScenario(Scenario):
                        self.source)
 
     def figure(self, traj: Trajectory) -> Figure:
-        """:func:`tumble.flexible.slew_figure` for a rotation about body z (the figure's slew axis), else
+        """:func:`tumble.viz.flexible.slew_figure` for a rotation about body z (the figure's slew axis), else
         :meth:`tumble.Trajectory.plot`.
 
         The slew figure compares the hub with the rigid body ``[body]`` under the same torque and
@@ -127,7 +128,7 @@ class FlexibleScenario(Scenario):
         ends = [entry.times[-1] for entry in self.torque if isinstance(entry, TabulatedTorque)]
         end = float(np.clip(max(ends, default=traj.t[0]), traj.t[0], traj.t[-1]))
         assert rigid.q is not None
-        figure = flexible.slew_figure(traj, rigid, end, float(flexible.slew_angle(rigid.q[-1])))
+        figure = slew_figure(traj, rigid, end, float(flexible.slew_angle(rigid.q[-1])))
         if self.name:
             figure.suptitle(self.name)
         return figure

@@ -44,7 +44,7 @@ from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.variable import rate_and_energy_rows
 from tumble.trajectory import Trajectory
 from tumble.variable import Human, Motion
-from tumble.variable.demo import figure_dive
+from tumble.viz.diver import figure_dive
 from tumble.variable.diver import Dive, orientation_angles
 
 if TYPE_CHECKING:
@@ -131,7 +131,7 @@ class HumanScenario(Scenario):
                        source=self.source)
 
     def figure(self, traj: Trajectory) -> Figure:
-        """:func:`tumble.variable.demo.figure_dive` (poses seen along ``L``, somersault and twist, tilt, arms,
+        """:func:`tumble.viz.diver.figure_dive` (poses seen along ``L``, somersault and twist, tilt, arms,
         energy) when the angular momentum lies along inertial x, the somersault axis of
         :mod:`tumble.variable.diver`; else :meth:`tumble.Trajectory.plot`."""
         momentum = traj.momentum_inertial[0]

@@ -41,6 +41,7 @@ from tumble.scenario._values import _Number, _Table, _Vector
 from tumble.scenario.tables import Body, Initial, Solver, Time
 from tumble.scenario.torques import Torque, build_torque
 from tumble.trajectory import Trajectory
+from tumble.viz.slosh import nutation_figure
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -115,8 +116,8 @@ class SloshScenario(Scenario):
         return slosh.nutation_angle(self.model, traj, self.slosh.spin_axis)
 
     def figure(self, traj: Trajectory) -> Figure:
-        """:func:`tumble.slosh.nutation_figure`: the nutation angle from ``spin_axis``, the energy and ``|H|``."""
-        figure = slosh.nutation_figure(traj, self.nutation_angle(traj), traj.momentum_norm, traj.energy)
+        """:func:`tumble.viz.slosh.nutation_figure`: the nutation angle from ``spin_axis``, the energy and ``|H|``."""
+        figure = nutation_figure(traj, self.nutation_angle(traj), traj.momentum_norm, traj.energy)
         axis = ", ".join(f"{x:g}" for x in self.slosh.spin_axis)
         figure.axes[0].set_title(f"(a) nutation: angle between the body axis [{axis}] and the total angular momentum")
         if self.name:

@@ -411,8 +411,8 @@ class SpacecraftScenario(Scenario):
         return None
 
     def figure(self, traj: Trajectory) -> Figure:
-        """:func:`tumble.spacecraft.figure.spacecraft_figure` of a run of this scenario, titled with its name."""
-        from tumble.spacecraft.figure import spacecraft_figure
+        """:func:`tumble.viz.spacecraft.spacecraft_figure` of a run of this scenario, titled with its name."""
+        from tumble.viz.spacecraft import spacecraft_figure
 
         return spacecraft_figure(traj, target=self.target(), title=self.name)
 

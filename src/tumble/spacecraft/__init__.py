@@ -17,6 +17,7 @@ geomagnetic field: ``docs/spacecraft_environment.md``; passive stability (major-
 gravity-gradient regions, nutation damper): ``docs/passive_stability.md``.
 """
 
+from tumble._moved import moved
 from tumble.spacecraft.actuators import PWPF, CMGCluster, Magnetorquers, ReactionWheel, Thruster, pyramid_wheels
 from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MRPFeedback, PythonLaw, QuaternionPD,
                                        RateDamping, WheelTorques)
@@ -24,10 +25,9 @@ from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
 from tumble.spacecraft.flight_software import FlightSoftware, Sampling
-from tumble.spacecraft.figure import save_spacecraft_figure, spacecraft_figure
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
-from tumble.spacecraft.passive import gravity_gradient_stability, gravity_gradient_stability_figure, spin_stability
+from tumble.spacecraft.passive import gravity_gradient_stability, spin_stability
 from tumble.spacecraft.tle import TLE
 
 __all__ = [
@@ -37,6 +37,10 @@ __all__ = [
     "Sampling",
     "SaturationWarning", "SingularityWarning", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE", "Thruster",
     "WheelTorques",
-    "attitude_in_lvlh", "gravity_gradient_stability", "gravity_gradient_stability_figure", "lvlh_quaternion",
-    "pyramid_wheels", "save_spacecraft_figure", "spacecraft_figure", "spin_stability",
+    "attitude_in_lvlh", "gravity_gradient_stability", "lvlh_quaternion",
+    "pyramid_wheels", "spin_stability",
 ]
+
+# The figures moved to tumble.viz: the old names warn and work for one release.
+__getattr__ = moved(__name__, {"gravity_gradient_stability_figure": "tumble.viz.passive",
+                               "save_spacecraft_figure": "tumble.viz.spacecraft", "spacecraft_figure": "tumble.viz.spacecraft"})

@@ -8,7 +8,7 @@ and ``dL_B/dt + ω × L_B = τ_B``. A :class:`VariableBody` (samples of ``I`` an
 prescribed angles) are models of :func:`tumble.simulate`. See
 ``docs/variable_inertia.md`` (equations, API) and ``docs/diver.md`` (the
 segment model of a human body, the twisting somersault;
-:mod:`tumble.variable.diver`, :mod:`tumble.variable.demo`).
+:mod:`tumble.variable.diver`; the figures and demo: :mod:`tumble.viz.diver`).
 
     >>> import numpy as np, tumble
     >>> from tumble.variable import Human, Motion

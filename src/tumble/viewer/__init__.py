@@ -34,7 +34,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tumble._validate import ValidationError
-from tumble.trajectory import Trajectory, load, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Trajectory, load
 from tumble.viewer._frames import DEFAULT_FRAMES, check_budget, frame_indices
 from tumble.viewer._page import document
 from tumble.viewer._scene import Scene, as_json

@@ -29,7 +29,8 @@ from tumble._validate import ValidationError, require_positive
 from tumble.analysis import lyapunov_exponents, poincare_section
 from tumble.analytic import omega_at_energy, upward_vertical
 from tumble.torques import Gravity
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
+from tumble.viz._output import out_directory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -121,8 +122,7 @@ def figure_chaos(data: dict) -> Figure:
 
 def demo_chaos(out_dir: str | os.PathLike[str], *, duration: float = 2000.0) -> dict:
     """``tumble demo chaos``: write ``chaos.png`` in ``out_dir``; returns the exponents and section sizes."""
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     data = chaos_data(duration=duration)
     png_path = os.path.join(os.fspath(out_dir), "chaos.png")
     figure = figure_chaos(data)

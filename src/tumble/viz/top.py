@@ -16,10 +16,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble._validate import ValidationError, require_positive
+from tumble._validate import require_positive
 from tumble.analytic import HeavyTop, axis_motion, measure_nutation
 from tumble.simulate import simulate
-from tumble.trajectory import Trajectory, write_atomic
+from tumble._files import write_atomic
+from tumble.trajectory import Trajectory
+from tumble.viz._output import out_directory
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -151,8 +153,7 @@ def demo_top(out_dir: str | os.PathLike[str], *, duration: float = 1.5) -> dict:
     written. ``out_dir`` must be an existing directory.
     """
     duration = require_positive(duration, "duration")
-    if not os.path.isdir(out_dir):
-        raise ValidationError(f"out_dir: {os.fspath(out_dir)!r} is not an existing directory")
+    out_directory(out_dir)
     top = DEMO_TOP
     n = math.ceil(_DEMO_SAMPLES_PER_PERIOD * duration / top.nutation_period)
     trajectory = simulate(**top.simulation_inputs(), t=np.linspace(0.0, duration, n + 1),

@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 
 import tumble
 from tumble.spacecraft import CMGCluster, ConstantTorque, SingularityWarning, Spacecraft
-from tumble.trajectory import write_atomic
+from tumble._files import write_atomic
 
 DELTA0 = np.radians([-90.0, 0.0, 90.0, 0.0])
 TORQUE = np.array([-0.5, 0.0, 0.0])            # N m, body axes

@@ -81,7 +81,7 @@ def main(samples: int = 500, figure: str | os.PathLike[str] | None = None) -> xa
     print(f"measured / energy-sink estimate tau ln(theta_f/theta_0), over the samples that reached it: median "
           f"{np.nanmedian(ratio):.3f}, range {np.nanmin(ratio):.3f} to {np.nanmax(ratio):.3f}")
     if figure:
-        from tumble.sweeps.figure import sweep_figure
+        from tumble.viz.sweep import sweep_figure
 
         fig = sweep_figure(ds, title="Explorer-1-like spinner, dispersed damper: time to flat spin",
                            units={"time_to_flat_spin": "s", "nutation_angle": "rad"})

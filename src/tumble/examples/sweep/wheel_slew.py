@@ -79,7 +79,7 @@ def main(samples: int = 1000, figure: str | os.PathLike[str] | None = None) -> x
           f"95th percentile {math.degrees(p[95.0]):.4g}, 99th percentile {math.degrees(p[99.0]):.4g}, "
           f"max {math.degrees(error.max()):.4g}")
     if figure:
-        from tumble.sweeps.figure import sweep_figure
+        from tumble.viz.sweep import sweep_figure
 
         fig = sweep_figure(ds, title="60° slew, 4 wheels: dispersed inertia, wheel axes, initial rates",
                            units={"final_pointing_error": "rad", "pointing_error": "rad"})

@@ -1,6 +1,7 @@
-"""The demonstrations of the extension packages, as a table the ``tumble demo`` command reads.
+"""The demonstrations, as the one table the ``tumble demo`` command reads.
 
-Each demo is a function of its package, ``demo_xxx(out_dir) -> dict``, that
+Each demo is a function ``demo_xxx(out_dir) -> dict`` of :mod:`tumble.viz` (the figures and demos of a
+domain: ``tumble.viz.flexible``, ``tumble.viz.passive``, ...) that
 writes its files atomically into an existing directory and returns its numbers.
 A row of :data:`DEMOS` names it (``"module:function"``, imported only when the
 demo runs), gives the command's help and turns the returned numbers into
@@ -35,7 +36,7 @@ class Demo:
 
 DEMOS: dict[str, Demo] = {
     "diver": Demo(
-        "tumble.variable.demo:demo_diver",
+        "tumble.viz.diver:demo_diver",
         """A diver's twisting somersaults: a segment model (de Leva 1996) whose arms move in flight.
 
         Runs the three experiments of docs/diver.md: (a) a layout somersault that acquires twist
@@ -57,7 +58,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "flexible": Demo(
-        "tumble.flexible:demo_flexible",
+        "tumble.viz.flexible:demo_flexible",
         """A 30 deg rest-to-rest slew of a spacecraft with two flexible panel modes (0.2 and 1.1 Hz).
 
         Bang-bang torque over 40 s, flexible hub against the rigid body (docs/flexible.md): the
@@ -74,7 +75,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "slosh": Demo(
-        "tumble.slosh:demo_slosh",
+        "tumble.viz.slosh:demo_slosh",
         """Fuel slosh turns a minor-axis spinner into a flat spin (pendulum analogue, docs/slosh.md).
 
         The nutation angle grows exponentially at the rate of the linearised steady spin while the
@@ -91,7 +92,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "gyro": Demo(
-        "tumble.ins.demo:demo_gyroscope",
+        "tumble.viz.ins:demo_gyroscope",
         """A mechanical gyroscope: precession under a torque, nutation, and drift from imbalance and friction.
 
         A rotor on a pivot simulated with Euler's equations (docs/ins.md): precession rate
@@ -109,7 +110,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "coning": Demo(
-        "tumble.ins.demo:demo_coning",
+        "tumble.viz.ins:demo_coning",
         """The classic coning test of strapdown attitude algorithms (alpha = 0.01 rad, Omega = 2 pi rad/s).
 
         Drift rate about the cone axis of the uncompensated, one-, two- and three-sample
@@ -121,7 +122,7 @@ DEMOS: dict[str, Demo] = {
                    for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
     ),
     "ins": Demo(
-        "tumble.ins.demo:demo_ins",
+        "tumble.viz.ins:demo_ins",
         """End to end: a tumbling body, a gyro with errors, strapdown integration, attitude error.
 
         The exact torque-free motion is sampled by a 200 Hz gyro (error-free, angle random walk only,
@@ -140,7 +141,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "explorer1": Demo(
-        "tumble.spacecraft.passive:demo_explorer1",
+        "tumble.viz.passive:demo_explorer1",
         """Explorer 1 (1958): a spin about the minor axis decays into a flat spin about the major axis.
 
         The satellite (750 rpm about its long, minor axis) dissipates energy in a spherical viscous
@@ -160,7 +161,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "gravity-gradient": Demo(
-        "tumble.spacecraft.passive:demo_gravity_gradient",
+        "tumble.viz.passive:demo_gravity_gradient",
         """A gravity-gradient-stabilised satellite librating about the local-vertical frame (LVLH).
 
         Classifies the spacecraft in the (k_R, k_Y) plane (Lagrange and DeBra-Delp regions),
@@ -175,7 +176,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "budget": Demo(
-        "tumble.spacecraft.budget:demo_budget",
+        "tumble.viz.budget:demo_budget",
         """A pointing and momentum budget: an Earth-pointing LEO smallsat with four wheels over a day.
 
         The disturbance torques by source (gravity gradient, solar pressure and drag on its six faces,
@@ -199,7 +200,7 @@ DEMOS: dict[str, Demo] = {
         ],
     ),
     "lorentz": Demo(
-        "tumble.lorentz:demo_lorentz",
+        "tumble.viz.lorentz:demo_lorentz",
         """Lorentz-factor inertia of a neutron star (R = 12 km, M = 1.4 Msun, period 1.4 ms).
 
         Incoherent matter in rigid rotation, special relativity only (not Born-rigid, no gravity:
@@ -226,7 +227,7 @@ DEMOS: dict[str, Demo] = {
                    for name, value in s["largest_exponent"].items()],
     ),
     "space-arm": Demo(
-        "tumble.robot.space_demo:demo_space_arm",
+        "tumble.viz.space_arm:demo_space_arm",
         """A two-link arm on a free-floating hub swings through a commanded manoeuvre, and the hub turns.
 
         The hub (100 kg) is the floating base of the arm (no gravity, no external force); a PD law drives
@@ -240,7 +241,7 @@ DEMOS: dict[str, Demo] = {
                                 f"{s['max_linear_momentum']:.2g} N s (exactly 0: internal torques)")],
     ),
     "estimation": Demo(
-        "tumble.spacecraft.estimation_demo:demo_estimation",
+        "tumble.viz.estimation:demo_estimation",
         """A slew and fine pointing with a star tracker and a gyro through the MEKF in the loop.
 
         The flight software samples a 10 arcsec star tracker and a gyro at 2 Hz, runs the MEKF and feeds
