@@ -10,6 +10,14 @@ import pytest
 os.environ.setdefault("TUMBLE_QUIET", "1")
 
 
+def pytest_configure(config):
+    """``TUMBLE_COMPILE_PROFILE=DIR`` logs each test's CPU time and Numba compilations (tests/compile_profile.py)."""
+    if os.environ.get("TUMBLE_COMPILE_PROFILE"):
+        from compile_profile import CompileProfile
+
+        config.pluginmanager.register(CompileProfile(os.environ["TUMBLE_COMPILE_PROFILE"]), "compile_profile")
+
+
 @pytest.fixture
 def random_rotation():
     """``random_rotation(seed)``: a proper rotation matrix drawn from the QR of a Gaussian matrix."""
