@@ -3,24 +3,31 @@
 Enabled by ``TUMBLE_COMPILE_PROFILE=DIR`` (``tests/conftest.py`` registers it): each pytest process (the
 controller and every xdist worker) appends JSON lines to ``DIR/<pid>.jsonl``, one per test::
 
-    {"test": nodeid, "cpu": s, "compiles": [[function, signature, inclusive s, self s, depth], ...]}
+    {"test": nodeid, "cpu": s, "children": s, "compiles": [[function, signature, inclusive s, self s, depth], ...]}
 
 ``cpu`` is the process's CPU time (user + system, all threads) from the start of the test's setup to the
-end of its teardown. A compilation is what Numba's ``numba:compile`` event brackets: a signature that the
+end of its teardown; ``children`` that of the subprocesses it started and waited for (the CLI's, Dask's). A compilation is what Numba's ``numba:compile`` event brackets: a signature that the
 disk cache did not answer. Compilations nest (a kernel compiles the dispatchers it calls); *inclusive* counts
-the callees, *self* does not, so the self times of a test add up to its compile time. Work done in
-subprocesses the test starts (the CLI tests) is not seen here. ``benchmarks/compile_report.py`` sums the logs.
+the callees, *self* does not, so the self times of a test add up to its compile time. Compilations in
+subprocesses are not seen (only their CPU time, in ``children``). ``benchmarks/compile_report.py`` sums the logs.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import resource
 import time
 from pathlib import Path
 
 import pytest
 from numba.core import event
+
+
+def _children_cpu() -> float:
+    """User + system CPU seconds of the subprocesses this process has waited for."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 class CompileClock(event.Listener):
@@ -54,9 +61,10 @@ class CompileProfile:
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_protocol(self, item: pytest.Item, nextitem: pytest.Item | None):
-        start = time.process_time()
+        start, children = time.process_time(), _children_cpu()
         yield
-        record = {"test": item.nodeid, "cpu": time.process_time() - start, "compiles": self.clock.done}
+        record = {"test": item.nodeid, "cpu": time.process_time() - start, "children": _children_cpu() - children,
+                  "compiles": self.clock.done}
         self.clock.done = []
         with self.log.open("a") as log:
             log.write(json.dumps(record) + "\n")

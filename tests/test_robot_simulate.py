@@ -14,6 +14,10 @@ from tumble.robot.cli import app
 
 from helpers import read_by
 
+# The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
+# integrators, ~50 CPU s on a cold Numba cache); the group keeps them on one xdist worker (--dist loadgroup).
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("robot")]
+
 ROBOTS = tumble.examples.directory() / "robots"
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "robot.md"
 Q0 = np.array([0.1, 0.5, -0.3, 0.2, 0.4, -0.1])

@@ -12,6 +12,10 @@ import tumble
 from robot_oracle import ERD, Pair, close
 from tumble import ValidationError, robot
 
+# The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
+# integrators, ~50 CPU s on a cold Numba cache); the group keeps them on one xdist worker (--dist loadgroup).
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("robot")]
+
 pin = pytest.importorskip("pinocchio")
 
 ROBOTS = tumble.examples.directory() / "robots"

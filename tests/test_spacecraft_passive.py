@@ -11,6 +11,11 @@ from tumble.spacecraft import passive
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.torques import GravityGradient
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
+# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
+# on one xdist worker (--dist loadgroup), so that one process pays it.
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+
 ORBIT = Orbit.circular(700e3)
 N = ORBIT.mean_motion
 # Body axes: 1 roll (along-track), 2 pitch (minus orbit normal), 3 yaw (nadir).

@@ -17,9 +17,10 @@ from tumble.spacecraft.figure import spacecraft_figure
 
 from helpers import assert_same_run
 
-# Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
-# on 2 shared cores, under 1 s warm).
-pytestmark = pytest.mark.slow
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
+# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
+# on one xdist worker (--dist loadgroup), so that one process pays it.
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = tumble.examples.directory() / "spacecraft"

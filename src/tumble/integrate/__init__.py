@@ -274,6 +274,8 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, dt: float |
 def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps, serial):
     # One body, or a model that calls back into Python: no parallel region
     # (its start-up costs more than a short run, and callbacks need the GIL).
+    # Nor for a fixed-step batch of one block (at most LANES bodies): its one task runs on one core anyway,
+    # and the parallel driver is not compiled for it.
     serial = serial or y.shape[0] == 1
     if method == "exact":
         _exact.run(model, y, t, out)
@@ -282,7 +284,7 @@ def _run_chunk(method, model, y, t, out, stats, *, steps, rtol, atol, max_steps,
         m, h = steps
         if y.shape[0] == 1:
             _fixed.run_one(scheme, model, y, t, m, h, out, stats)
-        elif serial:
+        elif serial or y.shape[0] <= _fixed.LANES:
             for k in range(-(-y.shape[0] // _fixed.LANES)):
                 _fixed.run_block(scheme, model, k, y, t, m, h, out, stats)
         else:

@@ -229,7 +229,12 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
     _, sample, _ = _assemble(1, _python(model))
-    return lambda model, t, y: sample(model, t, y, 0)
+
+    def impl(model, t, y):
+        for j in range(1):  # j an int64, as in the projection: a literal 0 would compile the sample once more
+            sample(model, t, y, j)
+
+    return impl
 
 
 @njit(cache=True)
