@@ -3,7 +3,8 @@
 Enabled by ``TUMBLE_COMPILE_PROFILE=DIR`` (``tests/conftest.py`` registers it): each pytest process (the
 controller and every xdist worker) appends JSON lines to ``DIR/<pid>.jsonl``, one per test::
 
-    {"test": nodeid, "cpu": s, "children": s, "compiles": [[function, signature, inclusive s, self s, depth], ...]}
+    {"test": nodeid, "outcome": "passed" | "failed" | "skipped", "cpu": s, "children": s,
+     "compiles": [[function, signature, inclusive s, self s, depth], ...]}
 
 ``cpu`` is the process's CPU time (user + system, all threads) from the start of the test's setup to the
 end of its teardown; ``children`` that of the subprocesses it started and waited for (the CLI's, Dask's). A compilation is what Numba's ``numba:compile`` event brackets: a signature that the
@@ -57,14 +58,19 @@ class CompileProfile:
         self.log = Path(directory) / f"{os.getpid()}.jsonl"
         self.log.parent.mkdir(parents=True, exist_ok=True)
         self.clock = CompileClock()
+        self.outcome = "passed"
         event.register("numba:compile", self.clock)
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        if report.outcome != "passed" and self.outcome != "failed":
+            self.outcome = report.outcome
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_runtest_protocol(self, item: pytest.Item, nextitem: pytest.Item | None):
         start, children = time.process_time(), _children_cpu()
         yield
-        record = {"test": item.nodeid, "cpu": time.process_time() - start, "children": _children_cpu() - children,
-                  "compiles": self.clock.done}
-        self.clock.done = []
+        record = {"test": item.nodeid, "outcome": self.outcome, "cpu": time.process_time() - start,
+                  "children": _children_cpu() - children, "compiles": self.clock.done}
+        self.clock.done, self.outcome = [], "passed"
         with self.log.open("a") as log:
             log.write(json.dumps(record) + "\n")
