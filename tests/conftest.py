@@ -10,6 +10,16 @@ import pytest
 os.environ.setdefault("TUMBLE_QUIET", "1")
 
 
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(config, items):
+    """A test with no ``xdist_group`` of its own joins its module's group: under ``--dist loadgroup``
+    (pyproject.toml) each module runs on one worker, as under ``--dist loadfile``, so that the code its tests
+    share is compiled by one worker rather than by both at once; the groups of a model kind span modules."""
+    for item in items:
+        if item.get_closest_marker("xdist_group") is None:
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
+
+
 def pytest_configure(config):
     """``TUMBLE_COMPILE_PROFILE=DIR`` logs each test's CPU time and Numba compilations (tests/compile_profile.py)."""
     if os.environ.get("TUMBLE_COMPILE_PROFILE"):
