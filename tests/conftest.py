@@ -10,14 +10,26 @@ import pytest
 os.environ.setdefault("TUMBLE_QUIET", "1")
 
 
-@pytest.hookimpl(tryfirst=True)
-def pytest_collection_modifyitems(config, items):
-    """A test with no ``xdist_group`` of its own joins its module's group: under ``--dist loadgroup``
-    (pyproject.toml) each module runs on one worker, as under ``--dist loadfile``, so that the code its tests
-    share is compiled by one worker rather than by both at once; the groups of a model kind span modules."""
-    for item in items:
-        if item.get_closest_marker("xdist_group") is None:
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
+#: Test modules whose tests compile the same model kind, by the start of their path: the spacecraft's assembled
+#: right-hand side and sample are compiled into each spacecraft driver and not kept on disk apart from them
+#: (docs/architecture.md, "The test suite and what it compiles"), so each process that compiles a spacecraft
+#: driver compiles them again (~35 CPU s); the robot's kernels are shared by its modules.
+KINDS = {"spacecraft": "tests/test_spacecraft_", "robot": "tests/test_robot"}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """Under ``--dist loadfile`` (pyproject.toml): each module runs on one worker, and so do all the modules of
+    a kind of :data:`KINDS`, so that the two workers do not compile the same code, each for itself."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class KindScheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid):
+            module = super()._split_scope(nodeid)
+            return next((kind for kind, start in KINDS.items() if module.startswith(start)), module)
+
+    return KindScheduling(config, log)
 
 
 def pytest_configure(config):

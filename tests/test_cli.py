@@ -249,8 +249,7 @@ def test_robot_torques_prints_the_published_puma_gravity_load():
     np.testing.assert_allclose(printed, [0.0, 31.6399, 6.0351, 0.0, 0.0283, 0.0], rtol=5e-5, atol=5e-5)
 
 
-@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache), on the worker of the spacecraft tests
-@pytest.mark.xdist_group("spacecraft")
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_run_dispatches_a_spacecraft_scenario(tmp_path):
     out = tmp_path / "slew.nc"
     result = invoke("run", EXAMPLES / "spacecraft" / "slew_wheels.toml", "-o", out, "--quiet")
@@ -261,8 +260,7 @@ def test_run_dispatches_a_spacecraft_scenario(tmp_path):
     assert f"peak speed {peak:.4g} rad/s" in result.stdout
 
 
-@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache), on the worker of the spacecraft tests
-@pytest.mark.xdist_group("spacecraft")
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_run_writes_the_mrp_disturbance_example_and_its_figure(tmp_path):
     # The command line of the example's header: exit 0, the trajectory (with the MRP integral term and the
     # disturbance torque of its [[torque]] table) and the spacecraft figure written, nothing else left.
@@ -280,8 +278,7 @@ def test_run_writes_the_mrp_disturbance_example_and_its_figure(tmp_path):
         assert f"{label} {value}" in " ".join(result.stdout.split())
 
 
-@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache), on the worker of the spacecraft tests
-@pytest.mark.xdist_group("spacecraft")
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 @pytest.mark.parametrize("scenario", [EXAMPLES / "symmetric_top.toml", EXAMPLES / "spacecraft" / "slew_wheels.toml"],
                          ids=lambda p: p.stem)
 def test_run_parses_the_file_once(tmp_path, monkeypatch, scenario):

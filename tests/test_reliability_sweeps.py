@@ -183,8 +183,7 @@ def test_a_python_callback_pickled_to_another_process_registers_there_under_its_
     np.testing.assert_allclose(copy(0.5, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), [0.0, 0.015, 0.2], rtol=1e-15)
 
 
-@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache), on the worker of the spacecraft tests
-@pytest.mark.xdist_group("spacecraft")
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_a_spacecraft_pickled_after_compiling_its_python_law_compiles_it_again_with_its_own_slot():
     # the compiled programs (a cached property) held the client's slot number: they are left out of the pickle
     from tumble.spacecraft import Spacecraft, pyramid_wheels

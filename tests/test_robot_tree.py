@@ -13,8 +13,8 @@ from robot_oracle import ERD, Pair, close
 from tumble import ValidationError, robot
 
 # The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
-# integrators, ~50 CPU s on a cold Numba cache); the group keeps them on one xdist worker (--dist loadgroup).
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("robot")]
+# integrators, ~50 CPU s on a cold Numba cache); the robot's modules run on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
 
 pin = pytest.importorskip("pinocchio")
 

@@ -20,10 +20,10 @@ from tumble.spacecraft import (CMGCluster, Environment, MRPFeedback, Orbit, Quat
                                Spacecraft, pyramid_wheels)
 from tumble.spacecraft.surfaces import Drag, SolarPressure, box_facets
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
-# on one xdist worker (--dist loadgroup), so that one process pays it.
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
 T = np.linspace(0.0, 2.0, 3)

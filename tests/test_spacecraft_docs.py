@@ -17,7 +17,6 @@ def test_every_page_has_python():
 
 
 @pytest.mark.slow  # each block compiles its spacecraft model on first use
-@pytest.mark.xdist_group("spacecraft")  # on the worker of the other spacecraft tests
 @pytest.mark.parametrize("page, k, code", BLOCKS, ids=[f"{page}:{k}" for page, k, _ in BLOCKS])
 def test_python_block_runs(page, k, code, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)

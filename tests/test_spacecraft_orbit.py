@@ -9,10 +9,10 @@ from tumble.spacecraft import (DipoleField, Magnetorquers, MomentumDumping, Orbi
                                pyramid_wheels)
 from tumble.scenario import load
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
-# on one xdist worker (--dist loadgroup), so that one process pays it.
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 INERTIA = np.array([[30.0, 0.5, 0.0], [0.5, 25.0, -0.3], [0.0, -0.3, 15.0]])
 ORBIT = Orbit.circular(600e3, inclination=np.radians(97.8))

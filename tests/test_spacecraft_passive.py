@@ -11,10 +11,10 @@ from tumble.spacecraft import passive
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.torques import GravityGradient
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
-# on one xdist worker (--dist loadgroup), so that one process pays it.
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 ORBIT = Orbit.circular(700e3)
 N = ORBIT.mean_motion

@@ -12,10 +12,10 @@ from tumble.spacecraft import Spacecraft
 from tumble.spacecraft import damper as d
 from tumble.spacecraft import passive
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
-# on one xdist worker (--dist loadgroup), so that one process pays it.
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 # A scaled Explorer 1: prolate hub (spin axis z the minor axis), damper 2 % of
 # the transverse moment, tuned for the spin (time constant 87 s instead of

@@ -17,10 +17,10 @@ from tumble.spacecraft.figure import spacecraft_figure
 
 from helpers import assert_same_run
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
-# on one xdist worker (--dist loadgroup), so that one process pays it.
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = tumble.examples.directory() / "spacecraft"

@@ -14,10 +14,10 @@ from tumble.kernels import spacecraft as _kernel
 from tumble.spacecraft import Environment, Orbit, ResidualDipole, Spacecraft
 from tumble.spacecraft.surfaces import SOLAR_IRRADIANCE, Drag, Facet, SolarPressure, box_facets
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver: not cached on disk); the group keeps them
-# on one xdist worker (--dist loadgroup), so that one process pays it.
-pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("spacecraft")]
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 AU, LIGHT_SPEED = 149597870700.0, 299792458.0
 EPOCH = datetime(2026, 3, 20, 12, 0, tzinfo=timezone.utc)
