@@ -270,7 +270,15 @@ FOLLOW_UP = {("README.md", "## Ten lines of Python"): _ten_lines,
              ("README.md", "## Exact motion, stability and the heavy top"): _exact_motion}
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+#: The pages whose examples compile model kinds other than the rigid body's or run demos, sweeps or the CLI's
+#: commands: seconds to a minute of CPU each on a cold Numba cache.
+SLOW_PAGES = {"chaos.md", "cli.md", "diver.md", "estimation.md", "flexible.md", "frames.md", "gpu.md", "ins.md",
+              "limits.md", "passive_stability.md", "robot.md", "scenarios.md", "slosh.md", "spacecraft.md",
+              "spacecraft_environment.md", "stability.md", "sweeps.md", "variable_inertia.md", "viewer.md"}
+
+
+@pytest.mark.parametrize("page", [pytest.param(page, marks=pytest.mark.slow) if page.name in SLOW_PAGES else page
+                                  for page in PAGES], ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_every_example_of_the_page_runs(page, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     matplotlib.use("Agg")

@@ -198,6 +198,7 @@ def test_a_spacecraft_pickled_after_compiling_its_python_law_compiles_it_again_w
     assert slots == [arrived.callback.slot] and [p.kind for p in compiled] == [p.kind for p in copy._programs]
 
 
+@pytest.mark.slow  # a sweep on a Dask worker process, compiling on a cold cache (~6 CPU s)
 def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in_this_one(scheduler_file):
     # the function's slot was a number of the client's registry: the worker raised KeyError, or called another
     # function registered there under the same number
@@ -224,6 +225,7 @@ def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in
 # -- 4. a lost chunk file is computed again ---------------------------------------------
 
 
+@pytest.mark.slow  # a sweep on Dask worker processes, each compiling on a cold cache (~8 CPU s)
 def test_a_complete_store_that_lost_a_chunk_file_computes_that_chunk_again(tmp_path):
     store = tmp_path / "mc.zarr"
     outcomes = {**OUTCOMES, "never": CrossingTime(Component("omega", 2), above=100.0)}  # NaN in every sample
