@@ -150,6 +150,7 @@ EXPLORER = (tumble.examples.directory() / "spacecraft" / "explorer1.toml").read_
 """)
 
 
+@pytest.mark.slow  # the plan compiles the spacecraft of the file (~80 CPU s on a cold cache)
 def test_a_scenario_whose_undispersed_table_changed_has_another_digest(tmp_path):
     # a dispersed non-state key (the damper's damping) rebuilds the model per sample from the file: the
     # recorded settings name the file and the keys only, the digest holds every table of it (here the
