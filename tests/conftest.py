@@ -13,7 +13,7 @@ os.environ.setdefault("TUMBLE_QUIET", "1")
 #: Test modules whose tests compile the same model kind, by the start of their path: the spacecraft's assembled
 #: right-hand side and sample are compiled into each spacecraft driver and not kept on disk apart from them
 #: (docs/architecture.md, "The test suite and what it compiles"), so each process that compiles a spacecraft
-#: driver compiles them again (~35 CPU s); the robot's kernels are shared by its modules.
+#: driver compiles them again (~50 CPU s); the robot's kernels are shared by its modules.
 KINDS = {"spacecraft": "tests/test_spacecraft_", "robot": "tests/test_robot"}
 
 
