@@ -10,6 +10,36 @@ import pytest
 os.environ.setdefault("TUMBLE_QUIET", "1")
 
 
+#: Test modules whose tests compile the same model kind, by the start of their path: the spacecraft's assembled
+#: right-hand side and sample are compiled into each spacecraft driver and not kept on disk apart from them
+#: (docs/architecture.md, "The test suite and what it compiles"), so each process that compiles a spacecraft
+#: driver compiles them again (~50 CPU s); the robot's kernels are shared by its modules.
+KINDS = {"spacecraft": "tests/test_spacecraft_", "robot": "tests/test_robot"}
+
+
+def pytest_xdist_make_scheduler(config, log):
+    """Under ``--dist loadfile`` (pyproject.toml): each module runs on one worker, and so do all the modules of
+    a kind of :data:`KINDS`, so that the two workers do not compile the same code, each for itself."""
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class KindScheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid):
+            module = super()._split_scope(nodeid)
+            return next((kind for kind, start in KINDS.items() if module.startswith(start)), module)
+
+    return KindScheduling(config, log)
+
+
+def pytest_configure(config):
+    """``TUMBLE_COMPILE_PROFILE=DIR`` logs each test's CPU time and Numba compilations (tests/compile_profile.py)."""
+    if os.environ.get("TUMBLE_COMPILE_PROFILE"):
+        from compile_profile import CompileProfile
+
+        config.pluginmanager.register(CompileProfile(os.environ["TUMBLE_COMPILE_PROFILE"]), "compile_profile")
+
+
 @pytest.fixture
 def random_rotation():
     """``random_rotation(seed)``: a proper rotation matrix drawn from the QR of a Gaussian matrix."""

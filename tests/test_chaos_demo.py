@@ -8,6 +8,9 @@ from tumble._validate import ValidationError
 from tumble.cli import app
 from tumble.viz.chaos import TOPS, demo_chaos
 
+# The chaos demo compiles the Lyapunov spectra and the figure's integrators on a cold Numba cache (~17 CPU s).
+pytestmark = pytest.mark.slow
+
 
 def test_demo_chaos_writes_the_figure_and_separates_chaos_from_integrability(tmp_path):
     # 100 s: the integrable tops' exponents are already below 2 ln(t)/t = 0.092 1/s (measured 0.039), the

@@ -170,6 +170,7 @@ def test_demo_polhode_output_in_missing_directory_exits_2(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow  # the heavy-top demo compiles its integrators (~6 CPU s on a cold cache)
 def test_demo_top_writes_the_trajectory_and_the_figure(tmp_path):
     pytest.importorskip("tumble.viz.top")  # written alongside; skipped only while the module is missing
     result = invoke("demo", "top", "-o", tmp_path, "--duration", 0.5)
@@ -239,6 +240,7 @@ def test_extension_demo_refuses_a_missing_directory(tmp_path):
     assert "is not an existing directory" in result.output
 
 
+@pytest.mark.slow  # compiles the robot's kernels (~6 CPU s on a cold cache)
 def test_robot_torques_prints_the_published_puma_gravity_load():
     # Corke's Robotics Toolbox: gravload(qn) = [0, 31.6399, 6.0351, 0, 0.0283, 0] N m for the PUMA 560
     # at qn = [0, pi/4, pi, 0, pi/4, 0] (4 significant digits, hence 5e-5 relative)
@@ -249,6 +251,7 @@ def test_robot_torques_prints_the_published_puma_gravity_load():
     np.testing.assert_allclose(printed, [0.0, 31.6399, 6.0351, 0.0, 0.0283, 0.0], rtol=5e-5, atol=5e-5)
 
 
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_run_dispatches_a_spacecraft_scenario(tmp_path):
     out = tmp_path / "slew.nc"
     result = invoke("run", EXAMPLES / "spacecraft" / "slew_wheels.toml", "-o", out, "--quiet")
@@ -259,6 +262,7 @@ def test_run_dispatches_a_spacecraft_scenario(tmp_path):
     assert f"peak speed {peak:.4g} rad/s" in result.stdout
 
 
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_run_writes_the_mrp_disturbance_example_and_its_figure(tmp_path):
     # The command line of the example's header: exit 0, the trajectory (with the MRP integral term and the
     # disturbance torque of its [[torque]] table) and the spacecraft figure written, nothing else left.
@@ -276,6 +280,7 @@ def test_run_writes_the_mrp_disturbance_example_and_its_figure(tmp_path):
         assert f"{label} {value}" in " ".join(result.stdout.split())
 
 
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 @pytest.mark.parametrize("scenario", [EXAMPLES / "symmetric_top.toml", EXAMPLES / "spacecraft" / "slew_wheels.toml"],
                          ids=lambda p: p.stem)
 def test_run_parses_the_file_once(tmp_path, monkeypatch, scenario):
@@ -319,6 +324,7 @@ def test_cli_does_not_import_back():
 # -- tumble warmup ------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # its subprocess compiles the rigid body's rk4 (~6 CPU s on a cold cache)
 def test_warmup_compiles_what_a_new_process_then_loads_from_the_cache():
     env = {**os.environ, "PYTHONPATH": str(Path(tumble.__file__).parents[1])}
     env.pop("TUMBLE_QUIET", None)

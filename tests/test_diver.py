@@ -12,6 +12,9 @@ from tumble.variable import diver
 from tumble.viz.diver import demo_diver
 from tumble.variable.human import DE_LEVA_MALE, Human, Motion
 
+# Every test here compiles this model kind's integrators on a cold Numba cache (several CPU s each).
+pytestmark = pytest.mark.slow
+
 HUMAN = Human.de_leva()
 ARM_DROP = {"left_shoulder_abduction": Motion(np.pi, [(0.2, 0.6, 0.0)]), "right_shoulder_abduction": np.pi}
 

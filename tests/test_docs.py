@@ -270,7 +270,19 @@ FOLLOW_UP = {("README.md", "## Ten lines of Python"): _ten_lines,
              ("README.md", "## Exact motion, stability and the heavy top"): _exact_motion}
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+#: The pages whose examples compile model kinds other than the rigid body's or run demos, sweeps or the CLI's
+#: commands: seconds to two minutes of CPU each on a cold Numba cache (the README's: 126 CPU s, measured).
+SLOW_PAGES = {"README.md", *(f"docs/{name}.md" for name in (
+    "chaos", "cli", "diver", "estimation", "flexible", "frames", "gpu", "ins", "limits", "passive_stability", "robot",
+    "scenarios", "slosh", "spacecraft", "spacecraft_environment", "stability", "sweeps", "variable_inertia", "viewer"))}
+
+
+def _page_id(page):
+    return page.relative_to(ROOT).as_posix()
+
+
+@pytest.mark.parametrize("page", [pytest.param(page, marks=pytest.mark.slow) if _page_id(page) in SLOW_PAGES else page
+                                  for page in PAGES], ids=_page_id)
 def test_every_example_of_the_page_runs(page, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     matplotlib.use("Agg")

@@ -11,6 +11,9 @@ from tumble.estimation import ahrs_ekf, madgwick, mahony
 from tumble.estimation.sensors import Magnetometer
 from tumble.ins import Imu, SensorErrors
 
+# The estimation kernels (parallel over the Monte-Carlo runs) take tens of CPU s to compile on a cold Numba cache.
+pytestmark = pytest.mark.slow
+
 pytest.importorskip("ahrs")
 
 DT = 0.01                      # s, 100 Hz

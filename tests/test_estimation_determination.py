@@ -8,6 +8,9 @@ import tumble
 from tumble import attitude
 from tumble.estimation import davenport, quest, triad
 
+# The estimation kernels (parallel over the Monte-Carlo runs) take tens of CPU s to compile on a cold Numba cache.
+pytestmark = pytest.mark.slow
+
 
 def _scene(n_att: int, n_vec: int, seed: int = 7):
     """Random attitudes (n_att, 4), inertial unit vectors (n_vec, 3) and their exact body components."""

@@ -10,6 +10,9 @@ from tumble import attitude
 from tumble.estimation import mekf
 from tumble.ins import from_trajectory
 
+# The estimation kernels (parallel over the Monte-Carlo runs) take tens of CPU s to compile on a cold Numba cache.
+pytestmark = pytest.mark.slow
+
 RUNS = 200
 DT = 0.5            # gyro interval, s
 ARW = 3e-5          # rad/√s

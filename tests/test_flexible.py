@@ -14,6 +14,9 @@ from tumble._validate import ValidationError
 from tumble.flexible import FlexibleBody, Mode
 from tumble.viz.flexible import demo_flexible
 
+# Every test here compiles this model kind's integrators on a cold Numba cache (several CPU s each).
+pytestmark = pytest.mark.slow
+
 INERTIA = np.array([[2.0, 0.1, -0.05], [0.1, 3.0, 0.2], [-0.05, 0.2, 4.0]])  # kg m², body axes
 OMEGA0 = np.array([0.3, 1.0, -0.4])  # rad/s: a generic tumble
 TIGHT = dict(method="dop853", rtol=1e-12, atol=1e-12)

@@ -255,6 +255,7 @@ def test_cf4_keeps_the_unit_quaternion_without_projection(torque):
     assert np.abs(np.linalg.norm(traj.q, axis=-1) - 1.0).max() <= EPS * np.sqrt(2 * steps)
 
 
+@pytest.mark.slow  # compiles the fused and the staged cf4 block drivers (~9 CPU s on a cold cache)
 def test_fused_cf4_equals_its_stages_over_a_block_bit_for_bit():
     # A rigid body runs CF4 fused (_fused.advance: the step of a lane in registers); the block formulation,
     # stage by stage over the lanes (_cf4_step, which the other models run), then q/|q|, must round alike.
@@ -275,6 +276,7 @@ def test_fused_cf4_equals_its_stages_over_a_block_bit_for_bit():
 # -- batches -------------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # compiles the parallel batch driver of each method (~25 CPU s on a cold cache)
 @pytest.mark.parametrize("method, torque", [("splitting2", "none"), ("splitting4", "none"), ("cf4", "none"),
                                             ("cf4", "ConstantInertial")])
 @pytest.mark.parametrize("shared", [False, True], ids=["a body per member", "one body"])

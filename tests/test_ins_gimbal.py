@@ -10,6 +10,9 @@ from tumble import attitude
 from tumble.ins import GimbaledGyro, Gyroscope
 from tumble._validate import ValidationError
 
+# Every test here compiles this model kind's integrators on a cold Numba cache (several CPU s each).
+pytestmark = pytest.mark.slow
+
 # With massless gimbals the Lagrange equations are the heavy top's: the rotor must move as the
 # free gyro simulated by tumble.simulate. Both run dop853 at rtol = atol = 1e-12; measured
 # 1.3e-13 rad (attitude) and 3.9e-14 rad/s (rate) over 0.5 s.

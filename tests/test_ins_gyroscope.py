@@ -11,6 +11,9 @@ from tumble.analytic import measure_nutation
 from tumble.ins import Gyroscope
 from tumble._validate import ValidationError
 
+# Every test here compiles this model kind's integrators on a cold Numba cache (several CPU s each).
+pytestmark = pytest.mark.slow
+
 # Released at rest with its axis horizontal, the rotor precesses on average at
 # τ/(I_s ω_s) (1 − 2ε² + O(ε⁴)), ε = τ I_t/(I_s ω_s)² (from the exact heavy top,
 # tumble.analytic.HeavyTop: −1.08e-6 at ε = 7.4e-4, −1.73e-9 at ε = 2.9e-5). At

@@ -12,6 +12,9 @@ from tumble.analysis import lyapunov_exponents
 from tumble.analytic import heavy_top_energy, omega_at_energy
 from tumble.torques import Gravity
 
+# Every test here compiles the variational (Lyapunov) integrators on a cold Numba cache (~10 CPU s).
+pytestmark = pytest.mark.slow
+
 UP = [0.0, 0.0, -1.0]  # m g |r| of order 1 and moments of order 1: the time unit is about 1 s
 GENERIC = np.diag([1.0, 1.6, 2.1]), Gravity(1.0, [1.0, 0.5, 0.3], UP)  # a generic (chaotic) heavy top
 INTEGRABLE = {

@@ -18,6 +18,9 @@ from tumble.variable import Human, Motion, VariableBody
 
 from helpers import read_by
 
+# Every test here compiles the integrators of several model kinds on a cold Numba cache (tens of CPU s).
+pytestmark = pytest.mark.slow
+
 INERTIA = np.array([[2.0, 0.1, -0.05], [0.1, 3.0, 0.2], [-0.05, 0.2, 4.0]])  # kg m², body axes
 OMEGA0 = np.array([0.3, 1.0, -0.4])  # rad/s: a generic tumble
 Q0 = attitude.normalize([0.9, 0.1, -0.3, 0.2])  # a generic attitude, unit (simulate warns on one that is not)

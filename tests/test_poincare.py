@@ -9,6 +9,9 @@ from tumble._validate import ValidationError
 from tumble.analysis import poincare_section
 from tumble.analytic import HeavyTop
 
+# Every test here compiles the variational (Lyapunov) integrators on a cold Numba cache (~10 CPU s).
+pytestmark = pytest.mark.slow
+
 # m g l = I₃ = 1: nutation period 4.64 s, spin 3 rad/s. With the body z axis along the symmetry axis, γ₃ = cos θ
 # = u(t), known in closed form (HeavyTop.u): the section γ₃ = (u₁ + u₂)/2 is crossed once upwards per period.
 TOP = HeavyTop(I1=2.0, I3=1.0, mass=1.0, length=1.0, g=1.0, theta0=0.6, theta_dot0=0.5, phi_dot0=-0.3, spin=3.0)

@@ -170,6 +170,7 @@ def test_simulate_on_any_rates_is_finite_or_a_clean_error(omega0, dt):
 MODELS = sorted(CASES)
 
 
+@pytest.mark.slow  # compiles each model kind's rk4 (tens of CPU s on a cold cache)
 @pytest.mark.parametrize("name", MODELS)
 def test_every_model_is_finite_and_keeps_its_invariants_or_refuses_naming_the_field(name):
     make, state, span, dt, tolerances = CASES[name]

@@ -150,6 +150,7 @@ EXPLORER = (tumble.examples.directory() / "spacecraft" / "explorer1.toml").read_
 """)
 
 
+@pytest.mark.slow  # the plan compiles the spacecraft of the file (~80 CPU s on a cold cache)
 def test_a_scenario_whose_undispersed_table_changed_has_another_digest(tmp_path):
     # a dispersed non-state key (the damper's damping) rebuilds the model per sample from the file: the
     # recorded settings name the file and the keys only, the digest holds every table of it (here the
@@ -183,6 +184,7 @@ def test_a_python_callback_pickled_to_another_process_registers_there_under_its_
     np.testing.assert_allclose(copy(0.5, [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0]), [0.0, 0.015, 0.2], rtol=1e-15)
 
 
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_a_spacecraft_pickled_after_compiling_its_python_law_compiles_it_again_with_its_own_slot():
     # the compiled programs (a cached property) held the client's slot number: they are left out of the pickle
     from tumble.spacecraft import Spacecraft, pyramid_wheels
@@ -197,6 +199,7 @@ def test_a_spacecraft_pickled_after_compiling_its_python_law_compiles_it_again_w
     assert slots == [arrived.callback.slot] and [p.kind for p in compiled] == [p.kind for p in copy._programs]
 
 
+@pytest.mark.slow  # a sweep on a Dask worker process, compiling on a cold cache (~6 CPU s)
 def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in_this_one(scheduler_file):
     # the function's slot was a number of the client's registry: the worker raised KeyError, or called another
     # function registered there under the same number
@@ -223,6 +226,7 @@ def test_a_summed_torque_with_a_python_function_sweeps_on_a_worker_process_as_in
 # -- 4. a lost chunk file is computed again ---------------------------------------------
 
 
+@pytest.mark.slow  # a sweep on Dask worker processes, each compiling on a cold cache (~8 CPU s)
 def test_a_complete_store_that_lost_a_chunk_file_computes_that_chunk_again(tmp_path):
     store = tmp_path / "mc.zarr"
     outcomes = {**OUTCOMES, "never": CrossingTime(Component("omega", 2), above=100.0)}  # NaN in every sample

@@ -6,6 +6,10 @@ import pytest
 import tumble
 from tumble import ValidationError, robot
 
+# The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
+# integrators, ~50 CPU s on a cold Numba cache); the robot's modules run on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
+
 ROBOTS = tumble.examples.directory() / "robots"
 EXAMPLES = ["planar_2link.toml", "puma560.toml", "panda.toml", "panda.urdf"]
 

@@ -14,6 +14,10 @@ from tumble.cli.robot import app
 
 from helpers import read_by
 
+# The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
+# integrators, ~50 CPU s on a cold Numba cache); the robot's modules run on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
+
 ROBOTS = tumble.examples.directory() / "robots"
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "robot.md"
 Q0 = np.array([0.1, 0.5, -0.3, 0.2, 0.4, -0.1])

@@ -6,10 +6,15 @@ DOP853. Tumble integrates the 3-D floating-base tree (Featherstone's floating-ba
 """
 
 import numpy as np
+import pytest
 from scipy.integrate import solve_ivp
 
 import tumble
 from tumble import robot
+
+# The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
+# integrators, ~50 CPU s on a cold Numba cache); the robot's modules run on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
 
 HUB = dict(mass=50.0, inertia=np.diag([20.0, 25.0, 8.0]))
 B, L1 = 0.5, 1.0  # mount offset on the hub (m), length of link 1 (m)

@@ -12,6 +12,10 @@ import tumble
 from robot_oracle import ERD, Pair, close
 from tumble import ValidationError, robot
 
+# The tests here compile or share the robot's kernels (tumble.kernels.featherstone and the chain model's
+# integrators, ~50 CPU s on a cold Numba cache); the robot's modules run on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
+
 pin = pytest.importorskip("pinocchio")
 
 ROBOTS = tumble.examples.directory() / "robots"

@@ -7,6 +7,10 @@ from scipy.spatial.transform import Rotation
 import tumble
 from tumble import RigidBody, ValidationError, robot
 
+# The tests here compile or share the robot's kernels (~30 CPU s on a cold Numba cache); the robot's modules run
+# on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
+
 ROBOTS = tumble.examples.directory() / "robots"
 # Same arm through two descriptions: differences are rounding (measured ≤ 4e-15).
 TOL = 1e-12

@@ -15,6 +15,10 @@ from robot_oracle import ERD, Pair, close
 from tumble import ValidationError, robot
 from tumble.robot.urdf import UrdfRepairWarning
 
+# The tests here compile or share the robot's kernels (~30 CPU s on a cold Numba cache); the robot's modules run
+# on one xdist worker (tests/conftest.py).
+pytestmark = pytest.mark.slow
+
 pin = pytest.importorskip("pinocchio")
 
 URDFS = sorted(str(p.relative_to(ERD)) for p in ERD.rglob("*.urdf"))

@@ -262,6 +262,7 @@ def test_batch_equals_single_runs(method, torque, random_batch):
         assert np.abs(state(batch)[:, k] - state(single)).max() <= TOL_BATCH
 
 
+@pytest.mark.slow  # compiles the parallel rk4 batch driver (~7 CPU s on a cold cache)
 @pytest.mark.parametrize("extra", [1, 3], ids=["lone body in the last block", "partial last block"])
 @pytest.mark.parametrize("torque", ["torque-free", "ConstantInertial + Tabulated"])
 def test_rk4_batch_across_blocks_equals_single_runs(torque, extra, random_batch):

@@ -15,6 +15,9 @@ from tumble.viz.slosh import demo_slosh
 
 from helpers import read_by
 
+# Every test here compiles this model kind's integrators on a cold Numba cache (several CPU s each).
+pytestmark = pytest.mark.slow
+
 HUB = tumble.RigidBody(np.array([[3.0, 0.1, 0.0], [0.1, 4.0, -0.2], [0.0, -0.2, 5.0]]), mass=10.0)
 OMEGA0 = np.array([0.3, 1.0, -0.4])  # rad/s: a generic tumble
 TIGHT = dict(method="dop853", rtol=1e-12, atol=1e-12)

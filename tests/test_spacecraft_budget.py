@@ -30,6 +30,7 @@ def three_hours():
     return orbit, env, momentum_budget(SmallSat(), env)
 
 
+@pytest.mark.slow  # simulates a spacecraft: compiles it (~40 CPU s on a cold cache)
 def test_gravity_gradient_builds_pitch_momentum_at_exactly_3_n2_jxz(three_hours):
     # Earth pointing, body z nadir: τ = 3 μ/|r|³ ẑ × (J ẑ) = 3 n² (−J_yz, J_xz, 0), n² = μ/|r|³, constant in the
     # body, and ω × J ω = ω² (J_yz, 0, −J_xy) = 0: h_y = 3 n² J_xz t exactly (RK4 on a constant rate)

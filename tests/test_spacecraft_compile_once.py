@@ -10,6 +10,7 @@ from datetime import datetime, timezone
 
 import numba
 import numpy as np
+import pytest
 from numba.core import event
 
 import tumble
@@ -18,6 +19,11 @@ from tumble.kernels import spacecraft as kernel
 from tumble.spacecraft import (CMGCluster, Environment, MRPFeedback, Orbit, QuaternionPD, ResidualDipole,
                                Spacecraft, pyramid_wheels)
 from tumble.spacecraft.surfaces import Drag, SolarPressure, box_facets
+
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
 T = np.linspace(0.0, 2.0, 3)

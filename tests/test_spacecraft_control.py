@@ -12,6 +12,11 @@ from tumble import attitude, torques
 from tumble.spacecraft import (ConstantTorque, MRPFeedback, Orbit, PythonLaw, QuaternionPD, ReactionWheel,
                                Spacecraft, WheelTorques, pyramid_wheels)
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 # Every test that simulates compiles a spacecraft model type on first use (30–60 s with a cold Numba cache on
 # the 2 shared cores of the development machine, under 1 s warm).
 SLOW = pytest.mark.slow

@@ -20,6 +20,11 @@ from tumble.spacecraft import (ConstantTorque, FlightSoftware, QuaternionPD, Rea
                               pyramid_wheels)
 from tumble.viz import estimation as demo
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 PERFECT = FlightSoftware(gyro_arw=1e-5, gyro_rrw=1e-8, star_tracker_sigma=5e-5, delay=0, sensor_noise=False)
 #: Measured: 2.2e-16 in q, 4.4e-17 rad/s in ω over 40 s (the estimate equals the truth to round-off).
 ROUND_OFF = 1e-13

@@ -9,8 +9,9 @@ from tumble.spacecraft import (DipoleField, Magnetorquers, MomentumDumping, Orbi
                                pyramid_wheels)
 from tumble.scenario import load
 
-# Every test here compiles a spacecraft model type on first use (30–40 s with a cold Numba cache
-# on 2 shared cores, under 1 s warm).
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
 pytestmark = pytest.mark.slow
 
 INERTIA = np.array([[30.0, 0.5, 0.0], [0.5, 25.0, -0.3], [0.0, -0.3, 15.0]])

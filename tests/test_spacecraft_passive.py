@@ -12,6 +12,11 @@ from tumble.viz.passive import gravity_gradient_stability_figure
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
 from tumble.torques import GravityGradient
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 ORBIT = Orbit.circular(700e3)
 N = ORBIT.mean_motion
 # Body axes: 1 roll (along-track), 2 pitch (minus orbit normal), 3 yaw (nadir).

@@ -13,6 +13,11 @@ from tumble.spacecraft import damper as d
 from tumble.spacecraft import passive
 from tumble.viz.passive import demo_explorer1
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 # A scaled Explorer 1: prolate hub (spin axis z the minor axis), damper 2 % of
 # the transverse moment, tuned for the spin (time constant 87 s instead of
 # Explorer 1's minutes, so the run is short).

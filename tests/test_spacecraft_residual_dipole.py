@@ -15,6 +15,11 @@ from tumble import ValidationError, attitude
 from tumble.scenario import parse_scenario
 from tumble.spacecraft import ResidualDipole, Spacecraft
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 MOMENTS = np.array([2.0, 3.0, 4.0])     # kg·m²
 DIPOLE, FIELD = 2.0, 3e-5               # A·m², T
 THETA0 = 2.0                            # rad: a large swing, far from the harmonic limit

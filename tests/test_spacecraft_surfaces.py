@@ -14,6 +14,11 @@ from tumble.kernels import spacecraft as _kernel
 from tumble.spacecraft import Environment, Orbit, ResidualDipole, Spacecraft
 from tumble.spacecraft.surfaces import SOLAR_IRRADIANCE, Drag, Facet, SolarPressure, box_facets
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 AU, LIGHT_SPEED = 149597870700.0, 299792458.0
 EPOCH = datetime(2026, 3, 20, 12, 0, tzinfo=timezone.utc)
 ORBIT = Orbit.circular(400e3, np.radians(51.6), raan=1.0)

@@ -16,6 +16,11 @@ from tumble.body import RigidBody
 from tumble.spacecraft import (QuaternionPD, RateDamping, ReactionWheel, SaturationWarning, Spacecraft,
                                pyramid_wheels)
 
+# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
+# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# worker (tests/conftest.py, KINDS), so that one process pays it.
+pytestmark = pytest.mark.slow
+
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
 WHEEL_INERTIA = 0.02
 

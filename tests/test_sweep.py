@@ -238,6 +238,7 @@ def test_outcome_percentiles_are_over_the_samples_where_the_event_happened():
                                   np.percentile(values[reached], ds.percentile.values))
 
 
+@pytest.mark.slow  # compiles the spacecraft (~35 CPU s on a cold cache)
 def test_a_model_built_per_sample_runs_member_by_member(tmp_path):
     # a spacecraft with a dispersed damper: no batched form, so one simulate per sample inside the chunk
     from tumble.spacecraft import Spacecraft, SphericalDamper

@@ -24,6 +24,9 @@ from helpers import dask_processes, stop
 import tumble
 from tumble.sweeps import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
 
+# Every test here starts a Dask scheduler and worker processes, each importing tumble (seconds of CPU each).
+pytestmark = pytest.mark.slow
+
 distributed = pytest.importorskip("distributed")
 
 BODY = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))

@@ -11,6 +11,9 @@ import tumble
 from tumble import attitude
 from tumble.variable import VariableBody, shape_power
 
+# Every test here compiles this model kind's integrators on a cold Numba cache (several CPU s each).
+pytestmark = pytest.mark.slow
+
 # dop853 tolerances of every run here (each distinct setting does not cost a compile; a method does)
 RTOL = ATOL = 1e-12
 

@@ -27,6 +27,9 @@ from tumble import attitude, robot
 from tumble.spacecraft import MRPFeedback, ReactionWheel, Spacecraft
 from tumble.viewer import Cylinder
 
+# Every test here opens pages in Chromium and simulates a spacecraft or a robot arm on a cold Numba cache.
+pytestmark = pytest.mark.slow
+
 ROBOTS = tumble.examples.directory() / "robots"
 CHROMIUM, DRIVER = "/usr/bin/chromium", "/usr/bin/chromedriver"
 # Chromium offline: no sandbox (root in CI), no GPU (software GL through SwiftShader for WebGL), and every

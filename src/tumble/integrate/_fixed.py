@@ -160,7 +160,8 @@ class FixedSteps(Driver):
 
     Its plan is :func:`landing_steps` for the whole run (so a run that needs more than ``max_steps`` is
     refused before it starts). A lone body runs on its state vector (:func:`run_one`); a batch runs in
-    blocks of :data:`LANES`, in parallel over the cores (:func:`run_batch`) unless ``serial``.
+    blocks of :data:`LANES`, in parallel over the cores (:func:`run_batch`) unless ``serial`` or the batch is
+    one block (its one task runs on one core anyway, and the parallel driver is not compiled for it).
     """
 
     def __init__(self, scheme: NamedTuple) -> None:
@@ -177,7 +178,7 @@ class FixedSteps(Driver):
         t = t[lo:hi + 1]
         if y.shape[0] == 1:
             run_one(self.scheme, model, y, t, m, h, out, stats)
-        elif serial:
+        elif serial or y.shape[0] <= LANES:
             for k in range(-(-y.shape[0] // LANES)):
                 run_block(self.scheme, model, k, y, t, m, h, out, stats)
         else:

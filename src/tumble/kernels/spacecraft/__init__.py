@@ -257,8 +257,9 @@ def _sample_overload(model, t, y):
     _, sense, sample, _ = _assemble(1, _python(model))
 
     def impl(model, t, y):
-        sense(model, t, y, 0)
-        sample(model, t, y, 0)
+        for j in range(1):  # j an int64, as in the projection: a literal 0 would compile these once more
+            sense(model, t, y, j)
+            sample(model, t, y, j)
 
     return impl
 
