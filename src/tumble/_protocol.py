@@ -196,6 +196,7 @@ CAPABILITIES = {
     "free_flow": "the closed-form motion of a free rigid body, with torque kicks",
     "torque_free": "a rigid body without torque",
     "cuda": "compiled functions that run on an NVIDIA GPU (device='cuda')",
+    "rigid_fields": "the fields of rigid bodies in principal axes that the GPU's fused RK4 kernel reads",
 }
 
 

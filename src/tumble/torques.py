@@ -446,7 +446,7 @@ def evaluate_compiled(t: float, qw: float, qx: float, qy: float, qz: float, w1: 
     return t1, t2, t3
 
 
-def add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):  # pragma: no cover
+def _add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):  # pragma: no cover
     """``(t1, t2, t3)`` plus the torque (N·m) of each Python callback of the torque program in row ``row``
     of ``P``, added in the program's order.
 
@@ -458,7 +458,7 @@ def add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes): 
     raise NotImplementedError("compiled code only")
 
 
-@overload(add_python_terms, target="cpu", jit_options={"cache": True})
+@overload(_add_python_terms, target="cpu", jit_options={"cache": True})
 def _add_python_terms_cpu(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
     def impl(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
         for k in range(0, codes.shape[0], 2):
@@ -472,7 +472,7 @@ def _add_python_terms_cpu(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, cod
     return impl
 
 
-@overload(add_python_terms, target="cuda")
+@overload(_add_python_terms, target="cuda")
 def _add_python_terms_gpu(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
     return lambda t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes: (t1, t2, t3)
 
@@ -482,7 +482,7 @@ def evaluate(t: float, qw: float, qx: float, qy: float, qz: float, w1: float, w2
              row: int, codes: np.ndarray) -> tuple[float, float, float]:
     """Run the torque program in row ``row`` of ``P``: the torque (N·m) in the axes it was compiled for.
 
-    The compiled terms (:func:`evaluate_compiled`), then the Python callbacks (:func:`add_python_terms`).
+    The compiled terms (:func:`evaluate_compiled`), then the Python callbacks (:func:`_add_python_terms`).
     """
     t1, t2, t3 = evaluate_compiled(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
-    return add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)
+    return _add_python_terms(t1, t2, t3, t, qw, qx, qy, qz, w1, w2, w3, P, row, codes)

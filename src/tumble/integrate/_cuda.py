@@ -302,9 +302,7 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.n
     t_out = np.ascontiguousarray(t_out, dtype=np.float64)
     m, h = landing_steps(t_out, float(dt), MAX_STEPS if max_steps is None else max_steps)
     steps = y0.shape[0] * int(m.sum())
-    from tumble.kernels.rigid import RigidModel  # the rigid body's own kernel: its fields
-
-    if method == "rk4" and isinstance(model, RigidModel):
+    if method == "rk4" and "rigid_fields" in model.provides:  # rigid bodies: the fused kernel reads their fields
         return _solve_rigid_rk4(model, y0, t_out, m, h), steps
     work = tuple(cuda.device_array((y0.shape[0], *w.shape)) for w in _workspace_of_one(SCHEMES[method], model,
                                                                                        y0[0].copy()))
@@ -318,7 +316,7 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.n
 def _solve_rigid_rk4(model, y0, t_out, m, h) -> np.ndarray:
     """The states (len(t_out), N, 7) of the rigid bodies of ``model`` by :func:`_rk4_kernel`.
 
-    It reads the fields of the :class:`~tumble.kernels.rigid.RigidModel`:
+    It reads the fields of a kernel that provides ``"rigid_fields"`` (:class:`tumble.kernels.rigid.RigidModel`):
 
     coefficients : (6, N or 1) Euler coefficients ``(c₁, c₂, c₃, 1/I₁, 1/I₂, 1/I₃)``,
                    one column per body or one shared

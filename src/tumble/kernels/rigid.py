@@ -42,9 +42,10 @@ class RigidModel(NamedTuple):
     @property
     def provides(self) -> frozenset[str]:
         """Capabilities (:data:`tumble._protocol.CAPABILITIES`): every one; ``"torque_free"`` only without
-        a torque program, ``"cuda"`` only without a Python torque function."""
+        a torque program, ``"cuda"`` (and ``"rigid_fields"``, read by the GPU's fused RK4 kernel) only without a
+        Python torque function."""
         free = {"torque_free"} if self.codes is None else set()
-        gpu = set() if self.calls_python else {"cuda"}
+        gpu = set() if self.calls_python else {"cuda", "rigid_fields"}
         return frozenset({"rhs", "body_rate", "free_flow", *free, *gpu})
 
     @property
