@@ -35,7 +35,7 @@ derived above for the axisymmetric body. For a real body
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -148,7 +148,8 @@ def simulate_dive(human: Human, angles: Mapping | None, *, momentum: float, t: A
     if method == "dop853":
         solver = {"rtol": 1e-10, "atol": 1e-10, **solver}
     traj = simulate(body, omega0, q0=q0, t=times, method=method, **solver)
-    return Dive(traj, orientation_angles(traj.q, momentum_inertial), float(momentum))
+    q = cast(np.ndarray, traj.q)  # a moving human has an attitude
+    return Dive(traj, orientation_angles(q, momentum_inertial), float(momentum))
 
 
 def _both(prefix, motion):
