@@ -8,29 +8,22 @@ tumble.sweep.MODULE import NAME`` give the module ``tumble.sweeps.MODULE``.
 
 For that, importing this module puts in its place (``sys.modules``, and so the
 attribute ``tumble.sweep`` that ``import tumble.sweep`` binds) one
-:class:`_Sweep`: the function, which also answers for the package's names, and
-a finder that gives the package's modules under their old names. In 0.5 this
+:class:`_Sweep`: the function, which also answers for the package's names; the
+package's modules are found under their old names by :func:`tumble._moved.moved_modules`. In 0.5 this
 file goes and ``tumble.sweep`` is :func:`tumble.sweeps.sweep` itself.
 """
 
 from __future__ import annotations
 
 import functools
-import importlib
-import importlib.abc
-import importlib.util
+import pkgutil
 import sys
-import warnings
 from typing import Any
 
 from tumble import sweeps
+from tumble._moved import deprecated, moved_modules
 
 _OLD, _NEW = "tumble.sweep", "tumble.sweeps"
-
-
-def _deprecated(old: str, new: str) -> None:
-    warnings.warn(f"{old} is deprecated and will be removed in tumble 0.5: use {new}", DeprecationWarning,
-                  stacklevel=3)
 
 
 class _Sweep:
@@ -50,23 +43,10 @@ class _Sweep:
         if name.startswith("__"):  # what tools ask of any object: none of the package's names
             raise AttributeError(name)
         value = getattr(sweeps, name)
-        _deprecated(f"{_OLD}.{name}", f"{_NEW}.{name}")
+        deprecated(f"{_OLD}.{name}", f"{_NEW}.{name}")
         return value
 
 
-class _Modules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
-    """Finds the module ``tumble.sweep.MODULE`` as ``tumble.sweeps.MODULE`` itself (deprecated)."""
-
-    def find_spec(self, fullname, path, target=None):
-        if not fullname.startswith(_OLD + ".") or importlib.util.find_spec(_NEW + fullname[len(_OLD):]) is None:
-            return None
-        return importlib.util.spec_from_loader(fullname, self)
-
-    def exec_module(self, module) -> None:
-        new = _NEW + module.__name__[len(_OLD):]
-        _deprecated(module.__name__, new)
-        sys.modules[module.__name__] = importlib.import_module(new)  # the import system returns this one
-
-
-sys.meta_path.append(_Modules())
+# the package's modules under their old names (not tumble.sweep itself, this file)
+moved_modules({f"{_OLD}.{m.name}": f"{_NEW}.{m.name}" for m in pkgutil.iter_modules(sweeps.__path__)})
 sys.modules[__name__] = _Sweep(__spec__)  # type: ignore[assignment]
