@@ -1,7 +1,7 @@
 """Where the non-spinning frame pays: work–precision of AxisymmetricBody against the body-frame model.
 
 Two axisymmetric heavy tops (``tumble.torques.Gravity`` on a pivot, inertia about the pivot), each run by
-``tumble.frames.AxisymmetricBody`` (non-spinning frame, κ = 0) and by the rigid body itself (body frame):
+``tumble.axisymmetric.AxisymmetricBody`` (non-spinning frame, κ = 0) and by the rigid body itself (body frame):
 
 * ``gyroscope``: a disk rotor (I_s = 2e-3, I_t = 1.2e-3 kg m² about the pivot, m g l = 0.098 N m) spun at
   1e4 rad/s and released at 60° from the vertical: it precesses at m g l/(I_s ω₃) = 4.9e-3 rad/s and nutates
@@ -33,7 +33,7 @@ import tumble
 from _timing import best_of
 from tumble import attitude
 from tumble.analytic import HeavyTop
-from tumble.frames import AxisymmetricBody
+from tumble.axisymmetric import AxisymmetricBody
 from tumble.trajectory import write_atomic
 
 CASES = {

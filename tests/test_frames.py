@@ -1,4 +1,4 @@
-"""The axisymmetric body integrated in a principal frame (tumble.frames, tumble.dynamics.euler_frame).
+"""The axisymmetric body integrated in a principal frame (tumble.axisymmetric, tumble.dynamics.euler_frame).
 
 Compiled specialisations kept to four: the frame model with dop853, torque-free and with the heavy-top
 gravity torque, and its references, the rigid model's closed form ("exact", torque-free) and dop853 with
@@ -11,7 +11,7 @@ import pytest
 import tumble
 from tumble import attitude, dynamics
 from tumble.analytic import HeavyTop, axis_motion, measure_nutation
-from tumble.frames import AxisymmetricBody
+from tumble.axisymmetric import AxisymmetricBody
 
 # A projectile-like prolate body (I_s/I_t = 0.2) described in tilted body axes, so that the symmetry axis is
 # none of them: the frame model must find it (the prolate case cycles the principal axes).

@@ -35,7 +35,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("kernels", ("tumble.kernels",)),
     ("integrate", ("tumble.integrate",)),
     ("front door", ("tumble", "tumble.model", "tumble.rigid", "tumble.simulate")),
-    ("domain", ("tumble.analytic", "tumble.analysis", "tumble.flexible", "tumble.frames", "tumble.ins",
+    ("domain", ("tumble.analytic", "tumble.analysis", "tumble.axisymmetric", "tumble.flexible", "tumble.ins",
                 "tumble.lorentz", "tumble.robot", "tumble.slosh", "tumble.spacecraft", "tumble.variable")),
     ("sweeps", ("tumble.ensemble", "tumble.sweep", "tumble.sweeps")),
     ("scenario, viz, viewer", ("tumble.scenario", "tumble.viz", "tumble.viewer", "tumble.examples")),

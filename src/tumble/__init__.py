@@ -16,6 +16,7 @@ implements :class:`tumble.Model` and runs through it.
 """
 
 from tumble._cache import ensure_writable_cache, use_content_key
+from tumble._moved import moved_modules
 
 ensure_writable_cache()  # before any compiled module: a read-only install must still import
 use_content_key()  # and compiled code is stale when any source compiled into it changes (docs/architecture.md)
@@ -29,6 +30,9 @@ from tumble.limits import RigidityWarning  # noqa: E402
 from tumble.simulate import Model, as_model, simulate  # noqa: E402
 from tumble.trajectory import Trajectory, load  # noqa: E402
 from tumble.viz import trajectory as _views  # noqa: E402, F401 - fills Trajectory's figure, page and tables
+
+# Modules renamed in 0.4: each old name imports the new module itself, with a DeprecationWarning naming it, until 0.5.
+moved_modules({"tumble.frames": "tumble.axisymmetric"})
 
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:

@@ -25,7 +25,7 @@ vanishes, which every Runge–Kutta method integrates exactly, and the frame
 only follows the slow precession and the nutation, whose amplitude sets the
 step. Where this pays and where it does not: ``docs/frames.md``.
 
-The compiled kernel is :mod:`tumble.kernels.frame`; the model runs through
+The compiled kernel is :mod:`tumble.kernels.axisymmetric`; the model runs through
 :func:`tumble.simulate` with ``dop853`` or ``rk4`` and any torque of
 :mod:`tumble.torques` (body axes, evaluated at the body's attitude and rate).
 """
@@ -37,7 +37,7 @@ import numpy as np
 from tumble import attitude, limits, torques
 from tumble._validate import ValidationError, as_array
 from tumble.body import RigidBody
-from tumble.kernels import frame as _kernel
+from tumble.kernels import axisymmetric as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra
 
@@ -119,7 +119,7 @@ class AxisymmetricBody(Model):
         )
 
     def compile(self, torque: torques.TorqueLike, t0: float) -> _kernel.FrameModel:
-        """The compiled model (:class:`tumble.kernels.frame.FrameModel`) under a torque (body axes)."""
+        """The compiled model (:class:`tumble.kernels.axisymmetric.FrameModel`) under a torque (body axes)."""
         return _kernel.build(self.transverse, self.axial, self.frame_spin, self.axes,
                              torques.as_torque_model(torque))
 

@@ -1,0 +1,91 @@
+"""Modules renamed in 0.4 keep their old names until tumble 0.5: importing one, or a name from it, gives the new
+module's very object, with one DeprecationWarning per old module that names its replacement; an object pickled
+under the old module path loads.
+
+The spellings run in a new Python process (``sys.executable``), since an import changes the process for good;
+before each one the process forgets the old names it imported (``sys.modules`` and the attribute of the parent
+package), as a process that never imported them but has loaded the new modules.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+SPELLINGS = textwrap.dedent("""
+    import importlib, json, sys, warnings
+    import tumble
+
+    def forget(old):
+        for name in [name for name in sys.modules if name == old or name.startswith(old + ".")]:
+            del sys.modules[name]
+        parent, _, child = old.rpartition(".")
+        vars(sys.modules[parent]).pop(child, None)
+
+    results = {}
+    for code, olds, news, check in json.loads(sys.argv[1]):
+        for old in olds:
+            forget(old)
+        for new in news:
+            importlib.import_module(new)
+        namespace = {"tumble": tumble}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            exec(code, namespace)
+        said = [str(w.message) for w in caught if w.category is DeprecationWarning]
+        results[code] = [eval(check, namespace), said]
+    print(json.dumps(results))
+""")
+
+
+def _said(*renames: tuple[str, str]) -> list[str]:
+    return [f"{old} is deprecated and will be removed in tumble 0.5: use {new}" for old, new in renames]
+
+
+def _pickled_under(old: str, new: str, value: str) -> str:
+    """Code that pickles ``value`` (protocol 2, whose globals are text), names the module ``old`` in place of
+    ``new`` (as a pickle written before the rename does), and loads it back as ``got``."""
+    return (f"import pickle\ndata = pickle.dumps({value}, protocol=2)\n"
+            f"assert b'c{new}\\n' in data\n"
+            f"got = pickle.loads(data.replace(b'c{new}\\n', b'c{old}\\n'))\nwant = {value}")
+
+
+FRAMES = ("tumble.frames", "tumble.axisymmetric")
+PRISM = "tumble.RigidBody([[2.0, 0, 0], [0, 2.0, 0], [0, 0, 3.0]])"
+
+#: (code that binds ``got``, the old modules it imports, the new ones, the check, the warnings it gives)
+CASES = [
+    ("import tumble.frames\ngot = tumble.frames", [FRAMES[0]], [FRAMES[1]], "got is tumble.axisymmetric",
+     _said(FRAMES)),
+    ("from tumble.frames import AxisymmetricBody as got", [FRAMES[0]], [FRAMES[1]],
+     "got is tumble.axisymmetric.AxisymmetricBody", _said(FRAMES)),
+]
+
+
+@pytest.fixture(scope="module")
+def spelled() -> dict[str, list]:
+    """Each case's code -> [its check, the DeprecationWarnings it gave], from one new process."""
+    cases = json.dumps([case[:4] for case in CASES])
+    out = subprocess.run([sys.executable, "-c", SPELLINGS, cases], capture_output=True, text=True, timeout=120,
+                         check=True)
+    return json.loads(out.stdout.splitlines()[-1])
+
+
+@pytest.mark.parametrize(("code", "said"), [(case[0], case[4]) for case in CASES],
+                         ids=[case[0].splitlines()[-1] if "pickle" not in case[0] else "pickle " + case[1][0]
+                              for case in CASES])
+def test_an_old_module_name_gives_the_new_module_with_a_warning_naming_it(spelled, code, said):
+    same, warned = spelled[code]
+    assert same
+    assert warned == said
+
+
+def test_a_name_that_no_module_had_is_still_a_module_not_found_error():
+    out = subprocess.run([sys.executable, "-c", "import tumble.frames_of_reference"], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 1
+    assert out.stderr.splitlines()[-1] == "ModuleNotFoundError: No module named 'tumble.frames_of_reference'"
