@@ -5,7 +5,7 @@ import pytest
 
 import tumble
 from tumble import attitude
-from tumble.analysis import flip_times, intermediate_rate
+from tumble.measure import flip_times, intermediate_rate
 
 # Linear interpolation of a linear signal is exact up to rounding of times ~10 s.
 ROUNDING = 1e-14  # s

@@ -1,4 +1,4 @@
-"""Lyapunov exponents of heavy tops (tumble.analysis.lyapunov_exponents): integrable tops, a chaotic top, spectrum.
+"""Lyapunov exponents of heavy tops (tumble.measure.lyapunov_exponents): integrable tops, a chaotic top, spectrum.
 
 The tangent kernel runs through the engine (tumble.integrate.Run), with the drivers tumble.simulate uses.
 """
@@ -8,7 +8,7 @@ import pytest
 
 from tumble import attitude
 from tumble._validate import ValidationError
-from tumble.analysis import lyapunov_exponents
+from tumble.measure import lyapunov_exponents
 from tumble.analytic import heavy_top_energy, omega_at_energy
 from tumble.torques import Gravity
 

@@ -31,7 +31,7 @@ from numba import typeof
 import tumble
 from tumble import analytic, attitude, integrate
 from tumble._validate import ValidationError
-from tumble.analysis import lyapunov_exponents
+from tumble.measure import lyapunov_exponents
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 

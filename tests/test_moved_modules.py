@@ -55,6 +55,7 @@ def _pickled_under(old: str, new: str, value: str) -> str:
 
 
 FRAMES = ("tumble.frames", "tumble.axisymmetric")
+ANALYSIS = ("tumble.analysis", "tumble.measure")
 PRISM = "tumble.RigidBody([[2.0, 0, 0], [0, 2.0, 0], [0, 0, 3.0]])"
 
 #: (code that binds ``got``, the old modules it imports, the new ones, the check, the warnings it gives)
@@ -63,6 +64,12 @@ CASES = [
      _said(FRAMES)),
     ("from tumble.frames import AxisymmetricBody as got", [FRAMES[0]], [FRAMES[1]],
      "got is tumble.axisymmetric.AxisymmetricBody", _said(FRAMES)),
+    ("got = tumble.analysis.lyapunov_exponents", [ANALYSIS[0]], [ANALYSIS[1]],
+     "got is tumble.measure.lyapunov_exponents", _said(ANALYSIS)),
+    ("from tumble.analysis import poincare_section as got", [ANALYSIS[0]], [ANALYSIS[1]],
+     "got is tumble.measure.poincare_section", _said(ANALYSIS)),
+    ("from tumble.analysis._flips import flip_times as got", [ANALYSIS[0]], [ANALYSIS[1]],
+     "got is tumble.measure.flip_times", _said(ANALYSIS, (f"{ANALYSIS[0]}._flips", f"{ANALYSIS[1]}._flips"))),
 ]
 
 

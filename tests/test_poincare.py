@@ -1,4 +1,4 @@
-"""Poincaré sections (tumble.analysis.poincare_section): crossings of the exact Lagrange top, named rules."""
+"""Poincaré sections (tumble.measure.poincare_section): crossings of the exact Lagrange top, named rules."""
 
 import numpy as np
 import pytest
@@ -6,7 +6,7 @@ from scipy.optimize import brentq
 
 import tumble
 from tumble._validate import ValidationError
-from tumble.analysis import poincare_section
+from tumble.measure import poincare_section
 from tumble.analytic import HeavyTop
 
 # Every test here compiles the variational (Lyapunov) integrators on a cold Numba cache (~10 CPU s).

@@ -5,7 +5,7 @@ import pytest
 
 import tumble
 from tumble import attitude
-from tumble.analysis import flip_times as measured_flip_times
+from tumble.measure import flip_times as measured_flip_times
 from tumble.analytic import _stability as stability
 from tumble.analytic._free import free_parameters, torque_free
 

@@ -32,13 +32,14 @@ from tumble.trajectory import Trajectory, load  # noqa: E402
 from tumble.viz import trajectory as _views  # noqa: E402, F401 - fills Trajectory's figure, page and tables
 
 # Modules renamed in 0.4: each old name imports the new module itself, with a DeprecationWarning naming it, until 0.5.
-moved_modules({"tumble.frames": "tumble.axisymmetric"})
+moved_modules({"tumble.frames": "tumble.axisymmetric", "tumble.analysis": "tumble.measure"})
 
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
-# `tumble.analytic.torque_free(...)` works after a plain `import tumble`.
-_LAZY = ("analytic", "viz", "scenario", "analysis", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep", "sweeps", "examples", "viewer", "estimation")
+# `tumble.analytic.torque_free(...)` works after a plain `import tumble`; so do the old names of the renamed
+# packages (`tumble.analysis`), with their warning.
+_LAZY = ("analytic", "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
+         "robot", "sweep", "sweeps", "examples", "viewer", "estimation", "analysis")
 
 
 def __getattr__(name):
@@ -52,7 +53,6 @@ __all__ = [
     "Model",
     "RigidBody",
     "RigidityWarning",
-    "analysis",
     "analytic",
     "as_model",
     "SolverError",
@@ -68,6 +68,7 @@ __all__ = [
     "integrate",
     "limits",
     "load",
+    "measure",
     "robot",
     "scenario",
     "simulate",

@@ -208,7 +208,7 @@ def flip_times(body: RigidBody, omega0, t_end: float) -> np.ndarray:
     ``m1 → 0``). The flips are then ``t₁ + 2jK/λ``, ``j = 0, 1, …``;
     ``m``, ``m1``, ``λ`` and ``K/λ`` come from :func:`free_parameters`.
     Empty when ``ω₂`` never changes sign (a sphere, a steady rotation, the
-    separatrix after its one flip). ``analysis.flip_times`` measures the
+    separatrix after its one flip). ``measure.flip_times`` measures the
     same events on a sampled trajectory.
     """
     body = _body(body)

@@ -13,7 +13,7 @@ import typer
 
 from tumble._files import write_atomic_all
 from tumble._validate import ValidationError, require_memory, require_positive
-from tumble.analysis import flip_times
+from tumble.measure import flip_times
 from tumble.analytic._stability import flip_interval, stability
 from tumble.body import RigidBody
 from tumble.cli.common import check_outputs, png, print_rows, progress_bar, summary, text, written

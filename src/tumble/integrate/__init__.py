@@ -38,7 +38,7 @@ would work. The engine imports no particular model.
 :func:`solve` is the one entry point used by :func:`tumble.simulate`, which
 runs every model; :class:`Run` is the same run advanced chunk by chunk of
 output times, for an analysis that acts on the states between them
-(:func:`tumble.analysis.lyapunov_exponents`).
+(:func:`tumble.measure.lyapunov_exponents`).
 """
 
 from __future__ import annotations

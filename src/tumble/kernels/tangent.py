@@ -12,7 +12,7 @@ the motion and its linearisation are (:mod:`tumble.analytic._integrable`)::
 The flow is divergence-free (``∂ω̇ᵢ/∂ωᵢ = ∂γ̇ᵢ/∂γᵢ = 0``), so the six Lyapunov
 exponents sum to zero. The kernel provides the core protocol (``rhs``,
 ``project``: nothing to project, ``state_size``), on a state vector or a block
-of them: :mod:`tumble.analysis._lyapunov` runs it through the engine
+of them: :mod:`tumble.measure._lyapunov` runs it through the engine
 (:class:`tumble.integrate.Run`) with any method that needs no more.
 """
 

@@ -10,9 +10,9 @@ same ``m g |r| = 1 N·m`` (time unit 1 s), on the same energy level ``H``:
 For each, orbits from random attitudes and rate directions on the level
 and on the level ``L_z = 0`` of the vertical momentum
 (:func:`tumble.analytic.omega_at_energy`) are cut by the section ``γ₁ = 0``
-crossed upwards (:func:`tumble.analysis.poincare_section`) and drawn in the
+crossed upwards (:func:`tumble.measure.poincare_section`) and drawn in the
 plane (γ₂, ω₃); the largest finite-time exponent of one orbit
-(:func:`tumble.analysis.lyapunov_exponents`) is drawn against time with the
+(:func:`tumble.measure.lyapunov_exponents`) is drawn against time with the
 ``ln t / t`` of an integrable top. ``docs/chaos.md`` shows and explains the figure.
 """
 
@@ -26,7 +26,7 @@ import numpy as np
 
 from tumble import attitude
 from tumble._validate import ValidationError, require_positive
-from tumble.analysis import lyapunov_exponents, poincare_section
+from tumble.measure import lyapunov_exponents, poincare_section
 from tumble.analytic import omega_at_energy, upward_vertical
 from tumble.torques import Gravity
 from tumble._files import write_atomic

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tumble.analysis import intermediate_rate
+from tumble.measure import intermediate_rate
 from tumble.body import RigidBody
 from tumble.trajectory import Trajectory
 

@@ -8,9 +8,9 @@
 ==========================================  ==========================================================
 """
 
-from tumble.analysis._flips import flip_times, intermediate_rate
-from tumble.analysis._lyapunov import LyapunovExponents, lyapunov_exponents
-from tumble.analysis._poincare import PoincareSection, poincare_section
+from tumble.measure._flips import flip_times, intermediate_rate
+from tumble.measure._lyapunov import LyapunovExponents, lyapunov_exponents
+from tumble.measure._poincare import PoincareSection, poincare_section
 
 __all__ = ["LyapunovExponents", "PoincareSection", "flip_times", "intermediate_rate", "lyapunov_exponents",
            "poincare_section"]
