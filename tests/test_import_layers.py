@@ -38,7 +38,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("domain", ("tumble.analytic", "tumble.axisymmetric", "tumble.flexible", "tumble.ins", "tumble.lorentz",
                 "tumble.measure", "tumble.robot", "tumble.slosh", "tumble.spacecraft", "tumble.variable")),
     ("sweeps", ("tumble.ensemble", "tumble.sweep", "tumble.sweeps")),
-    ("scenario, viz, viewer", ("tumble.scenario", "tumble.viz", "tumble.viewer", "tumble.examples")),
+    ("scenario, viz", ("tumble.scenario", "tumble.viz", "tumble.examples")),
     ("cli", ("tumble.cli", "tumble.__main__", "tumble._cli_errors", "tumble._warmup", "tumble.robot.cli")),
 )
 

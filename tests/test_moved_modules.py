@@ -36,7 +36,7 @@ SPELLINGS = textwrap.dedent("""
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             exec(code, namespace)
-        said = [str(w.message) for w in caught if w.category is DeprecationWarning]
+        said = [[str(w.message), w.filename] for w in caught if w.category is DeprecationWarning]
         results[code] = [eval(check, namespace), said]
     print(json.dumps(results))
 """)
@@ -56,6 +56,7 @@ def _pickled_under(old: str, new: str, value: str) -> str:
 
 FRAMES = ("tumble.frames", "tumble.axisymmetric")
 ANALYSIS = ("tumble.analysis", "tumble.measure")
+VIEWER = ("tumble.viewer", "tumble.viz.viewer")
 PRISM = "tumble.RigidBody([[2.0, 0, 0], [0, 2.0, 0], [0, 0, 3.0]])"
 
 #: (code that binds ``got``, the old modules it imports, the new ones, the check, the warnings it gives)
@@ -70,6 +71,11 @@ CASES = [
      "got is tumble.measure.poincare_section", _said(ANALYSIS)),
     ("from tumble.analysis._flips import flip_times as got", [ANALYSIS[0]], [ANALYSIS[1]],
      "got is tumble.measure.flip_times", _said(ANALYSIS, (f"{ANALYSIS[0]}._flips", f"{ANALYSIS[1]}._flips"))),
+    ("import tumble.viewer\ngot = tumble.viewer.write_html", [VIEWER[0]], [VIEWER[1]],
+     "got is tumble.viz.viewer.write_html", _said(VIEWER)),
+    ("from tumble import viewer as got", [VIEWER[0]], [VIEWER[1]], "got is tumble.viz.viewer", _said(VIEWER)),
+    ("from tumble.viewer.scenes import rigid as got", [VIEWER[0]], [f"{VIEWER[1]}.scenes.rigid"],
+     "got is tumble.viz.viewer.scenes.rigid", _said(VIEWER, (f"{VIEWER[0]}.scenes", f"{VIEWER[1]}.scenes"))),
 ]
 
 
@@ -88,7 +94,10 @@ def spelled() -> dict[str, list]:
 def test_an_old_module_name_gives_the_new_module_with_a_warning_naming_it(spelled, code, said):
     same, warned = spelled[code]
     assert same
-    assert warned == said
+    # `from tumble import viewer` reads the attribute twice (the import system's hasattr, then the name): the
+    # same warning twice; each at the line of the code that spelled the old name
+    assert sorted({message for message, _ in warned}) == sorted(said) and len(warned) <= 2 * len(said)
+    assert {where for _, where in warned} == {"<string>"}
 
 
 def test_a_name_that_no_module_had_is_still_a_module_not_found_error():

@@ -198,7 +198,7 @@ def test_wheel_and_sdist_carry_the_package_data(tmp_path):
     names = set(zipfile.ZipFile(wheel).namelist())
     examples = {f"tumble/examples/{n}" for n in tumble.examples.names()}
     assert examples <= names
-    assert {"tumble/py.typed", "tumble/viewer/viewer.js", "tumble/examples/__init__.py"} <= names
+    assert {"tumble/py.typed", "tumble/viz/viewer/viewer.js", "tumble/examples/__init__.py"} <= names
     licenses = f"tumble-{version}.dist-info/licenses/"
     assert {licenses + "LICENSE", licenses + "NOTICE", licenses + "LICENSES/Apache-2.0.txt"} <= names
     assert not [n for n in names if n.startswith(("tests/", "docs/", "benchmarks/")) or "__pycache__" in n]

@@ -27,7 +27,7 @@ from tumble._files import MAX_INPUT_BYTES, read_input, write_atomic, write_atomi
 from tumble._validate import ValidationError
 from tumble.cli import app
 from tumble.trajectory import Extra, Trajectory
-from tumble.viewer._frames import MAX_FRAMES, check_budget
+from tumble.viz.viewer._frames import MAX_FRAMES, check_budget
 
 runner = CliRunner()
 

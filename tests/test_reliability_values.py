@@ -194,7 +194,7 @@ def test_disagreeing_batch_sizes_name_the_field(given, message):
 
 
 def test_a_trajectory_file_with_nan_times_is_not_called_empty(tmp_path):
-    from tumble import viewer
+    from tumble.viz import viewer
 
     ds = tumble.simulate(BODY, OMEGA0, t=[0.0, 0.5, 1.0], method="rk4", dt=0.5).to_xarray()
     path = tmp_path / "nan.nc"
@@ -283,15 +283,15 @@ def test_a_run_at_the_rate_bound_stops_at_once_instead_of_after_max_steps():
     assert abs(traj.energy[-1] / traj.energy[0] - 1.0) < 1e-10  # measured 1.1e-12
 
 
-# -- 7. tumble.viewer, lazily imported ----------------------------------------------------------------
+# -- 7. tumble.viz.viewer, lazily imported ----------------------------------------------------------------
 
 
 def test_tumble_viewer_is_imported_on_first_use():
     # before: AttributeError: module 'tumble' has no attribute 'viewer' (a fresh process: nothing imported it yet)
-    out = subprocess.run([sys.executable, "-c", "import tumble; print(tumble.viewer.write_html.__module__)"],
+    out = subprocess.run([sys.executable, "-c", "import tumble; print(tumble.viz.viewer.write_html.__module__)"],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
-    assert out.stdout.strip() == "tumble.viewer"
+    assert out.stdout.strip() == "tumble.viz.viewer"
 
 
 # -- 8. the Goryachev–Chaplygin invariant, whatever the body axes -------------------------------------

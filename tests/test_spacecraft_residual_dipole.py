@@ -92,7 +92,7 @@ step = 1.0
 
 
 def test_viewer_draws_the_dipole_along_body_x(swing):
-    from tumble import viewer
+    from tumble.viz import viewer
 
     scene = viewer.scene(swing, model=needle(), frames=50)
     line = {line.name: line.points for line in scene.lines}["residual dipole"]

@@ -296,7 +296,7 @@ def test_bad_environment_tables_are_refused_naming_the_key(old, new, message):
 
 
 def test_viewer_draws_the_sun_hidden_in_the_umbra_and_the_facet_normals():
-    from tumble import viewer
+    from tumble.viz import viewer
 
     orbit = Orbit.circular(500e3, 0.0)
     dark = Environment.sample(orbit, EPOCH, duration=orbit.period, step=10.0, shadow="cylindrical")

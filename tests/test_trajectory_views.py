@@ -13,7 +13,7 @@ import tumble.viz.trajectory as views
 
 SRC = Path(tumble.__file__).parent
 #: What the result type and its file format may not import, at any level (outside `if TYPE_CHECKING:`).
-ABOVE = ("tumble.viz", "tumble.viewer", "tumble._tables", "tumble.scenario", "tumble.cli", "tumble.sweep",
+ABOVE = ("tumble.viz", "tumble._tables", "tumble.scenario", "tumble.cli", "tumble.sweep",
          "matplotlib", "pandas")
 
 

@@ -11,12 +11,13 @@ import xarray as xr
 from typer.testing import CliRunner
 
 import tumble
-from tumble import ValidationError, viewer
+from tumble import ValidationError
+from tumble.viz import viewer
 from tumble.cli import app
 from tumble.trajectory import Extra, Trajectory
-from tumble.viewer._frames import frame_indices
-from tumble.viewer._shapes import body_mesh, box_mesh, cylinder_mesh, ellipsoid_mesh, equivalent_box
-from tumble.viewer.scenes.spacecraft import spin_angles
+from tumble.viz.viewer._frames import frame_indices
+from tumble.viz.viewer._shapes import body_mesh, box_mesh, cylinder_mesh, ellipsoid_mesh, equivalent_box
+from tumble.viz.viewer.scenes.spacecraft import spin_angles
 
 ROBOTS = tumble.examples.directory() / "robots"
 INERTIA = np.diag([1.0, 2.0, 3.0])   # kg m²

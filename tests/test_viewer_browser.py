@@ -25,7 +25,7 @@ import pytest
 import tumble
 from tumble import attitude, robot
 from tumble.spacecraft import MRPFeedback, ReactionWheel, Spacecraft
-from tumble.viewer import Cylinder
+from tumble.viz.viewer import Cylinder
 
 # Every test here opens pages in Chromium and simulates a spacecraft or a robot arm on a cold Numba cache.
 pytestmark = pytest.mark.slow

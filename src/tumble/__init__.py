@@ -16,7 +16,7 @@ implements :class:`tumble.Model` and runs through it.
 """
 
 from tumble._cache import ensure_writable_cache, use_content_key
-from tumble._moved import moved_modules
+from tumble._moved import deprecated, moved_modules
 
 ensure_writable_cache()  # before any compiled module: a read-only install must still import
 use_content_key()  # and compiled code is stale when any source compiled into it changes (docs/architecture.md)
@@ -32,21 +32,29 @@ from tumble.trajectory import Trajectory, load  # noqa: E402
 from tumble.viz import trajectory as _views  # noqa: E402, F401 - fills Trajectory's figure, page and tables
 
 # Modules renamed in 0.4: each old name imports the new module itself, with a DeprecationWarning naming it, until 0.5.
-moved_modules({"tumble.frames": "tumble.axisymmetric", "tumble.analysis": "tumble.measure"})
+_RENAMED = {
+    "tumble.analysis": "tumble.measure",
+    "tumble.frames": "tumble.axisymmetric",
+    "tumble.viewer": "tumble.viz.viewer",
+}
+moved_modules(_RENAMED)
 
 
 # Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
 # `tumble.analytic.torque_free(...)` works after a plain `import tumble`; so do the old names of the renamed
-# packages (`tumble.analysis`), with their warning.
+# modules (`tumble.analysis`), with their warning at the line that reads them.
 _LAZY = ("analytic", "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep", "sweeps", "examples", "viewer", "estimation", "analysis")
+         "robot", "sweep", "sweeps", "examples", "estimation")
 
 
 def __getattr__(name):
-    if name in _LAZY:
-        import importlib
+    import importlib
 
+    if name in _LAZY:
         return importlib.import_module(f"tumble.{name}")
+    if f"tumble.{name}" in _RENAMED:
+        deprecated(f"tumble.{name}", _RENAMED[f"tumble.{name}"])
+        return importlib.import_module(_RENAMED[f"tumble.{name}"])
     raise AttributeError(f"module 'tumble' has no attribute {name!r}")
 
 __all__ = [
@@ -78,6 +86,5 @@ __all__ = [
     "sweeps",
     "torques",
     "variable",
-    "viewer",
     "viz",
 ]

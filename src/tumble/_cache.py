@@ -52,8 +52,7 @@ PACKAGE = Path(__file__).resolve().parent
 
 #: What the content key leaves out, relative to :data:`PACKAGE`: modules and sub-packages above the compiled
 #: layers (docs/architecture.md), which define no compiled code and which no compiled module imports.
-UNCOMPILED = ("__main__.py", "cli", "_warmup.py", "ensemble.py", "examples", "scenario", "sweep.py", "sweeps", "viewer",
-              "viz")
+UNCOMPILED = ("__main__.py", "cli", "_warmup.py", "ensemble.py", "examples", "scenario", "sweep.py", "sweeps", "viz")
 
 
 def _writable(directory: str) -> bool:

@@ -460,7 +460,7 @@ class Trajectory:
 
     def to_html(self, path: str | os.PathLike, **options: Any) -> None:
         """Write the offline 3-D viewer of this trajectory to ``path``: one self-contained HTML file, atomically;
-        ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``): :func:`tumble.viewer.write_html`."""
+        ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``): :func:`tumble.viz.viewer.write_html`."""
         VIEWS["to_html"](self, path, **options)
 
     def _repr_html_(self) -> str:

@@ -61,7 +61,7 @@ def racket(
     solution, 2K(m)/lambda. Beside the figure it writes the flips in the offline 3-D viewer
     (the figure's name with .html).
     """
-    from tumble.viewer import Cylinder, html_page
+    from tumble.viz.viewer import Cylinder, html_page
     from tumble.viz.racket import racket_figure
 
     with exit_codes():
@@ -101,7 +101,7 @@ def polhode(
     predicted times. Beside the PNG, the same name with .html: the 3-D viewer of one polhode
     period of the motion (the T-handle turning, omega and L, and its polhode on the energy ellipsoid).
     """
-    from tumble.viewer import Cylinder, html_page
+    from tumble.viz.viewer import Cylinder, html_page
     from tumble.viz.polhode import polhode_figure
 
     with exit_codes():

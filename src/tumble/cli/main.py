@@ -175,7 +175,7 @@ def view(
     Bad input (not a tumble trajectory, an empty one, --frames < 2 or > 100000) exits with code 2 and writes
     nothing.
     """
-    from tumble.viewer import write_html
+    from tumble.viz.viewer import write_html
 
     with exit_codes(path):
         check_outputs([("--output", output)], inputs=(path,) + (() if scenario is None else (scenario,)))

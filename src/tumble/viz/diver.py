@@ -34,7 +34,7 @@ def demo_diver(out_dir: str | os.PathLike[str]) -> dict:
     (the dive as a :class:`~tumble.Trajectory`; extras: ``inertia_t``,
     ``shape_momentum``, ``angular_momentum``, ``energy_rotational``,
     ``joint_angles``, ``shape_energy``), and ``diver_513xd.html``, the dive
-    in the offline viewer (:mod:`tumble.viewer`). Returns the numbers: somersaults and
+    in the offline viewer (:mod:`tumble.viz.viewer`). Returns the numbers: somersaults and
     twists of (a) and (c), the largest relative ``|L|`` drift, the final tilt
     of (c), the rule-of-thumb comparison of (b), and the paths written.
     ``out_dir`` must be an existing directory.

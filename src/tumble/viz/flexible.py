@@ -36,7 +36,7 @@ def demo_flexible(out_dir: str | os.PathLike[str]) -> dict:
     Integrates with dop853 (rtol = atol = 1e-11) through the manoeuvre and 60 s after it,
     writes ``out_dir/flexible.nc`` (the flexible trajectory with its modal coordinates) and
     ``out_dir/flexible.png`` (:func:`slew_figure`) and ``out_dir/flexible.html`` (the offline viewer,
-    :mod:`tumble.viewer`) atomically and returns a summary: the peak
+    :mod:`tumble.viz.viewer`) atomically and returns a summary: the peak
     torque (N·m), the residual modal amplitudes after the manoeuvre (kg^½·m), the pointing
     jitter (peak and RMS, arcsec) and rate jitter (peak, arcsec/s) of the flexible hub after
     the manoeuvre, the final pointing error of the rigid body (arcsec), the largest total

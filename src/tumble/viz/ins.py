@@ -83,7 +83,7 @@ def demo_gyroscope(out_dir: str | os.PathLike[str]) -> dict:
 
     Writes ``ins_gyro_precession.png`` (azimuth and tilt of the axis over
     0.4 s: cycloidal nutation about the mean precession) with ``ins_gyro_precession.html`` (that
-    run in the offline viewer, :mod:`tumble.viewer`) and
+    run in the offline viewer, :mod:`tumble.viz.viewer`) and
     ``ins_gyro_drift.png`` (azimuth drift from imbalance with and without a
     spin-bearing drag of 2e-3 N·m, which slows the spin from 100 to 80 rad/s,
     and the tilt from a pivot friction of 1e-5 N·m, over 20 s, each against

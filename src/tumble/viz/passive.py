@@ -101,7 +101,7 @@ def demo_gravity_gradient(out_dir: str | os.PathLike[str]) -> dict:
     Writes ``gravity_gradient.nc`` (the trajectory), ``gravity_gradient.png``
     (roll, pitch, yaw from LVLH against orbits),
     ``passive_gg_regions.png`` (the stability regions with the satellite) and
-    ``gravity_gradient.html`` (the offline viewer, :mod:`tumble.viewer`) in
+    ``gravity_gradient.html`` (the offline viewer, :mod:`tumble.viz.viewer`) in
     ``out_dir``, atomically. Returns the stability classification, the
     linear-theory frequencies (units of the orbit rate), the largest angle
     from LVLH (deg) and the paths written.
@@ -178,7 +178,7 @@ def demo_explorer1(out_dir: str | os.PathLike[str], spacecraft: Explorer1 = EXPL
     Integrates hub + damper (:meth:`Explorer1.spacecraft` through :func:`tumble.simulate`,
     dop853, rtol 1e-12) for ``spacecraft.duration`` s, writes
     ``explorer1.nc``, ``explorer1.png`` and ``explorer1.html`` (the offline viewer,
-    :mod:`tumble.viewer`) in ``out_dir`` atomically, and
+    :mod:`tumble.viz.viewer`) in ``out_dir`` atomically, and
     returns: the time constant measured (fit of ln θ for θ between 2θ₀ and
     0.2 rad) and estimated (s), the final nutation angle (deg) and spin axis
     (unit ``L`` in body axes), the relative drift of ``|L|`` and of the

@@ -34,7 +34,7 @@ def demo_slosh(out_dir: str | os.PathLike[str]) -> dict:
 
     Spins the hub at 2 rad/s about its minor axis z with a small wobble, integrates 600 s
     with dop853 (rtol = atol = 1e-11), writes ``out_dir/slosh.nc``, ``out_dir/slosh.png``
-    (:func:`nutation_figure`) and ``out_dir/slosh.html`` (the offline viewer, :mod:`tumble.viewer`) atomically and returns: the initial and final nutation angles
+    (:func:`nutation_figure`) and ``out_dir/slosh.html`` (the offline viewer, :mod:`tumble.viz.viewer`) atomically and returns: the initial and final nutation angles
     (deg), the growth time constant (s), measured (:func:`~tumble.slosh.growth_time_constant` over 2°–20°) and
     predicted by the linearisation about the steady spin (:func:`~tumble.slosh.steady_spin_eigenvalues`), the largest
     relative change of ``|H|``, the relative energy change, whether the energy decreased at every

@@ -146,7 +146,7 @@ def demo_top(out_dir: str | os.PathLike[str], *, duration: float = 1.5) -> dict:
     samples per nutation period) and ``tumble.torques.Gravity``, writes
     ``out_dir/top.nc`` (:meth:`Trajectory.save`), ``out_dir/top.png``
     (:func:`top_figure`) and ``out_dir/top.html`` (the 3-D viewer,
-    :mod:`tumble.viewer`), each atomically, and returns a summary: nutation
+    :mod:`tumble.viz.viewer`), each atomically, and returns a summary: nutation
     bounds (deg), exact and measured (:func:`measure_nutation`, mean over the
     turning points), nutation period (s) and mean precession rate (rad/s),
     exact and measured, the spin and critical spin (rad/s), and the paths

@@ -8,7 +8,7 @@ when ``import tumble`` loads it. matplotlib, the viewer and pandas are
 imported on the first call.
 
 :func:`plot`          matplotlib figure: body rates, drift of the invariants, direction of ``L``
-:func:`to_html`       the offline 3-D viewer page (:func:`tumble.viewer.write_html`)
+:func:`to_html`       the offline 3-D viewer page (:func:`tumble.viz.viewer.write_html`)
 :func:`notebook_html` the table of the run, then the viewer in an ``<iframe>``
 :func:`to_dataframe`  the samples as a pandas DataFrame
 """
@@ -111,9 +111,9 @@ def to_html(traj: Trajectory, path: str | os.PathLike, **options: Any) -> None:
     """Write the offline 3-D viewer of ``traj`` to ``path``, atomically: ``traj.to_html(path, **options)``.
 
     ``options`` (``model=``, ``frames=``, ``axis=``, ``shape=``) and what the page shows:
-    :func:`tumble.viewer.write_html` (``docs/viewer.md``).
+    :func:`tumble.viz.viewer.write_html` (``docs/viewer.md``).
     """
-    from tumble.viewer import write_html
+    from tumble.viz.viewer import write_html
 
     write_html(traj, path, **options)
 
@@ -121,9 +121,9 @@ def to_html(traj: Trajectory, path: str | os.PathLike, **options: Any) -> None:
 def notebook_html(traj: Trajectory) -> str:
     """A notebook cell's view of ``traj`` (its ``_repr_html_``): the table of the run (model, method, samples,
     time span, solver statistics, largest drifts of energy and angular momentum), then the viewer in an
-    ``<iframe>`` (:func:`tumble.viewer.notebook_html`) where the trajectory can be drawn without its model."""
+    ``<iframe>`` (:func:`tumble.viz.viewer.notebook_html`) where the trajectory can be drawn without its model."""
     from tumble.viz._notebook import summary_html
-    from tumble.viewer import notebook_html as viewer_html
+    from tumble.viz.viewer import notebook_html as viewer_html
 
     return summary_html(traj) + (viewer_html(traj) or "")
 

@@ -3,8 +3,8 @@
 The body is the user's shape (``shape=``), else the equivalent box of the
 model's inertia (with its mass when the model is a :class:`tumble.RigidBody`
 that has one), else the equivalent box of the trajectory's ``inertia``
-(:func:`tumble.viewer._shapes.body_mesh`); the rest is
-:func:`~tumble.viewer.scenes._attitude.attitude_scene`.
+(:func:`tumble.viz.viewer._shapes.body_mesh`); the rest is
+:func:`~tumble.viz.viewer.scenes._attitude.attitude_scene`.
 """
 
 from __future__ import annotations
@@ -12,17 +12,17 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from tumble.body import RigidBody
-from tumble.viewer._scene import check_model
-from tumble.viewer._shapes import body_mesh
-from tumble.viewer.scenes._attitude import attitude_scene
+from tumble.viz.viewer._scene import check_model
+from tumble.viz.viewer._shapes import body_mesh
+from tumble.viz.viewer.scenes._attitude import attitude_scene
 
 if TYPE_CHECKING:
     import numpy as np
 
     from tumble.trajectory import Trajectory
-    from tumble.viewer._scene import Scene
-    from tumble.viewer._shapes import Mesh
-    from tumble.viewer.scenes import Options
+    from tumble.viz.viewer._scene import Scene
+    from tumble.viz.viewer._shapes import Mesh
+    from tumble.viz.viewer.scenes import Options
 
 __all__ = ["hub_mesh", "scene"]
 

@@ -14,13 +14,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from tumble.viewer.scenes import flexible, human, rigid, robot, slosh, spacecraft
+from tumble.viz.viewer.scenes import flexible, human, rigid, robot, slosh, spacecraft
 
 if TYPE_CHECKING:
     import numpy as np
 
     from tumble.trajectory import Trajectory
-    from tumble.viewer._scene import Scene
+    from tumble.viz.viewer._scene import Scene
 
 __all__ = ["BUILDERS", "Options"]
 

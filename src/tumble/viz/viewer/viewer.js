@@ -1,4 +1,4 @@
-// tumble's offline trajectory viewer: draws the scene that tumble.viewer wrote into #tumble-scene with the
+// tumble's offline trajectory viewer: draws the scene that tumble.viz.viewer wrote into #tumble-scene with the
 // embedded plotly.js, frame by frame. Every number comes from Python (rotation matrices, positions, arrows);
 // this file only applies them (world = R v + p) and runs the controls. window.tumbleViewer exposes the state
 // the tests read back: the frame shown and, per solid, the rotation and position applied.

@@ -29,15 +29,15 @@ import numpy as np
 
 from tumble.kernels.spacecraft import environment_table as _table
 from tumble.spacecraft import Orbit, Spacecraft
-from tumble.viewer._scene import Lines, Solid, check_model
-from tumble.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
-from tumble.viewer.scenes._attitude import attitude_scene, rotations
-from tumble.viewer.scenes.rigid import hub_mesh
+from tumble.viz.viewer._scene import Lines, Solid, check_model
+from tumble.viz.viewer._shapes import Mesh, box_mesh, cylinder_mesh, turn_z_to
+from tumble.viz.viewer.scenes._attitude import attitude_scene, rotations
+from tumble.viz.viewer.scenes.rigid import hub_mesh
 
 if TYPE_CHECKING:
     from tumble.trajectory import Trajectory
-    from tumble.viewer._scene import Scene
-    from tumble.viewer.scenes import Options
+    from tumble.viz.viewer._scene import Scene
+    from tumble.viz.viewer.scenes import Options
 
 __all__ = ["scene", "spin_angles"]
 

@@ -21,16 +21,16 @@ import numpy as np
 from tumble._inertia import principal_axes
 from tumble._validate import ValidationError
 from tumble.variable.human import Human, MovingHuman
-from tumble.viewer._scene import Solid, check_model
-from tumble.viewer._shapes import Mesh, box_mesh, equivalent_box
-from tumble.viewer.scenes import rigid
-from tumble.viewer.scenes._attitude import attitude_scene, rotations
+from tumble.viz.viewer._scene import Solid, check_model
+from tumble.viz.viewer._shapes import Mesh, box_mesh, equivalent_box
+from tumble.viz.viewer.scenes import rigid
+from tumble.viz.viewer.scenes._attitude import attitude_scene, rotations
 
 if TYPE_CHECKING:
     from tumble.body import Part
     from tumble.trajectory import Trajectory
-    from tumble.viewer._scene import Scene
-    from tumble.viewer.scenes import Options
+    from tumble.viz.viewer._scene import Scene
+    from tumble.viz.viewer.scenes import Options
 
 __all__ = ["scene", "segment_mesh"]
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tumble._validate import ValidationError
-from tumble.viewer._shapes import Mesh
+from tumble.viz.viewer._shapes import Mesh
 
 __all__ = ["Lines", "Panel", "Polhode", "Scene", "Solid", "as_json", "check_model"]
 

@@ -17,12 +17,12 @@ import numpy as np
 
 from tumble._validate import ValidationError
 from tumble.robot import SerialChain, link_poses
-from tumble.viewer._scene import Lines, Panel, Scene, Solid, check_model
-from tumble.viewer._shapes import box_mesh
+from tumble.viz.viewer._scene import Lines, Panel, Scene, Solid, check_model
+from tumble.viz.viewer._shapes import box_mesh
 
 if TYPE_CHECKING:
     from tumble.trajectory import Trajectory
-    from tumble.viewer.scenes import Options
+    from tumble.viz.viewer.scenes import Options
 
 __all__ = ["joint_points", "scene"]
 

@@ -17,14 +17,14 @@ from typing import TYPE_CHECKING, cast
 import numpy as np
 
 from tumble.flexible import FlexibleBody
-from tumble.viewer._scene import Lines, check_model
-from tumble.viewer.scenes._attitude import attitude_scene, rotations
-from tumble.viewer.scenes.rigid import hub_mesh
+from tumble.viz.viewer._scene import Lines, check_model
+from tumble.viz.viewer.scenes._attitude import attitude_scene, rotations
+from tumble.viz.viewer.scenes.rigid import hub_mesh
 
 if TYPE_CHECKING:
     from tumble.trajectory import Trajectory
-    from tumble.viewer._scene import Scene
-    from tumble.viewer.scenes import Options
+    from tumble.viz.viewer._scene import Scene
+    from tumble.viz.viewer.scenes import Options
 
 __all__ = ["scene"]
 

@@ -19,8 +19,8 @@ import numpy as np
 
 from tumble import attitude
 from tumble._inertia import principal_axes
-from tumble.viewer._scene import Lines, Panel, Polhode, Scene, Solid
-from tumble.viewer._shapes import Mesh, ellipsoid_mesh
+from tumble.viz.viewer._scene import Lines, Panel, Polhode, Scene, Solid
+from tumble.viz.viewer._shapes import Mesh, ellipsoid_mesh
 
 __all__ = ["AXIS_COLORS", "attitude_scene", "rotations"]
 

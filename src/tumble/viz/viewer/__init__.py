@@ -1,6 +1,6 @@
 """The offline 3-D viewer: one self-contained HTML file that shows any trajectory moving.
 
-    tumble.viewer.write_html(traj, "run.html", model=craft)       # or traj.to_html("run.html", model=craft)
+    tumble.viz.viewer.write_html(traj, "run.html", model=craft)       # or traj.to_html("run.html", model=craft)
     tumble view run.nc -o run.html [--scenario run.toml]          # the command line
 
 The page draws, frame by frame, the body as a solid (the user's shape, or
@@ -10,7 +10,7 @@ space when no torque acts), the trace of a body axis on the unit sphere,
 and each model's own parts: a spacecraft's wheels spinning, CMG gimbals,
 thruster firings, nadir and orbit normal; a robot arm's links from the
 chain's forward kinematics; a diver's segments; a flexible panel's
-deflection and a slosh pendulum (``tumble.viewer.scenes``). Beside it: the
+deflection and a slosh pendulum (``tumble.viz.viewer.scenes``). Beside it: the
 body rates against time with a cursor and, for a free rigid body, the
 polhode on the energy ellipsoid; controls: play/pause, speed, a time
 slider, the time and the frame shown.
@@ -36,11 +36,11 @@ import numpy as np
 from tumble._validate import ValidationError
 from tumble._files import write_atomic
 from tumble.trajectory import Trajectory, load
-from tumble.viewer._frames import DEFAULT_FRAMES, check_budget, frame_indices
-from tumble.viewer._page import document
-from tumble.viewer._scene import Scene, as_json
-from tumble.viewer._shapes import Box, Cylinder
-from tumble.viewer.scenes import BUILDERS, Options
+from tumble.viz.viewer._frames import DEFAULT_FRAMES, check_budget, frame_indices
+from tumble.viz.viewer._page import document
+from tumble.viz.viewer._scene import Scene, as_json
+from tumble.viz.viewer._shapes import Box, Cylinder
+from tumble.viz.viewer.scenes import BUILDERS, Options
 
 if TYPE_CHECKING:
     from tumble.simulate import Model
@@ -83,7 +83,7 @@ def _axis(axis, traj: Trajectory) -> int:
 def scene(traj: Trajectory | str | os.PathLike[str], *, model: Model | Human | None = None,
           frames: int = DEFAULT_FRAMES, axis: str | None = None,
           shape: Box | Cylinder | Sequence[Box | Cylinder] | None = None) -> Scene:
-    """The :class:`~tumble.viewer._scene.Scene` of a trajectory (what the page draws), refusing what it cannot show.
+    """The :class:`~tumble.viz.viewer._scene.Scene` of a trajectory (what the page draws), refusing what it cannot show.
 
     traj   : a :class:`tumble.Trajectory` (one run, not a batch: ``traj.member(i)`` picks one) or the path of one
     model  : the model that made it, for what the trajectory cannot tell (a robot's links, a spacecraft's

@@ -60,7 +60,7 @@ def _json_for_script(doc: dict) -> str:
 
 
 def document(scene_json: dict) -> str:
-    """The page of a scene (:func:`tumble.viewer._scene.as_json`)."""
-    viewer = resources.files("tumble.viewer").joinpath("viewer.js").read_text(encoding="utf-8")
+    """The page of a scene (:func:`tumble.viz.viewer._scene.as_json`)."""
+    viewer = resources.files("tumble.viz.viewer").joinpath("viewer.js").read_text(encoding="utf-8")
     return _TEMPLATE.format(title=html.escape(scene_json["title"]), scene=_json_for_script(scene_json),
                             plotly=get_plotlyjs(), viewer=viewer)
