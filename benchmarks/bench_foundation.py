@@ -46,7 +46,7 @@ from tumble._protocol import project, rhs
 from tumble._validate import readonly
 from tumble.integrate import _fixed, _rk4
 from tumble.kernels import rigid as _rigid
-from tumble.rigid import RigidBodies
+from tumble.rigid_model import RigidBodies
 
 MOMENTS = np.array([1.0, 2.0, 3.0])          # kg m², principal axes = body axes
 C1, C2, C3 = (MOMENTS[1] - MOMENTS[2]) / MOMENTS[0], (MOMENTS[2] - MOMENTS[0]) / MOMENTS[1], \

@@ -1,4 +1,4 @@
-"""Tests of tumble.body: shapes against textbook formulas, principal axes, composites, validation."""
+"""Tests of tumble.rigid_body: shapes against textbook formulas, principal axes, composites, validation."""
 
 import pickle
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from tumble._validate import ValidationError
-from tumble.body import Part, RigidBody, principal_axes
+from tumble.rigid_body import Part, RigidBody, principal_axes
 
 # Closed-form values computed with a handful of float operations agree to a
 # few ulps; 1e-14 relative leaves room for ~50 roundings.

@@ -7,7 +7,7 @@ import tumble
 from tumble import integrate
 from tumble._protocol import CAPABILITIES
 from tumble._validate import ValidationError
-from tumble.rigid import RigidBodies
+from tumble.rigid_model import RigidBodies
 from tumble.simulate import Model
 
 DIAG = np.diag([1.0, 2.0, 3.0])
@@ -95,7 +95,7 @@ def test_the_engine_imports_no_model():
         imported = [getattr(node, "module", None) or "" for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)]
         imported += [alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names]
         models = [name for name in imported if name.startswith("tumble.kernels") or name in (
-            "tumble.body", "tumble.rigid", "tumble._free_flow")]
+            "tumble.rigid_body", "tumble.rigid_model", "tumble._free_flow")]
         assert not models, (path.name, models)
 
 
@@ -125,8 +125,9 @@ def test_the_model_interface_of_a_rigid_body_answers_for_one_release_with_a_depr
         np.testing.assert_array_equal(kept[name], values)
     with pytest.warns(DeprecationWarning, match=r"^RigidBody\.state_fields is deprecated"):
         assert [f.name for f in body.state_fields()] == ["omega0", "q0"]
-    with pytest.warns(DeprecationWarning, match=r"^tumble\.rigid\.RigidMotion is deprecated: .*RigidBodies"):
-        assert tumble.rigid.RigidMotion is RigidBodies
+    with pytest.warns(DeprecationWarning, match=r"^tumble\.rigid\.RigidMotion is deprecated: .*RigidBodies"), \
+            pytest.warns(DeprecationWarning, match=r"^tumble\.rigid is deprecated .*: use tumble\.rigid_model$"):
+        assert tumble.rigid.RigidMotion is RigidBodies  # the old spelling: tumble.rigid is tumble.rigid_model
     with pytest.raises(AttributeError, match="'RigidBody' object has no attribute 'spin'"):
         body.spin  # noqa: B018 (the attribute access is the test)
 

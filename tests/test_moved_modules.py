@@ -37,7 +37,7 @@ SPELLINGS = textwrap.dedent("""
             warnings.simplefilter("always")
             exec(code, namespace)
         said = [[str(w.message), w.filename] for w in caught if w.category is DeprecationWarning]
-        results[code] = [eval(check, namespace), said]
+        results[code] = [bool(eval(check, namespace)), said]
     print(json.dumps(results))
 """)
 
@@ -57,6 +57,8 @@ def _pickled_under(old: str, new: str, value: str) -> str:
 FRAMES = ("tumble.frames", "tumble.axisymmetric")
 ANALYSIS = ("tumble.analysis", "tumble.measure")
 VIEWER = ("tumble.viewer", "tumble.viz.viewer")
+BODY = ("tumble.body", "tumble.rigid_body")
+RIGID = ("tumble.rigid", "tumble.rigid_model")
 PRISM = "tumble.RigidBody([[2.0, 0, 0], [0, 2.0, 0], [0, 0, 3.0]])"
 
 #: (code that binds ``got``, the old modules it imports, the new ones, the check, the warnings it gives)
@@ -76,6 +78,17 @@ CASES = [
     ("from tumble import viewer as got", [VIEWER[0]], [VIEWER[1]], "got is tumble.viz.viewer", _said(VIEWER)),
     ("from tumble.viewer.scenes import rigid as got", [VIEWER[0]], [f"{VIEWER[1]}.scenes.rigid"],
      "got is tumble.viz.viewer.scenes.rigid", _said(VIEWER, (f"{VIEWER[0]}.scenes", f"{VIEWER[1]}.scenes"))),
+    ("from tumble.body import RigidBody as got", [BODY[0]], [BODY[1]], "got is tumble.RigidBody", _said(BODY)),
+    ("got = tumble.body.principal_axes", [BODY[0]], [BODY[1]], "got is tumble.rigid_body.principal_axes",
+     _said(BODY)),
+    (_pickled_under(*BODY, PRISM), [BODY[0]], [BODY[1]], "type(got) is tumble.RigidBody and got == want",
+     _said(BODY)),
+    ("from tumble.rigid import RigidBodies as got", [RIGID[0]], [RIGID[1]], "got is tumble.rigid_model.RigidBodies",
+     _said(RIGID)),
+    ("import tumble.rigid\ngot = tumble.rigid.RigidBodies", [RIGID[0]], [RIGID[1]],
+     "got is tumble.rigid_model.RigidBodies", _said(RIGID)),
+    (_pickled_under(*RIGID, f"tumble.as_model({PRISM})"), [RIGID[0]], [RIGID[1]],
+     "type(got) is tumble.rigid_model.RigidBodies and (got.inertia == want.inertia).all()", _said(RIGID)),
 ]
 
 
@@ -83,8 +96,8 @@ CASES = [
 def spelled() -> dict[str, list]:
     """Each case's code -> [its check, the DeprecationWarnings it gave], from one new process."""
     cases = json.dumps([case[:4] for case in CASES])
-    out = subprocess.run([sys.executable, "-c", SPELLINGS, cases], capture_output=True, text=True, timeout=120,
-                         check=True)
+    out = subprocess.run([sys.executable, "-c", SPELLINGS, cases], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
     return json.loads(out.stdout.splitlines()[-1])
 
 

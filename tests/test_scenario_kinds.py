@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 import tumble
 from tumble import flexible, robot, slosh
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.cli import app
 from tumble.ins import GimbaledGyro
 from tumble.viz.ins import DEMO_GYRO

@@ -224,7 +224,7 @@ def test_rk4_motion_does_not_depend_on_the_body_axes_to_rounding(kind, random_ro
 def test_states_reach_body_axes_by_the_quaternion_product_and_the_rotation(bodies, random_batch):
     # the compiled change of axes of the outputs against the batched API: q_NB = q_NP ⊗ q_BP* bit for bit
     # (the same product), ω_B = R_BP ω_P to the rounding of its three terms (einsum pairs them otherwise)
-    from tumble.rigid import RigidBodies, _to_body_axes
+    from tumble.rigid_model import RigidBodies, _to_body_axes
 
     model = RigidBodies.of(random_batch(bodies)[0])
     axes, q_bp = model.axes, model.q_bp

@@ -9,7 +9,7 @@ import pytest
 
 import tumble
 from tumble import attitude, torques
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.scenario import ScenarioError, load, parse, run_scenario
 from tumble.spacecraft import (CMGCluster, MRPFeedback, QuaternionPD, ReactionWheel, Spacecraft, SphericalDamper,
                                WheelTorques, pyramid_wheels)
@@ -116,7 +116,7 @@ dt = 0.05
 
 
 def _total_inertia():
-    """The craft's total inertia about its centre of mass, summed independently of tumble.body: the
+    """The craft's total inertia about its centre of mass, summed independently of tumble.rigid_body: the
     rotors' I_s a aᵀ + I_t (E − a aᵀ) and the parallel-axis terms m (|c|² E − c cᵀ)."""
     masses = np.array([100.0, 2.0, 2.0, 2.0])
     coms = np.array([[0.01, 0.0, -0.02], [0.3, 0.0, 0.0], [0.0, 0.3, 0.0], [0.0, 0.0, 0.3]])

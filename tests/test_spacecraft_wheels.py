@@ -12,7 +12,7 @@ import pytest
 import tumble
 from tumble import attitude
 from tumble._validate import ValidationError
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.spacecraft import (QuaternionPD, RateDamping, ReactionWheel, SaturationWarning, Spacecraft,
                                pyramid_wheels)
 

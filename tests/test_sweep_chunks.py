@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble.rigid import RigidBodies
+from tumble.rigid_model import RigidBodies
 from tumble.sweeps.chunks import SAMPLES_PER_CHUNK, Chunks, batch_members
 
 RNG = np.random.default_rng(11)

@@ -24,7 +24,7 @@ use_content_key()  # and compiled code is stale when any source compiled into it
 from tumble import attitude, dynamics, integrate, limits, torques  # noqa: E402
 from tumble._validate import ValidationError  # noqa: E402
 from tumble._version import __version__  # noqa: E402, F401 (tumble.__version__)
-from tumble.body import RigidBody  # noqa: E402
+from tumble.rigid_body import RigidBody  # noqa: E402
 from tumble.integrate import SolverError  # noqa: E402
 from tumble.limits import RigidityWarning  # noqa: E402
 from tumble.simulate import Model, as_model, simulate  # noqa: E402
@@ -34,7 +34,9 @@ from tumble.viz import trajectory as _views  # noqa: E402, F401 - fills Trajecto
 # Modules renamed in 0.4: each old name imports the new module itself, with a DeprecationWarning naming it, until 0.5.
 _RENAMED = {
     "tumble.analysis": "tumble.measure",
+    "tumble.body": "tumble.rigid_body",
     "tumble.frames": "tumble.axisymmetric",
+    "tumble.rigid": "tumble.rigid_model",
     "tumble.viewer": "tumble.viz.viewer",
 }
 moved_modules(_RENAMED)

@@ -36,7 +36,7 @@ import numpy as np
 
 from tumble import attitude, limits, torques
 from tumble._validate import ValidationError, as_array
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.kernels import axisymmetric as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.simulate import as_model
 from tumble.sweeps.chunks import SAMPLES_PER_CHUNK, Chunks, batch_members, simulate_chunks
 from tumble.sweeps.moments import STATISTICS, merge, moments, summary

@@ -61,7 +61,7 @@ from numpy.typing import ArrayLike
 from tumble import attitude, dynamics, torques
 from tumble._moved import moved
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.kernels import flexible as _kernel
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Extra, Trajectory

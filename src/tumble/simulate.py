@@ -13,7 +13,7 @@ progress reporting, the device, and the one result type :class:`~tumble.Trajecto
 A model implements :class:`tumble.model.Model` once (re-exported here with
 :class:`~tumble.model.Outputs` and :class:`~tumble.model.StateField`); a
 :class:`~tumble.RigidBody`, a sequence of them or an inertia array is a value,
-which :func:`as_model` turns into its model, :class:`tumble.rigid.RigidBodies`.
+which :func:`as_model` turns into its model, :class:`tumble.rigid_model.RigidBodies`.
 """
 
 from __future__ import annotations
@@ -30,11 +30,11 @@ from numpy.typing import ArrayLike
 from tumble import _callback, _compiling, integrate
 from tumble._validate import ValidationError, output_times, require_finite
 from tumble.model import Model, Outputs, StateField
-from tumble.rigid import RigidBodies
+from tumble.rigid_model import RigidBodies
 from tumble.trajectory import Extra, Trajectory
 
 if TYPE_CHECKING:
-    from tumble.body import RigidBody
+    from tumble.rigid_body import RigidBody
     from tumble.torques import TorqueLike
 
 __all__ = ["Model", "Outputs", "StateField", "as_model", "simulate"]
@@ -54,7 +54,7 @@ class SolverOptions(TypedDict, total=False):
 
 def as_model(model: Model | RigidBody | Sequence[RigidBody] | ArrayLike) -> Model:
     """``model`` itself when it is a :class:`Model`; a rigid body (a value), a sequence of them or an inertia
-    array (3, 3) or (N, 3, 3) (kg·m², body axes) as the rigid-body model, :class:`~tumble.rigid.RigidBodies`."""
+    array (3, 3) or (N, 3, 3) (kg·m², body axes) as the rigid-body model, :class:`~tumble.rigid_model.RigidBodies`."""
     if isinstance(model, Model):
         return model
     return RigidBodies.of(model)

@@ -48,7 +48,7 @@ from tumble.attitude import rotate_inverse
 from tumble._inertia import principal_axes
 
 if TYPE_CHECKING:
-    from tumble.body import RigidBody
+    from tumble.rigid_body import RigidBody
     from tumble.spacecraft.orbit import Orbit
 
 __all__ = [

@@ -43,7 +43,7 @@ import numpy as np
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.analytic._free import free_parameters
 from tumble.attitude import rotate
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.trajectory import Trajectory
 
 __all__ = ["Polhode", "Herpolhode", "polhode", "polhode_through", "polhode_family", "separatrix", "herpolhode"]

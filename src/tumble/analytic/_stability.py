@@ -38,7 +38,7 @@ from scipy.special import elliprf
 from tumble._validate import ValidationError, as_array, require_positive
 from tumble.analytic._free import free_parameters
 from tumble.analytic._geometry import _amplitude, _circled, _omega_principal
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 
 __all__ = [
     "StabilityReport",

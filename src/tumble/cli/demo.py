@@ -15,7 +15,7 @@ from tumble._files import write_atomic_all
 from tumble._validate import ValidationError, require_memory, require_positive
 from tumble.measure import flip_times
 from tumble.analytic._stability import flip_interval, stability
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.cli.common import check_outputs, png, print_rows, progress_bar, summary, text, written
 from tumble.cli.errors import exit_codes
 from tumble.simulate import simulate

@@ -61,7 +61,7 @@ import numpy as np
 from tumble import attitude, dynamics, torques
 from tumble._validate import ValidationError, require_non_negative, require_positive
 from tumble.analytic import AxisMotion, HeavyTop, axis_motion
-from tumble.rigid import RigidBodies
+from tumble.rigid_model import RigidBodies
 from tumble.simulate import Model, Outputs, StateField
 from tumble.trajectory import Trajectory
 

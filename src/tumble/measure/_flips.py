@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tumble._validate import ValidationError
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.trajectory import Trajectory
 
 __all__ = ["intermediate_rate", "flip_times"]

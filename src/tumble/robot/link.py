@@ -58,7 +58,7 @@ class Link:
     slender link is allowed; the chain's mass matrix must still be positive
     definite), with principal moments that satisfy the triangle inequality
     unless ``check_triangle=False`` (published link inertias sometimes break
-    it): the rules of :func:`tumble.body.principal_axes`. ``lower`` ≤
+    it): the rules of :func:`tumble.rigid_body.principal_axes`. ``lower`` ≤
     ``upper`` are the joint limits (rad or m, on ``q``; ±inf when unlimited).
     """
 

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike
 
 from tumble._inertia import as_rotation, as_shape
 from tumble._validate import ValidationError
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.robot.chain import SerialChain
 from tumble.robot.link import Link
 from tumble.robot.tree import RobotTree

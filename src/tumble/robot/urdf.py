@@ -407,7 +407,7 @@ class _Builder:
 
             m = Σ mₖ,   c = Σ mₖ cₖ / m,   I = Σ [Iₖ + mₖ (|dₖ|² E − dₖ dₖᵀ)],   dₖ = cₖ − c
 
-        (the rule of :meth:`tumble.body.RigidBody.composite`, which needs every mass > 0), its principal moments
+        (the rule of :meth:`tumble.rigid_body.RigidBody.composite`, which needs every mass > 0), its principal moments
         raised to ``min_inertia``. A broken inertia rule names the URDF links of the body.
         """
         parts, members, spec = self.parts[i], self.members[i], self.specs[i]

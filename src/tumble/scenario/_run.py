@@ -13,7 +13,7 @@ from tumble.simulate import Model, SolverOptions, simulate
 from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:
-    from tumble.body import RigidBody
+    from tumble.rigid_body import RigidBody
 
 __all__ = ["RUN_KEYS", "Run"]
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from tumble import torques
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import in_file, keyed
 from tumble.scenario._run import Run

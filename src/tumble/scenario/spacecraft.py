@@ -55,7 +55,7 @@ import numpy as np
 from pydantic import Field, field_validator, model_validator
 
 from tumble import attitude
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.scenario._base import Scenario
 from tumble.scenario._errors import ScenarioError, in_file, keyed
 from tumble.scenario._run import RUN_KEYS, Run

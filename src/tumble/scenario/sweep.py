@@ -56,7 +56,7 @@ from tumble.sweeps.plan import store_name_problem
 if TYPE_CHECKING:
     import numpy as np
 
-    from tumble.body import RigidBody
+    from tumble.rigid_body import RigidBody
     from tumble.scenario._base import Scenario
     from tumble.scenario.rigid import Problem
     from tumble.simulate import Model

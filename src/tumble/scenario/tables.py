@@ -15,7 +15,7 @@ from pydantic import BaseModel, Discriminator, Field, Tag, field_validator
 
 from tumble import attitude, integrate
 from tumble._validate import ValidationError
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.scenario._errors import ScenarioError
 from tumble.scenario._values import (_Axis, _Bool, _Matrix, _Number, _Positive, _Quaternion, _Table, _Text,
                                      _Vector)

@@ -15,7 +15,7 @@ from typing import Annotated, ClassVar, Literal, Union
 from pydantic import Field
 
 from tumble import torques
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.scenario._errors import keyed
 from tumble.scenario._values import _Number, _Positive, _Table, _Vector
 from tumble.scenario.orbit import OrbitTable

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.body import Part
+from tumble.rigid_body import Part
 from tumble.kernels.spacecraft import cmgs as _cmgs
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
 from tumble.kernels.spacecraft._base import Program
@@ -112,7 +112,7 @@ class ReactionWheel:
         return self.mass is not None
 
     def part(self) -> Part:
-        """The rotor as a :class:`tumble.body.Part` of the spacecraft (body axes):
+        """The rotor as a :class:`tumble.rigid_body.Part` of the spacecraft (body axes):
         inertia ``I_s a aᵀ + I_t (E − a aᵀ)`` about its centre at ``position``."""
         mass, position, transverse = self.mass, self.position, self.transverse_inertia
         if mass is None or position is None or transverse is None:  # all or none: checked in __post_init__

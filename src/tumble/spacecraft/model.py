@@ -11,7 +11,7 @@ properties are described in one of two ways:
 * ``Spacecraft(hub=RigidBody(...), ...)``: the hub **without** the wheels or
   the sphere; each wheel then needs ``mass``, ``position`` and
   ``transverse_inertia`` (the hub a mass), and the total ``J`` is the composite
-  of hub and rotors (:meth:`tumble.body.RigidBody.composite`) plus the
+  of hub and rotors (:meth:`tumble.rigid_body.RigidBody.composite`) plus the
   sphere's ``J_d E`` (it sits at the centre of mass).
 
 Both give the same motion for the same total (tested). The body rate answers
@@ -38,7 +38,7 @@ from numpy.typing import ArrayLike
 
 from tumble import attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.kernels import spacecraft as _kernel
 from tumble.kernels.spacecraft import cmgs as _cmgs
 from tumble.kernels.spacecraft import drag as _drag

@@ -48,7 +48,7 @@ from tumble import attitude
 from tumble._moved import moved
 from tumble._validate import ValidationError, as_array
 from tumble.analytic import classify_axes
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.simulate import simulate
 from tumble.spacecraft import damper as _damper
 from tumble.spacecraft.model import Spacecraft

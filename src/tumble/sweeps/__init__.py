@@ -63,7 +63,7 @@ if TYPE_CHECKING:
     from distributed import Client
     from numpy.typing import ArrayLike
 
-    from tumble.body import RigidBody
+    from tumble.rigid_body import RigidBody
     from tumble.simulate import Model
     from tumble.torques import TorqueLike
 

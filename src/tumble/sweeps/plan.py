@@ -16,7 +16,7 @@ How a chunk is batched:
 * dispersed initial states (``omega0``, ``q0``, ``wheel_speeds0``, ...): one
   :func:`~tumble.simulate` call with a leading axis of ``m`` members;
 * a dispersed ``inertia`` of a rigid body, or a ``build`` function returning
-  rigid bodies: one call on the batch of bodies (:class:`tumble.rigid.RigidBodies`);
+  rigid bodies: one call on the batch of bodies (:class:`tumble.rigid_model.RigidBodies`);
 * a ``build`` function returning other models (a spacecraft with dispersed
   inertia or wheel axes): one call per sample inside the chunk's task (the
   compiled kernel is shared; such a model has no batched form of its
@@ -39,8 +39,8 @@ from numpy.typing import ArrayLike
 
 from tumble._inertia import principal_axes
 from tumble._validate import ValidationError
-from tumble.body import RigidBody
-from tumble.rigid import RigidBodies
+from tumble.rigid_body import RigidBody
+from tumble.rigid_model import RigidBodies
 from tumble.simulate import Model, as_model, simulate
 from tumble.sweeps.chunks import Chunks
 from tumble.sweeps.dispersions import Dispersion, Grid, Inertia, as_dispersion, sample_uniforms

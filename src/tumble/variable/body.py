@@ -274,7 +274,7 @@ def shape_power(body: VariableBody, t: ArrayLike, omega: ArrayLike) -> np.ndarra
 
 
 def _check_tensors(t: np.ndarray, inertia: np.ndarray, check_triangle: bool) -> np.ndarray:
-    """The rules of :func:`tumble.body.principal_axes` (symmetric, then symmetrised exactly; positive definite;
+    """The rules of :func:`tumble.rigid_body.principal_axes` (symmetric, then symmetrised exactly; positive definite;
     the triangle inequality ``I₁ + I₂ ≥ I₃`` that every mass distribution obeys) at every sample; a broken
     rule is refused naming the sample and its time."""
     return principal_axes(inertia, "inertia", check_triangle=check_triangle,

@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike
 
 from tumble import analytic, attitude, simulate
 from tumble._validate import ValidationError, as_array
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.trajectory import Trajectory
 from tumble.variable.body import angular_velocity
 from tumble.variable.human import Human, Motion

@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble._validate import ValidationError, as_array, require_positive
-from tumble.body import Part, RigidBody
+from tumble.rigid_body import Part, RigidBody
 from tumble.simulate import Outputs
 from tumble.trajectory import Extra
 from tumble.variable.body import VariableBody
@@ -147,7 +147,7 @@ class Segment:
 
     def __post_init__(self):
         if not isinstance(self.part, Part):
-            raise ValidationError(f"{self.name}.part: must be a tumble.body.Part, got {type(self.part).__name__}")
+            raise ValidationError(f"{self.name}.part: must be a tumble.rigid_body.Part, got {type(self.part).__name__}")
         axes = as_array(self.axes, f"{self.name}.axes").reshape(-1, 3) if len(self.axes) else np.zeros((0, 3))
         if np.any(np.abs(np.linalg.norm(axes, axis=1) - 1.0) > 1e-12):
             raise ValidationError(f"{self.name}.axes: must be unit vectors")

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.simulate import simulate
 from tumble.spacecraft import damper as _damper
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh

@@ -20,7 +20,7 @@ from tumble._validate import ValidationError, as_array
 from tumble.analytic._free import torque_free
 from tumble.analytic._geometry import herpolhode, polhode_family, polhode_through, separatrix
 from tumble.analytic._stability import stability
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tumble.measure import intermediate_rate
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.robot.chain import SerialChain
 from tumble.robot.link import Link
 from tumble.robot.space import space_manipulator

@@ -153,7 +153,8 @@ def body_mesh(inertia, *, mass: float | None = None, com=None, shape=None) -> tu
         pieces = list(shape) if isinstance(shape, (list, tuple)) else [shape]
         for k, piece in enumerate(pieces):
             if not isinstance(piece, (Box, Cylinder)):
-                raise ValidationError(f"shape[{k}]: must be a tumble.viz.viewer.Box or Cylinder, got {type(piece).__name__}")
+                raise ValidationError(f"shape[{k}]: must be a tumble.viz.viewer.Box or Cylinder, "
+                                      f"got {type(piece).__name__}")
         mesh = Mesh.join([piece.mesh() for piece in pieces])
         centre = np.zeros(3) if com is None else np.asarray(com, dtype=np.float64)
         return Mesh(mesh.vertices - centre, mesh.faces), "the body's shape"

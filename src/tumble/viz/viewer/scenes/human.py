@@ -27,7 +27,7 @@ from tumble.viz.viewer.scenes import rigid
 from tumble.viz.viewer.scenes._attitude import attitude_scene, rotations
 
 if TYPE_CHECKING:
-    from tumble.body import Part
+    from tumble.rigid_body import Part
     from tumble.trajectory import Trajectory
     from tumble.viz.viewer._scene import Scene
     from tumble.viz.viewer.scenes import Options

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.viz.viewer._scene import check_model
 from tumble.viz.viewer._shapes import body_mesh
 from tumble.viz.viewer.scenes._attitude import attitude_scene

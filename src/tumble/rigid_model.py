@@ -34,7 +34,7 @@ from tumble._inertia import principal_axes
 from tumble._quat import qmul
 from tumble._validate import ValidationError, as_array, readonly
 from tumble.kernels import rigid as _kernel
-from tumble.body import RigidBody
+from tumble.rigid_body import RigidBody
 from tumble.model import Model, Outputs, StateField
 
 __all__ = ["RigidBodies"]
@@ -184,7 +184,8 @@ RigidBody._model_of = RigidBodies.of  # the deprecated model interface of a Rigi
 
 def __getattr__(name: str) -> type[RigidBodies]:
     if name == "RigidMotion":  # deprecated in 0.4: the base of RigidBody and RigidBodies, now RigidBodies alone
-        warnings.warn("tumble.rigid.RigidMotion is deprecated: the rigid-body model is tumble.rigid.RigidBodies "
-                      "(RigidBodies.of(body) for one RigidBody)", DeprecationWarning, stacklevel=2)
+        warnings.warn("tumble.rigid.RigidMotion is deprecated: the rigid-body model is "
+                      "tumble.rigid_model.RigidBodies (RigidBodies.of(body) for one RigidBody)", DeprecationWarning,
+                      stacklevel=2)
         return RigidBodies
-    raise AttributeError(f"module 'tumble.rigid' has no attribute {name!r}")
+    raise AttributeError(f"module 'tumble.rigid_model' has no attribute {name!r}")

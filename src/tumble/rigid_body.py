@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import attitude
-from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes  # noqa: F401 (re-exported: tumble.body.principal_axes)
+from tumble._inertia import as_rotation, as_shape, check_inertia, frozen, parallel_axis, principal_axes  # noqa: F401 (re-exported: tumble.rigid_body.principal_axes)
 from tumble._validate import ValidationError, as_array, require_positive
 
 __all__ = ["RigidBody", "Part"]
@@ -99,7 +99,7 @@ class Part:
 
 class RigidBody:
     """Immutable, validated mass properties of a rigid body: a value, which :func:`tumble.simulate` turns into
-    its model (:func:`tumble.as_model`: :class:`tumble.rigid.RigidBodies`).
+    its model (:func:`tumble.as_model`: :class:`tumble.rigid_model.RigidBodies`).
 
     ``RigidBody(inertia, *, mass=None, com=None, check_triangle=True, name=None)``
 
@@ -128,7 +128,7 @@ class RigidBody:
     _name: str | None
     _q_bp: np.ndarray | None
 
-    #: How a body becomes its model, registered by :mod:`tumble.rigid` (the model builds on this value): what the
+    #: How a body becomes its model, registered by :mod:`tumble.rigid_model` (the model builds on this value): what the
     #: deprecated model interface (:data:`_MODEL_INTERFACE`) answers with.
     _model_of: ClassVar[Callable[[RigidBody], Any] | None] = None
 
