@@ -38,6 +38,7 @@ import os
 import sys
 from typing import TYPE_CHECKING
 
+import numpy as np
 from distributed.diagnostics.plugin import WorkerPlugin
 
 from tumble._cache import PACKAGE, _writable, content_key
@@ -77,14 +78,15 @@ def _python_tag() -> str:
     return f"py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}"
 
 
-def _tumble_dispatchers() -> list:
+def _tumble_dispatchers() -> list[tuple[object, str]]:
     """Numba's dispatchers of the functions defined in tumble's package that hold compiled code in this
-    process and cache it on disk."""
+    process and cache it on disk, each with its source file relative to the package."""
     from numba.core.caching import Cache
     from numba.core.dispatcher import Dispatcher
 
-    return [d for d in gc.get_objects() if isinstance(d, Dispatcher) and d.overloads and isinstance(
-        getattr(d, "_cache", None), Cache) and _relative_source(d.py_func.__code__.co_filename) is not None]
+    held = [d for d in gc.get_objects() if isinstance(d, Dispatcher) and d.overloads
+            and isinstance(getattr(d, "_cache", None), Cache)]
+    return [(d, source) for d in held if (source := _relative_source(d.py_func.__code__.co_filename)) is not None]
 
 
 def _relative_source(path: str) -> str | None:
@@ -93,8 +95,9 @@ def _relative_source(path: str) -> str | None:
     return os.path.relpath(real, PACKAGE).replace(os.sep, "/") if real.startswith(str(PACKAGE) + os.sep) else None
 
 
-def _entries(dispatcher) -> list[Entry]:
-    """The cache entries of ``dispatcher`` for the signatures it holds compiled code for here."""
+def _entries(dispatcher, source: str) -> list[Entry]:
+    """The cache entries of ``dispatcher`` (of the function defined in ``source``) for the signatures it holds
+    compiled code for here."""
     from numba.core import sigutils
 
     cache_file = dispatcher._cache._cache_file
@@ -108,25 +111,23 @@ def _entries(dispatcher) -> list[Entry]:
                 data = f.read()
         except OSError:  # removed since the index was written: the worker compiles this one
             continue
-        found.append(Entry(_relative_source(dispatcher.py_func.__code__.co_filename),
-                           cache_file._index_name.removesuffix(".nbi"), key, data))
+        found.append(Entry(source, cache_file._index_name.removesuffix(".nbi"), key, data))
     return found
 
 
 def compiled_for(plan: Plan) -> CompiledCode:
-    """The plugin carrying the cache entries of the tumble functions that ``plan``'s chunks run: the first
-    chunk's samples are simulated here over the first output interval (at most one step of a fixed-step
-    method), which loads or compiles them, then every tumble function compiled in this process is taken
-    (in a process that ran other models before, theirs too)."""
-    from tumble.sweeps.runner import _numba_settings_from_environment
-
+    """The plugin carrying the cache entries of the tumble functions that ``plan``'s chunks run, compiled for
+    this process's CPU: the first chunk's samples are simulated here over the first output interval (at most
+    one step of a fixed-step method), which loads or compiles them, then the entries of every tumble function
+    compiled in this process are taken (in a process that ran other models before, theirs too)."""
     lo, hi = plan.chunks.bounds(0)
-    t0, t1 = float(plan.t[0]), float(plan.t[min(1, len(plan.t) - 1)])
-    if "dt" in plan.options:
-        t1 = min(t1, t0 + float(plan.options["dt"]))
-    _numba_settings_from_environment()
-    dataclasses.replace(plan, t=[t0, t1]).simulate(plan.inputs(lo, hi))
-    entries = [entry for dispatcher in _tumble_dispatchers() for entry in _entries(dispatcher)]
+    t = np.array(plan.t[:2], dtype=np.float64)
+    if len(t) == 2 and "dt" in plan.options:
+        t[1] = min(t[1], t[0] + float(plan.options["dt"]))
+    dataclasses.replace(plan, t=t).simulate(plan.inputs(lo, hi))
+    cpu = target()
+    entries = [entry for dispatcher, source in _tumble_dispatchers() for entry in _entries(dispatcher, source)
+               if entry.cpu == cpu]
     return CompiledCode(content_key(), _python_tag(), tuple(entries))
 
 
