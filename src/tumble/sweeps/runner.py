@@ -190,5 +190,5 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         if cluster is not None:
             client.close()
             cluster.close()
-        else:
+        elif client.status == "running":  # a scheduler gone leaves no plugin behind
             client.unregister_worker_plugin(run)
