@@ -57,20 +57,22 @@ def assert_one_line_error(result, message, code=2):
 @contextlib.contextmanager
 def dask_processes(path, workers, env, timeout):
     """A ``dask scheduler`` process writing its address to ``path`` and one ``dask worker`` process per entry
-    ``(name, threads)`` of ``workers``, every server on 127.0.0.1; yields ``path`` once every worker has joined,
-    and stops them all after (the workers first: a worker whose scheduler is gone retries it before it exits)."""
+    ``(name, threads)`` or ``(name, threads, environment)`` of ``workers`` (``env`` updated with the worker's own
+    ``environment``), every server on 127.0.0.1; yields ``path`` once every worker has joined, and stops them
+    all after (the workers first: a worker whose scheduler is gone retries it before it exits)."""
     import distributed
 
     cli = [sys.executable, "-m"]
     commands = [["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
                  "--dashboard-address", "127.0.0.1:0", "--scheduler-file", str(path)]]
     commands += [["distributed.cli.dask_worker", "--scheduler-file", str(path), "--host", "127.0.0.1", "--nthreads",
-                  str(threads), "--nworkers", "1", "--name", name, "--dashboard-address", "127.0.0.1:0"]
-                 for name, threads in workers]  # a worker waits for the scheduler's file
+                  str(worker[1]), "--nworkers", "1", "--name", worker[0], "--dashboard-address", "127.0.0.1:0"]
+                 for worker in workers]  # a worker waits for the scheduler's file
+    environments = [env] + [{**env, **(worker[2] if len(worker) > 2 else {})} for worker in workers]
     processes = []
     try:
-        for command in commands:
-            processes.append(subprocess.Popen(cli + command, env=env, stdout=subprocess.DEVNULL,
+        for command, environment in zip(commands, environments):
+            processes.append(subprocess.Popen(cli + command, env=environment, stdout=subprocess.DEVNULL,
                                               stderr=subprocess.DEVNULL))
         deadline = time.monotonic() + timeout
         while not path.exists():
@@ -82,3 +84,31 @@ def dask_processes(path, workers, env, timeout):
     finally:
         stop(*processes[1:])
         stop(*processes[:1])
+
+
+_RECORDERS: list = []  # the compile recorder of this process, once record_compiles has run
+
+
+def record_compiles() -> None:
+    """From now on, record Numba's compiles in this process (a Dask worker's, through ``client.run``)."""
+    from numba.core import event
+
+    if not _RECORDERS:
+        _RECORDERS.append(event.RecordingListener())
+        event.register("numba:compile", _RECORDERS[0])
+
+
+def compiled() -> list[str]:
+    """The functions Numba compiled in this process since :func:`record_compiles` (``module.qualname``)."""
+    function = lambda ev: ev.data["dispatcher"].py_func  # noqa: E731
+    return [f"{function(ev).__module__}.{function(ev).__qualname__}" for _, ev in _RECORDERS[0].buffer
+            if ev.is_start]
+
+
+def numba_cache_files() -> list[str]:
+    """The names of Numba's cache files (index, data) under this process's ``NUMBA_CACHE_DIR``."""
+    from pathlib import Path
+
+    from numba.core import config
+
+    return sorted(path.name for path in Path(config.CACHE_DIR).rglob("*.nb[ic]"))

@@ -1,5 +1,6 @@
 """tumble.sweep on real Dask components: a LocalCluster of 2 worker processes, and a ``dask scheduler`` with two
-``dask worker`` processes started here on 127.0.0.1; a worker killed mid-sweep, a client killed and resumed.
+``dask worker`` processes started here on 127.0.0.1; a worker killed mid-sweep, a client killed and resumed;
+workers importing tumble from another path, each with an empty cache, given the client's compiled code.
 
 Every result is compared bit for bit with the same sweep run in this process
 (``workers=0``), which is computed first: it compiles the kernel (a batch of
@@ -10,6 +11,7 @@ from which the worker processes load it instead of compiling again.
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -19,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import dask_processes, stop
+from helpers import compiled, dask_processes, numba_cache_files, record_compiles, stop
 
 import tumble
 from tumble.sweeps import Final, Max, Normal, NutationAngle, PointingError, UniformAttitude
@@ -124,6 +126,34 @@ def test_scheduler_and_worker_processes_equal_the_run_in_this_process(scheduler_
         assert sorted(w["name"] for w in client.scheduler_info()["workers"].values()) == ["w1", "w2"]
         ds = tumble.sweep(BODY, client=client, **SWEEP)
     assert_same(ds, reference)
+
+
+@pytest.fixture(scope="module")
+def elsewhere(reference, tmp_path_factory):
+    """``dask scheduler`` and two ``dask worker`` processes importing tumble from a copy of its sources at
+    another path (without their caches), each worker with its own empty ``NUMBA_CACHE_DIR``; yields the
+    scheduler's file and the copy's root."""
+    root = tmp_path_factory.mktemp("elsewhere")
+    shutil.copytree(Path(tumble.__file__).parent, root / "src" / "tumble", ignore=shutil.ignore_patterns("__pycache__"))
+    env = {**ENV, "PYTHONPATH": os.pathsep.join([str(root / "src"), str(Path(__file__).parent)])}
+    workers = [(name, 1, {"NUMBA_CACHE_DIR": str(root / f"cache-{name}")}) for name in ("w1", "w2")]
+    with dask_processes(root / "scheduler.json", workers, env, TIMEOUT) as path:
+        yield path, root
+
+
+def test_workers_elsewhere_with_empty_caches_load_the_clients_compiled_code(elsewhere, reference):
+    path, root = elsewhere
+    with distributed.Client(scheduler_file=str(path), timeout=TIMEOUT) as client:
+        assert client.run(numba_cache_files) == {address: [] for address in client.scheduler_info()["workers"]}
+        client.run(record_compiles)
+        ds = tumble.sweep(BODY, client=client, **SWEEP)
+        files = client.run(numba_cache_files)
+        compiles = client.run(compiled)
+        sources = client.run(lambda: __import__("tumble").__file__)
+    assert_same(ds, reference)
+    assert all(Path(source).is_relative_to(root) for source in sources.values())
+    assert all(any(name.endswith(".nbi") for name in names) for names in files.values()), files
+    assert compiles == {address: [] for address in files}  # every kernel of the sweep loaded, none compiled
 
 
 CLIENT = textwrap.dedent("""

@@ -157,6 +157,10 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         raise ValidationError("workers: give it only without client= (a client's cluster has its own workers)")
     # keys of this call alone: two sweeps on one scheduler never share a task, whatever their settings
     run = f"tumble-sweep-{plan.token()}-{uuid.uuid4().hex}"
+    if cluster is None:  # workers perhaps elsewhere, with another cache: give them this process's compiled code
+        from tumble.sweeps.shipping import compiled_for
+
+        client.register_plugin(compiled_for(plan), name=run)
     futures: dict = {}  # the chunks in flight: future → chunk
 
     def submit(k: int):
@@ -186,3 +190,5 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         if cluster is not None:
             client.close()
             cluster.close()
+        elif client.status == "running":  # a scheduler gone leaves no plugin behind
+            client.unregister_worker_plugin(run)
