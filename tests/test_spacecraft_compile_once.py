@@ -16,14 +16,14 @@ from numba.core import event
 import tumble
 from tumble import torques
 from tumble.kernels import spacecraft as kernel
+from tumble.kernels.spacecraft import _assembly
 from tumble.spacecraft import (CMGCluster, Environment, MRPFeedback, Orbit, QuaternionPD, ResidualDipole,
                                Spacecraft, pyramid_wheels)
 from tumble.spacecraft.surfaces import Drag, SolarPressure, box_facets
 
-# Every test here compiles the spacecraft's kernels on a cold Numba cache (its assembled right-hand side alone
-# ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# The tests marked slow compile the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
+# alone ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
 # worker (tests/conftest.py, KINDS), so that one process pays it.
-pytestmark = pytest.mark.slow
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
 T = np.linspace(0.0, 2.0, 3)
@@ -50,12 +50,22 @@ def environment_parts():
                       controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
 
 
+def test_one_assembly_per_state_rank():
+    """The right-hand side, the projection, the diagnostics and the start sample share one assembly of the
+    compiled functions: however the arguments are spelled, a second assembly would compile them all again."""
+    first = _assembly.assemble(1, False)
+    assert first is _assembly.assemble(1, False, False) is _assembly.assemble(np.int64(1), 0, device=False)
+    assert _assembly.assemble(2, False) is not first and _assembly.assemble(1, False, True) is not first
+
+
+@pytest.mark.slow
 def test_every_composition_has_one_numba_type():
     first = wheels_and_mrp().compile(None, 0.0)
     second = wheels_cmgs_pd_dipole().compile(torques.ConstantBody([1e-3, 0.0, -2e-3]), 0.0)
     assert numba.typeof(first) == numba.typeof(second) == numba.typeof(environment_parts().compile(None, 0.0))
 
 
+@pytest.mark.slow
 def test_a_new_composition_compiles_nothing():
     tumble.simulate(wheels_and_mrp(), [0.01, -0.02, 0.03], t=T, method="rk4", dt=0.1)
     signatures = len(kernel.evaluate.signatures)

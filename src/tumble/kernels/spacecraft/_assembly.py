@@ -195,7 +195,6 @@ def _no_sensing(model, t, y, j):
     pass
 
 
-@functools.lru_cache(maxsize=None)
 def assemble(ndim, python, device=False):
     """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, discrete)``; ``python``: the
     variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
@@ -209,6 +208,13 @@ def assemble(ndim, python, device=False):
     PWPF triggers); ``discrete(model)`` is True when a part present updates after every step (without a
     zero-order hold, which samples at its own times); ``device``: the variant compiled for a GPU, without the
     flight software. Cached, so that the right-hand side, the projection and the diagnostics share it."""
+    return _assembled(int(ndim), bool(python), bool(device))
+
+
+@functools.lru_cache(maxsize=None)
+def _assembled(ndim, python, device):
+    """:func:`assemble`, cached on its arguments normalised (``assemble(1, False)`` and ``assemble(1, False,
+    False)`` are one assembly: a second would compile every function of the spacecraft again)."""
     access = lane(ndim)
     at, put, put3 = access
     direct = _commands.make_direct(access)
