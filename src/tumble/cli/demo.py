@@ -21,10 +21,12 @@ from typing import Annotated, Any
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-try:  # the recent typer releases carry their own copy of click, which raises these
+try:  # the recent typer releases carry their own copy of click
+    from typer._click import Command, Context
     from typer._click.exceptions import BadParameter, NoSuchOption, UsageError
-except ImportError:
-    from click.exceptions import BadParameter, NoSuchOption, UsageError
+except ImportError:  # the earlier ones raise click's own
+    from click import Command, Context  # type: ignore[assignment]
+    from click.exceptions import BadParameter, NoSuchOption, UsageError  # type: ignore[assignment]
 
 from tumble._validate import ValidationError
 from tumble.cli.common import check_outputs, print_rows, progress_bar
@@ -48,8 +50,8 @@ class _OneLineUsage:
 
     params: list[Any]
 
-    def make_context(self, info_name: str | None, args: list[str], parent: typer.Context | None = None,
-                     **extra: Any) -> typer.Context:
+    def make_context(self, info_name: str | None, args: list[str], parent: Context | None = None,
+                     **extra: Any) -> Context:
         try:
             return super().make_context(info_name, args, parent=parent, **extra)  # type: ignore[misc]
         except UsageError as exc:
@@ -64,7 +66,7 @@ class _DemoCommand(_OneLineUsage, TyperCommand):
 class _DemoGroup(_OneLineUsage, TyperGroup):
     """``tumble demo``: a name that is no demo is one ``error:`` line naming the demos (exit 2)."""
 
-    def resolve_command(self, ctx: typer.Context, args: list[str]) -> tuple[str | None, Any | None, list[str]]:
+    def resolve_command(self, ctx: Context, args: list[str]) -> tuple[str | None, Command | None, list[str]]:
         if args and args[0] not in DEMOS and not args[0].startswith("-"):
             fail(f"{args[0]}: not a demo of tumble demo (the demos: {', '.join(DEMOS)})")
         return super().resolve_command(ctx, args)
@@ -101,7 +103,7 @@ _OLD_SPELLINGS = {
 }
 
 
-def _old_outputs(old: _OldSpelling, output: Path, plot: Path | None) -> list[tuple[str, Path]]:
+def _old_outputs(old: _OldSpelling, output: Path, plot: Path | None) -> list[tuple[str, Path | None]]:
     """The files of the old spelling, each with the option that names it: the viewer page is the figure's
     name with ``.html``."""
     if old.plot is None:
@@ -114,15 +116,17 @@ def _run(name: str, demo: Demo, output: Path, plot: Path | None, quiet: bool, op
     """Check the options and the outputs, run the demo (in its old spelling where ``output`` names a file or
     ``--plot`` is given), print its rows and the files written."""
     old = _OLD_SPELLINGS.get(name)
-    is_old = old is not None and (plot is not None or (output.suffix == old.suffix and not output.is_dir()))
-    if is_old:
+    if old is not None and not (plot is not None or (output.suffix == old.suffix and not output.is_dir())):
+        old = None  # the new spelling
+    if old is not None:
         typer.echo(f"warning: `tumble demo {name} -o FILE{old.suffix}"
                    + (" --plot FILE.png" if old.plot else "") + f"` is deprecated and removed in 0.5: use "
                    f"`tumble demo {name} -o DIRECTORY` (writes {', '.join(demo.files)} there)", err=True)
     with exit_codes():
         for option in demo.options:
             options[option.keyword] = resolve(option.check)(options[option.keyword], option.flag)
-        if is_old:
+        outputs: list[tuple[str, Path | None]]
+        if old is not None:
             outputs = _old_outputs(old, output, plot)
         elif output.is_dir():
             outputs = [("--output", output / file) for file in demo.files]
@@ -132,7 +136,7 @@ def _run(name: str, demo: Demo, output: Path, plot: Path | None, quiet: bool, op
         with progress_bar("simulating", enabled=demo.progress and not quiet) as progress:
             if demo.progress:
                 options["progress"] = progress
-            if is_old:
+            if old is not None:
                 numbers = resolve(old.write)(*(path for option, path in outputs if "page" not in option), **options)
             else:
                 numbers = resolve(demo.target)(output, **options)

@@ -27,7 +27,7 @@ from tumble.analytic._stability import stability
 from tumble.body import RigidBody
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
-from tumble.viz._output import out_directory
+from tumble.viz._output import out_directory, png_writer, text_writer
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -236,8 +236,7 @@ def write_polhode(output: str | os.PathLike[str]) -> dict:
     traj = simulate(body, omega0, t=np.linspace(0.0, report.polhode_period, _DEMO_FRAMES),
                     method="dop853", rtol=_DEMO_TOLERANCE, atol=_DEMO_TOLERANCE)
     html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in T_HANDLE_PIECES])
-    write_atomic_all([(output, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120)),
-                      (page, lambda tmp_path: Path(tmp_path).write_text(html, encoding="utf-8"))])
+    write_atomic_all([(output, png_writer(figure)), (page, text_writer(html))])
     return {"moments": tuple(float(m) for m in report.moments), "axis_stability": tuple(report.axis_stability),
             "regime": report.regime, "flip_interval_s": report.flip_interval,
             "polhode_period_s": report.polhode_period, "omega_principal": DEMO_OMEGA,

@@ -21,7 +21,7 @@ from tumble.analytic._stability import flip_interval
 from tumble.body import RigidBody
 from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
-from tumble.viz._output import out_directory
+from tumble.viz._output import out_directory, png_writer, text_writer
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -95,9 +95,7 @@ def write_racket(output: str | os.PathLike[str], plot: str | os.PathLike[str], *
     flips = flip_times(traj, body)
     html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in T_HANDLE_PIECES])
     figure = racket_figure(traj, body, flips)
-    write_atomic_all([(output, traj._write_netcdf),
-                      (plot, lambda tmp_path: figure.savefig(tmp_path, format="png", dpi=120)),
-                      (page, lambda tmp_path: Path(tmp_path).write_text(html, encoding="utf-8"))])
+    write_atomic_all([(output, traj._write_netcdf), (plot, png_writer(figure)), (page, text_writer(html))])
     return {"trajectory": traj, "duration_s": duration, "flips": flips.size,
             "mean_flip_interval_s": float(np.diff(flips).mean()) if flips.size > 1 else None,
             "predicted_flip_interval_s": flip_interval(body, omega0),
