@@ -8,7 +8,7 @@ compiled version per model kind and integration method (docs/architecture.md,
 every later process loads the cached code in milliseconds. ``tumble warmup``
 (or ``python -m tumble warmup``) makes those first calls at install time
 instead: each path below runs a tiny simulation (a few steps) — each model
-kind of :data:`KINDS` under each method its kernel provides for, then the
+kind of the registry :data:`tumble._kinds.MODEL_KINDS` under each method its kernel provides for, then the
 quick-start demo, a batch of rigid bodies and a heavy top.
 """
 
@@ -19,23 +19,26 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from tumble._kinds import MODEL_KINDS, resolve
+
 if TYPE_CHECKING:
     from tumble.simulate import Model, SolverOptions
 
-__all__ = ["KINDS", "kind_path", "methods", "paths"]
+__all__ = ["example", "flexible", "gimbaled_gyro", "gyroscope", "human", "kind_path", "methods", "paths", "rigid",
+           "robot_tree", "serial_chain", "slosh", "spacecraft", "variable"]
 
 _OMEGA0 = np.array([0.1, 1.0, 0.1])  # rad/s
 _T = np.array([0.0, 0.02, 0.04])  # s: a few steps
 _INERTIA = np.diag([1.0, 2.0, 3.0])  # kg·m²
 
 
-def _rigid() -> tuple[Model, dict[str, Any]]:
+def rigid() -> tuple[Model, dict[str, Any]]:
     import tumble
 
     return tumble.as_model(tumble.RigidBody(_INERTIA)), {"omega0": _OMEGA0}
 
 
-def _spacecraft() -> tuple[Model, dict[str, Any]]:
+def spacecraft() -> tuple[Model, dict[str, Any]]:
     """Three reaction wheels under Schaub's MRP feedback (the craft of tests/test_models.py)."""
     from tumble.spacecraft import MRPFeedback, ReactionWheel, Spacecraft
 
@@ -45,7 +48,7 @@ def _spacecraft() -> tuple[Model, dict[str, Any]]:
     return craft, {"omega0": [0.01, -0.01, 0.005], "wheel_speeds0": [20.0, -10.0, 5.0]}
 
 
-def _flexible() -> tuple[Model, dict[str, Any]]:
+def flexible() -> tuple[Model, dict[str, Any]]:
     import tumble
     from tumble.flexible import FlexibleBody, Mode
 
@@ -53,7 +56,7 @@ def _flexible() -> tuple[Model, dict[str, Any]]:
     return body, {"omega0": _OMEGA0, "eta0": [0.05]}
 
 
-def _slosh() -> tuple[Model, dict[str, Any]]:
+def slosh() -> tuple[Model, dict[str, Any]]:
     import tumble
     from tumble.slosh import Pendulum, SloshBody
 
@@ -62,7 +65,7 @@ def _slosh() -> tuple[Model, dict[str, Any]]:
     return body, {"omega0": _OMEGA0, "direction0": [1.0, 1.0, 0.0]}
 
 
-def _variable() -> tuple[Model, dict[str, Any]]:
+def variable() -> tuple[Model, dict[str, Any]]:
     """A body whose inertia grows by 10 % a second."""
     from tumble.variable import VariableBody
 
@@ -72,7 +75,7 @@ def _variable() -> tuple[Model, dict[str, Any]]:
     return VariableBody.from_functions(inertia, t_span=(0.0, 1.0), dt=0.01), {"omega0": _OMEGA0}
 
 
-def _human() -> tuple[Model, dict[str, Any]]:
+def human() -> tuple[Model, dict[str, Any]]:
     """de Leva's diver raising the left arm."""
     from tumble.variable import Human, Motion
 
@@ -80,14 +83,14 @@ def _human() -> tuple[Model, dict[str, Any]]:
     return diver, {"omega0": [5.0, 0.0, 0.3]}
 
 
-def _gyroscope() -> tuple[Model, dict[str, Any]]:
+def gyroscope() -> tuple[Model, dict[str, Any]]:
     from tumble.ins import Gyroscope
 
     return (Gyroscope(spin_inertia=2e-3, transverse_inertia=1.5e-3, spin=100.0, mass=0.1, offset=0.02, tilt=1.0),
             {"precession_rate0": 0.5})
 
 
-def _gimbaled() -> tuple[Model, dict[str, Any]]:
+def gimbaled_gyro() -> tuple[Model, dict[str, Any]]:
     from tumble.ins import GimbaledGyro
 
     gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
@@ -95,7 +98,7 @@ def _gimbaled() -> tuple[Model, dict[str, Any]]:
     return gyro, {"spin": 100.0, "theta0": 1.0}
 
 
-def _chain() -> tuple[Model, dict[str, Any]]:
+def serial_chain() -> tuple[Model, dict[str, Any]]:
     """The planar two-link arm of the examples, falling."""
     import tumble
     from tumble import robot
@@ -103,7 +106,7 @@ def _chain() -> tuple[Model, dict[str, Any]]:
     return robot.load(tumble.examples.directory() / "robots" / "planar_2link.toml"), {"q0": [0.3, -0.5]}
 
 
-def _tree() -> tuple[Model, dict[str, Any]]:
+def robot_tree() -> tuple[Model, dict[str, Any]]:
     """A tree: a shoulder link carrying two one-link arms, turning about z, falling along −z."""
     from tumble.robot import Link, RobotTree
 
@@ -116,19 +119,10 @@ def _tree() -> tuple[Model, dict[str, Any]]:
     return RobotTree(links, [-1, 0, 0]), {"q0": [0.3, -0.5, 0.2]}
 
 
-#: model kind -> a function giving a model of that kind and its initial state (keyword arguments of simulate).
-KINDS: dict[str, Callable[[], tuple[Model, dict[str, Any]]]] = {
-    "RigidBody": _rigid,
-    "Spacecraft": _spacecraft,
-    "FlexibleBody": _flexible,
-    "SloshBody": _slosh,
-    "VariableBody": _variable,
-    "MovingHuman": _human,
-    "Gyroscope": _gyroscope,
-    "GimbaledGyro": _gimbaled,
-    "SerialChain": _chain,
-    "RobotTree": _tree,
-}
+def example(kind: str) -> tuple[Model, dict[str, Any]]:
+    """A tiny model of ``kind`` and its initial state (keyword arguments of ``simulate``): the example that the
+    registry of model kinds names (:data:`tumble._kinds.MODEL_KINDS`), one of the functions above."""
+    return resolve(MODEL_KINDS[kind].example)()
 
 
 def _options(method: str) -> SolverOptions:
@@ -145,7 +139,7 @@ def kind_path(kind: str, method: str) -> Callable[[], None]:
     def run() -> None:
         import tumble
 
-        model, state = KINDS[kind]()
+        model, state = example(kind)
         tumble.simulate(model, t=_T, method=method, **state, **_options(method))
 
     return run
@@ -155,7 +149,7 @@ def methods(kind: str) -> list[str]:
     """The methods whose needs the kernel of ``kind`` provides (:func:`tumble.integrate.check_method`'s rule)."""
     from tumble import integrate
 
-    provides = KINDS[kind]()[0].compile(None, 0.0).provides
+    provides = example(kind)[0].compile(None, 0.0).provides
     return [name for name, method in integrate.METHODS.items() if method.needs <= provides]
 
 
@@ -186,9 +180,9 @@ def _racket() -> None:
 
 def paths() -> dict[str, Callable[[], None]]:
     """Path name -> the call that compiles it, in the order ``tumble warmup`` runs them: ``"KIND, METHOD"`` for
-    each kind of :data:`KINDS` and each method it provides, then the first session's paths."""
+    each model kind and each method it provides, then the first session's paths."""
     return {
-        **{f"{kind}, {method}": kind_path(kind, method) for kind in KINDS for method in methods(kind)},
+        **{f"{kind}, {method}": kind_path(kind, method) for kind in MODEL_KINDS for method in methods(kind)},
         "demo racket": _racket,
         "a batch, rk4": _rigid_paths(members=2, method="rk4"),
         "a batch, dop853": _rigid_paths(members=2, method="dop853"),

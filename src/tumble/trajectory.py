@@ -29,6 +29,10 @@ trajectory converts to an :class:`xarray.Dataset`, saves to NetCDF-4
 atomically and reads back validated (:func:`load`). Its figure, viewer page,
 notebook view and table are drawn by :mod:`tumble.viz.trajectory`. The layout
 is described in ``docs/trajectory.md``.
+
+The module is one unit (about 500 lines): the checks of the fields, the
+invariants derived from them and the members of a batch all read the same
+shapes (``lead``), and its file format is :mod:`tumble._netcdf`.
 """
 
 from __future__ import annotations

@@ -1,184 +1,172 @@
-"""``tumble demo``: the T-handle's flips (``racket``), Poinsot's construction (``polhode``), the heavy top (``top``),
-and one command per row of the demo table :data:`tumble.viz.demos.DEMOS`."""
+"""``tumble demo NAME [-o DIRECTORY] [options]``: one command per row of the demo table
+:data:`tumble.viz.demos.DEMOS`; ``tumble demo`` (or ``tumble demo --list``) lists them, one line each.
+
+Every demo writes the files of its row into an existing directory (``-o``, default ``.``), each checked before
+it runs, and prints its numbers and the files written; its row's options are its command's options. A bad
+option, value or demo name is one ``error:`` line naming it (exit 2).
+
+Until 0.5 the spellings of ``racket`` and ``polhode`` that named files rather than a directory
+(``tumble demo racket -o FILE.nc --plot FILE.png``, ``tumble demo polhode -o FILE.png``) still work and write the
+same files, after a ``warning:`` line naming the new spelling (:data:`_OLD_SPELLINGS`).
+"""
 
 from __future__ import annotations
 
-import importlib
+import inspect
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
-import numpy as np
 import typer
+from typer.core import TyperCommand, TyperGroup
 
-from tumble._files import write_atomic_all
-from tumble._validate import ValidationError, require_memory, require_positive
-from tumble.measure import flip_times
-from tumble.analytic._stability import flip_interval, stability
-from tumble.rigid_body import RigidBody
-from tumble.cli.common import check_outputs, png, print_rows, progress_bar, summary, text, written
-from tumble.cli.errors import exit_codes
-from tumble.simulate import simulate
-from tumble.viz.demos import DEMOS, Demo
+try:  # the recent typer releases carry their own copy of click
+    from typer._click import Command, Context
+    from typer._click.exceptions import BadParameter, NoSuchOption, UsageError
+except ImportError:  # the earlier ones raise click's own
+    from click import Command, Context  # type: ignore[assignment]
+    from click.exceptions import BadParameter, NoSuchOption, UsageError  # type: ignore[assignment]
+
+from tumble._validate import ValidationError
+from tumble.cli.common import check_outputs, print_rows, progress_bar
+from tumble.cli.errors import exit_codes, fail
+from tumble.viz.demos import DEMOS, Demo, resolve
 
 __all__ = ["demo_app"]
 
-demo_app = typer.Typer(help="Built-in demonstrations.", no_args_is_help=True, rich_markup_mode="markdown")
 
-# Tennis-racket demo: spin about the intermediate axis, perturbation on the
-# other two (rad/s, principal axes), and output rate. A flip of the default
-# T-handle at 10 rad/s lasts about 1/λ = 0.14 s (λ = |ω| √((I₂−I₁)(I₃−I₂)/(I₁I₃))
-# = 7.2 /s), so 200 samples per second put ~28 samples on each flip.
-_RACKET_SPIN = 10.0
-_RACKET_PERTURBATION = 1e-3
-_RACKET_SAMPLES_PER_SECOND = 200
-_RACKET_TOLERANCE = 1e-12
-# Polhode demo: the same T-handle, 10 rad/s about the intermediate axis and
-# 1 rad/s about each of the others (principal axes): a motion just inside the
-# "major" regime, so that its polhode stands apart from the separatrix.
-_POLHODE_OMEGA = (1.0, 10.0, 1.0)
-# Samples of its viewer page: one polhode period (4K/λ) at the viewer's default frame budget.
-_POLHODE_FRAMES = 600
-# The T-handle as the viewer draws it: RigidBody.t_handle()'s handle (along x, from the origin) and cross bar
-# (along y, centred on the handle's end), solid cylinders of its default radius and lengths (m).
-_T_HANDLE_PIECES: list[dict[str, Any]] = [dict(radius=0.004, length=0.08, axis="x", position=(0.04, 0.0, 0.0)),
-                                          dict(radius=0.004, length=0.08, axis="y", position=(0.08, 0.0, 0.0))]
+def _usage(exc: UsageError, command: str, options: list[str]) -> str:
+    """The one line of a command-line mistake: the option or value it names, and the rule."""
+    if isinstance(exc, NoSuchOption):
+        return f"{exc.option_name}: not an option of {command} (its options: {', '.join(options)})"
+    if isinstance(exc, BadParameter) and exc.param is not None and exc.param.opts:
+        return f"{'/'.join(exc.param.opts)}: {exc.message}"
+    return f"{command}: {exc.format_message()}"
 
 
-@demo_app.command("racket")
-def racket(
-    output: Annotated[Path, typer.Option("-o", "--output", help="NetCDF file to write.")] = Path("racket.nc"),
-    plot: Annotated[Path, typer.Option("--plot", help="PNG figure of the flips to write.")] = Path("racket.png"),
-    duration: Annotated[float, typer.Option("--duration", help="Simulated time, s.")] = 20.0,
-    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
-) -> None:
-    """Tennis-racket (Dzhanibekov) effect: a T-handle spun about its intermediate axis flips over and over.
+class _OneLineUsage:
+    """A command whose command-line mistakes are one ``error:`` line (exit 2), not a usage box."""
 
-    The default RigidBody.t_handle() starts at 10 rad/s about its intermediate principal axis
-    with 1e-3 rad/s about the other two, integrated by dop853 at rtol = atol = 1e-12. A flip
-    is a sign change of the intermediate-axis rate; the command prints their number, the
-    mean time between them, and the time between flips predicted by the exact (elliptic)
-    solution, 2K(m)/lambda. Beside the figure it writes the flips in the offline 3-D viewer
-    (the figure's name with .html).
-    """
-    from tumble.viz.viewer import Cylinder, html_page
-    from tumble.viz.racket import racket_figure
+    params: list[Any]
 
+    def make_context(self, info_name: str | None, args: list[str], parent: Context | None = None,
+                     **extra: Any) -> Context:
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)  # type: ignore[misc]
+        except UsageError as exc:
+            options = ["/".join(param.opts) for param in self.params if param.opts and not param.hidden]
+            fail(_usage(exc, f"tumble demo{'' if info_name == 'demo' else f' {info_name}'}", options))
+
+
+class _DemoCommand(_OneLineUsage, TyperCommand):
+    """A demo's command."""
+
+
+class _DemoGroup(_OneLineUsage, TyperGroup):
+    """``tumble demo``: a name that is no demo is one ``error:`` line naming the demos (exit 2)."""
+
+    def resolve_command(self, ctx: Context, args: list[str]) -> tuple[str | None, Command | None, list[str]]:
+        if args and args[0] not in DEMOS and not args[0].startswith("-"):
+            fail(f"{args[0]}: not a demo of tumble demo (the demos: {', '.join(DEMOS)})")
+        return super().resolve_command(ctx, args)
+
+
+demo_app = typer.Typer(cls=_DemoGroup, invoke_without_command=True, rich_markup_mode="markdown",
+                       help="Built-in demonstrations: `tumble demo` lists them; `tumble demo NAME --help` tells one.")
+
+
+@demo_app.callback()
+def demos(ctx: typer.Context,
+          list_: Annotated[bool, typer.Option("--list", help="List the demos, one line each.")] = False) -> None:
+    """Built-in demonstrations: ``tumble demo NAME [-o DIRECTORY] [options]``; ``tumble demo`` lists them."""
+    if ctx.invoked_subcommand is None:
+        width = max(map(len, DEMOS)) + 2
+        for name, demo in DEMOS.items():
+            typer.echo(f"{name:<{width}}{demo.shows}")
+
+
+@dataclass(frozen=True)
+class _OldSpelling:
+    """A demo's spelling before 0.4, kept until 0.5: ``-o`` named a file (with ``suffix``), and ``--plot`` the
+    figure where ``plot`` is set; ``write`` (``"module:function"``, ``(output[, plot], **options) -> dict``)
+    writes them, the viewer page beside the figure."""
+
+    suffix: str
+    plot: str | None
+    write: str
+
+
+_OLD_SPELLINGS = {
+    "racket": _OldSpelling(".nc", "racket.png", "tumble.viz.racket:write_racket"),
+    "polhode": _OldSpelling(".png", None, "tumble.viz.polhode:write_polhode"),
+}
+
+
+def _old_outputs(old: _OldSpelling, output: Path, plot: Path | None) -> list[tuple[str, Path | None]]:
+    """The files of the old spelling, each with the option that names it: the viewer page is the figure's
+    name with ``.html``."""
+    if old.plot is None:
+        return [("--output", output), ("--output's viewer page", output.with_suffix(".html"))]
+    plot = Path(old.plot) if plot is None else plot
+    return [("--output", output), ("--plot", plot), ("--plot's viewer page", plot.with_suffix(".html"))]
+
+
+def _run(name: str, demo: Demo, output: Path, plot: Path | None, quiet: bool, options: dict[str, Any]) -> None:
+    """Check the options and the outputs, run the demo (in its old spelling where ``output`` names a file or
+    ``--plot`` is given), print its rows and the files written."""
+    old = _OLD_SPELLINGS.get(name)
+    if old is not None and not (plot is not None or (output.suffix == old.suffix and not output.is_dir())):
+        old = None  # the new spelling
+    if old is not None:
+        typer.echo(f"warning: `tumble demo {name} -o FILE{old.suffix}"
+                   + (" --plot FILE.png" if old.plot else "") + f"` is deprecated and removed in 0.5: use "
+                   f"`tumble demo {name} -o DIRECTORY` (writes {', '.join(demo.files)} there)", err=True)
     with exit_codes():
-        require_positive(duration, "--duration")
-        page = plot.with_suffix(".html")
-        check_outputs([("--output", output), ("--plot", plot), ("--plot's viewer page", page)])
-        body = RigidBody.t_handle()
-        omega0 = body.axes @ np.array([_RACKET_PERTURBATION, _RACKET_SPIN, _RACKET_PERTURBATION])
-        # t, q, omega and the totals (energy, momentum): 11 float64 per sample, twice over (states and result)
-        samples = duration * _RACKET_SAMPLES_PER_SECOND + 1
-        require_memory(2 * 11 * 8 * samples, "--duration", f"the samples of {duration:g} s "
-                                                           f"({_RACKET_SAMPLES_PER_SECOND} per second)")
-        n = int(np.ceil(duration * _RACKET_SAMPLES_PER_SECOND))
-        with progress_bar("simulating", enabled=not quiet) as progress:
-            traj = simulate(body, omega0, t=np.linspace(0.0, duration, n + 1),
-                            method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE, progress=progress)
-        flips = flip_times(traj, body)
-        html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
-        write_atomic_all([(output, traj._write_netcdf), *png(racket_figure(traj, body, flips), plot),
-                          (page, text(html))])
-    mean = f", mean time between flips {np.diff(flips).mean():.6g} s" if flips.size > 1 else ""
-    print_rows([*summary(traj), ("flips", f"{flips.size} in {duration:g} s{mean}"),
-                 ("predicted", f"time between flips 2K/lambda = {flip_interval(body, omega0):.6g} s (exact solution)"),
-                 ("wrote", f"{written(output, plot)}, {page}")])
-
-
-@demo_app.command("polhode")
-def polhode(
-    output: Annotated[Path, typer.Option("-o", "--output", help="PNG figure to write.")] = Path("polhode.png"),
-) -> None:
-    """Poinsot's construction: polhodes on the energy ellipsoid and the herpolhode of a T-handle.
-
-    RigidBody.t_handle() spinning at 10 rad/s about its intermediate principal axis and 1 rad/s
-    about each of the other two. The figure (tumble.viz.polhode.polhode_figure) shows the energy
-    ellipsoid with a family of polhodes, the separatrix and this motion's polhode, and the
-    herpolhode on the invariable plane; the command prints the stability of the axes and the
-    predicted times. Beside the PNG, the same name with .html: the 3-D viewer of one polhode
-    period of the motion (the T-handle turning, omega and L, and its polhode on the energy ellipsoid).
-    """
-    from tumble.viz.viewer import Cylinder, html_page
-    from tumble.viz.polhode import polhode_figure
-
-    with exit_codes():
-        page = output.with_suffix(".html")
-        check_outputs([("--output", output), ("--output's viewer page", page)])
-        body = RigidBody.t_handle()
-        omega0 = body.axes @ np.array(_POLHODE_OMEGA)
-        report = stability(body, omega0)
-        figure = polhode_figure(body, omega0)
-        traj = simulate(body, omega0, t=np.linspace(0.0, report.polhode_period, _POLHODE_FRAMES),
-                        method="dop853", rtol=_RACKET_TOLERANCE, atol=_RACKET_TOLERANCE)
-        html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in _T_HANDLE_PIECES])
-        write_atomic_all([*png(figure, output), (page, text(html))])
-    moments = ", ".join(f"{m:.4g}" for m in report.moments)
-    print_rows([
-        ("body", f"T-handle, principal moments {moments} kg m^2"),
-        ("axes", ", ".join(f"{i + 1}: {kind}" for i, kind in enumerate(report.axis_stability))),
-        ("omega", "[" + ", ".join(f"{w:g}" for w in _POLHODE_OMEGA) + f"] rad/s (principal axes), "
-                  f"regime {report.regime!r}"),
-        ("timing", f"flips every 2K/lambda = {report.flip_interval:.6g} s, "
-                   f"polhode period 4K/lambda = {report.polhode_period:.6g} s"),
-        ("wrote", f"{output}, {page}"),
-    ])
-
-
-@demo_app.command("top")
-def top(
-    output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write top.nc, top.png and top.html in.")]
-    = Path("."),
-    duration: Annotated[float, typer.Option("--duration", help="Simulated time, s.")] = 1.5,
-) -> None:
-    """Heavy symmetric top: simulation (gravity torque on a pivot) against the exact theory.
-
-    Runs tumble.viz.top.demo_top: a spinning top released at 60 deg from the vertical nutates
-    between two angles while it precesses. Writes top.nc and top.png in the directory and prints
-    the nutation bounds, the nutation period and the mean precession rate, exact and measured; and top.html,
-    the 3-D viewer of the run.
-    """
-    from tumble.viz.top import demo_top
-
-    with exit_codes():
-        require_positive(duration, "--duration")
-        if not output.is_dir():
+        for option in demo.options:
+            options[option.keyword] = resolve(option.check)(options[option.keyword], option.flag)
+        outputs: list[tuple[str, Path | None]]
+        if old is not None:
+            outputs = _old_outputs(old, output, plot)
+        elif output.is_dir():
+            outputs = [("--output", output / file) for file in demo.files]
+        else:
             raise ValidationError(f"--output: {str(output)!r} is not an existing directory")
-        check_outputs([("--output", output / name) for name in ("top.nc", "top.png", "top.html")])
-        summary = demo_top(output, duration=duration)
-    print_rows([
-        ("nutation", f"theta from {summary['theta_min_deg']:.6g} to {summary['theta_max_deg']:.6g} deg (exact), "
-                     f"{summary['theta_min_deg_measured']:.6g} to {summary['theta_max_deg_measured']:.6g} deg "
-                     "(simulated)"),
-        ("period", f"{summary['nutation_period_s']:.6g} s (exact), "
-                   f"{summary['nutation_period_s_measured']:.6g} s (simulated)"),
-        ("rate", f"mean precession rate {summary['mean_precession_rate']:.6g} rad/s (exact), "
-                 f"{summary['mean_precession_rate_measured']:.6g} rad/s (simulated)"),
-        ("spin", f"{summary['spin']:.6g} rad/s (critical spin {summary['critical_spin']:.6g} rad/s: "
-                 "the upright top is stable above it)"),
-        ("wrote", f"{summary['nc']}, {summary['png']}, {summary['html']}"),
-    ])
+        check_outputs(outputs)
+        with progress_bar("simulating", enabled=demo.progress and not quiet) as progress:
+            if demo.progress:
+                options["progress"] = progress
+            if old is not None:
+                numbers = resolve(old.write)(*(path for option, path in outputs if "page" not in option), **options)
+            else:
+                numbers = resolve(demo.target)(output, **options)
+    print_rows([*demo.rows(numbers), ("wrote", ", ".join(str(path) for _, path in outputs))])
 
 
-def _demo_command(demo: Demo) -> Callable[..., None]:
-    """The ``tumble demo NAME`` command of a row of :data:`tumble.viz.demos.DEMOS`: call its function on the
-    output directory, print its rows and the files it wrote."""
-    module, function = demo.target.split(":")
+def _command(name: str, demo: Demo) -> Callable[..., None]:
+    """The command of a row: ``-o DIRECTORY``, the row's options, ``--quiet`` where it draws a progress bar,
+    and the hidden ``--plot`` of an old spelling."""
 
-    def command(
-        output: Annotated[Path, typer.Option("-o", "--output", help="Existing directory to write the files in.")]
-        = Path("."),
-    ) -> None:
-        with exit_codes():
-            summary = getattr(importlib.import_module(module), function)(output)
-        written = [str(v) for v in summary.values() if isinstance(v, (str, Path)) and str(v).endswith((".png", ".nc", ".html"))]
-        print_rows([*demo.rows(summary), ("wrote", ", ".join(written))])
+    def command(*, output: Path, plot: Path | None = None, quiet: bool = False, **options: Any) -> None:
+        _run(name, demo, output, plot, quiet, options)
 
+    keyword = inspect.Parameter.KEYWORD_ONLY
+    parameters = [inspect.Parameter("output", keyword, default=Path("."), annotation=Annotated[
+        Path, typer.Option("-o", "--output", help="Existing directory to write the files in.")])]
+    parameters += [inspect.Parameter(option.keyword, keyword, default=option.default,
+                                     annotation=Annotated[option.type, typer.Option(option.flag, help=option.help)])
+                   for option in demo.options]
+    if demo.progress:
+        parameters.append(inspect.Parameter("quiet", keyword, default=False, annotation=Annotated[
+            bool, typer.Option("--quiet", "-q", help="No progress bar.")]))
+    old = _OLD_SPELLINGS.get(name)
+    if old is not None and old.plot is not None:
+        parameters.append(inspect.Parameter("plot", keyword, default=None, annotation=Annotated[
+            Path | None, typer.Option("--plot", hidden=True, help="Deprecated (until 0.5): the figure's file.")]))
+    command.__signature__ = inspect.Signature(parameters)  # type: ignore[attr-defined]
     command.__doc__ = demo.help
     return command
 
 
 for _name, _demo in DEMOS.items():
-    demo_app.command(_name)(_demo_command(_demo))
+    demo_app.command(_name, cls=_DemoCommand)(_command(_name, _demo))

@@ -23,6 +23,7 @@ import os
 import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import NoReturn
 
 import numpy as np
 import typer
@@ -30,7 +31,7 @@ import typer
 from tumble._validate import ValidationError
 from tumble.integrate import SolverError
 
-__all__ = ["EXIT_ERROR", "EXIT_BUG", "exit_codes"]
+__all__ = ["EXIT_ERROR", "EXIT_BUG", "exit_codes", "fail"]
 
 EXIT_ERROR = 2
 EXIT_BUG = 1
@@ -65,12 +66,18 @@ def exit_codes(*inputs: str | os.PathLike[str]) -> Iterator[None]:
               "TUMBLE_TRACEBACK=1 shows the traceback)", EXIT_BUG)
 
 
+def fail(message: str) -> NoReturn:
+    """Exit with code 2 and ``message`` as ``error:`` lines on stderr: a mistake found outside
+    :func:`exit_codes` (a command line that does not parse)."""
+    _fail(message, EXIT_ERROR)
+
+
 def _first_line(exc: BaseException) -> str:
     text = str(exc).strip()
     return text.splitlines()[0] if text else "(no message)"
 
 
-def _fail(message: str, code: int) -> None:
+def _fail(message: str, code: int) -> NoReturn:
     for line in message.splitlines() or [""]:
         typer.echo(f"error: {line}", err=True)
     raise typer.Exit(code) from None

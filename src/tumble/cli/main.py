@@ -1,10 +1,8 @@
 """The ``tumble`` command: run scenario files, the demos, inspect results.
 
     tumble run SCENARIO.toml -o out.nc [--plot out.png] [--quiet]
-    tumble demo racket [-o racket.nc] [--plot racket.png] [--duration 20]
-    tumble demo polhode [-o polhode.png]
-    tumble demo top [-o DIRECTORY] [--duration 1.5]
-    tumble demo NAME [-o DIRECTORY]        (the demos of tumble.viz.demos.DEMOS: diver, flexible, ...)
+    tumble demo [--list]
+    tumble demo NAME [-o DIRECTORY] [options]   (the rows of tumble.viz.demos.DEMOS: racket, polhode, top, ...)
     tumble robot torques ROBOT_FILE --q ...
     tumble examples list | tumble examples copy DIRECTORY
     tumble sweep SCENARIO.toml -o out.zarr [--samples N] [--scheduler ADDR] [--workers N] [--plot out.png]

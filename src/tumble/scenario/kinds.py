@@ -4,18 +4,18 @@ A file says its kind with a top-level ``kind = "..."``. A file without one
 keeps working: its kind is the one whose marker table it has (``[spacecraft]``
 → ``"spacecraft"``, ``[robot]`` → ``"robot"``, ...), else ``"rigid"``.
 
-Adding a model kind is one module (a :class:`tumble.scenario.Scenario`
+Adding a scenario kind is one module (a :class:`tumble.scenario.Scenario`
 subclass with the kind's tables, ``build()`` returning a problem with
 ``.model`` and ``.simulate(progress=...)``, and ``figure(traj)``) and one row
-here.
+of :data:`tumble._kinds.SCENARIOS`, the registry of model kinds (``docs/architecture.md``, "Adding a model
+kind").
 """
 
 from __future__ import annotations
 
-import importlib
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from tumble._kinds import SCENARIOS, ScenarioKind, resolve
 from tumble.scenario._errors import ScenarioError, short
 
 if TYPE_CHECKING:
@@ -24,42 +24,9 @@ if TYPE_CHECKING:
 __all__ = ["DEFAULT_KIND", "KINDS", "Kind", "kind_of", "scenario_class"]
 
 
-@dataclass(frozen=True)
-class Kind:
-    """One row of the kind table.
-
-    scenario    : ``"module:Class"``, the kind's top-level table (a :class:`~tumble.scenario.Scenario` subclass),
-                  imported only when a file of this kind is read
-    table       : a top-level table whose presence means this kind in a file without ``kind`` (None: none)
-    description : what the kind simulates, in words
-    """
-
-    scenario: str
-    table: str | None
-    description: str
-
-
-KINDS = {
-    "rigid": Kind("tumble.scenario.rigid:RigidScenario", None,
-                  "a rigid body under external torques, optionally with a nutation [damper] (tumble.RigidBody)"),
-    "spacecraft": Kind("tumble.scenario.spacecraft:SpacecraftScenario", "spacecraft",
-                       "a spacecraft with wheels, CMGs, thrusters, magnetorquers and controllers "
-                       "(tumble.spacecraft.Spacecraft)"),
-    "flexible": Kind("tumble.scenario.flexible:FlexibleScenario", "flexible",
-                     "a hub with flexible appendages: cantilever modes of the hybrid-coordinate model "
-                     "(tumble.flexible.FlexibleBody)"),
-    "slosh": Kind("tumble.scenario.slosh:SloshScenario", "slosh",
-                  "a free-floating hub with a fuel-slosh pendulum (tumble.slosh.SloshBody)"),
-    "variable": Kind("tumble.scenario.variable:VariableScenario", "variable",
-                     "a body whose inertia and shape momentum are tabulated in time (tumble.variable.VariableBody)"),
-    "human": Kind("tumble.scenario.human:HumanScenario", "human",
-                  "a human body in flight moving its joints: de Leva's segments (tumble.variable.MovingHuman)"),
-    "gyroscope": Kind("tumble.scenario.gyroscope:GyroscopeScenario", "gyroscope",
-                      "a spinning rotor on a pivot or in a two-axis gimbal (tumble.ins.Gyroscope, "
-                      "tumble.ins.GimbaledGyro)"),
-    "robot": Kind("tumble.scenario.robot:RobotScenario", "robot",
-                  "a robot arm on a fixed base from a DH table or URDF file (tumble.robot.SerialChain)"),
-}
+#: Scenario kind -> its row (the model kinds' registry, :data:`tumble._kinds.SCENARIOS`).
+KINDS = SCENARIOS
+Kind = ScenarioKind
 
 #: The kind of a file that neither says ``kind`` nor has a marker table.
 DEFAULT_KIND = "rigid"
@@ -85,5 +52,4 @@ def kind_of(data: dict) -> str:
 
 def scenario_class(kind: str) -> type[Scenario]:
     """The :class:`~tumble.scenario.Scenario` subclass of ``kind`` (a key of :data:`KINDS`)."""
-    module, name = KINDS[kind].scenario.split(":")
-    return getattr(importlib.import_module(module), name)
+    return resolve(KINDS[kind].scenario)

@@ -1,40 +1,150 @@
 """The demonstrations, as the one table the ``tumble demo`` command reads.
 
-Each demo is a function ``demo_xxx(out_dir) -> dict`` of :mod:`tumble.viz` (the figures and demos of a
-domain: ``tumble.viz.flexible``, ``tumble.viz.passive``, ...) that
-writes its files atomically into an existing directory and returns its numbers.
-A row of :data:`DEMOS` names it (``"module:function"``, imported only when the
-demo runs), gives the command's help and turns the returned numbers into
-printed rows. :mod:`tumble.cli` reads this table and makes one
-``tumble demo NAME [-o DIRECTORY]`` command per row; this module imports
-nothing of the CLI.
+Each demo is a function ``demo_xxx(out_dir, **options) -> dict`` of :mod:`tumble.viz` (the figures and demos of
+a domain: ``tumble.viz.flexible``, ``tumble.viz.passive``, ...) that writes its files atomically into an
+existing directory and returns its numbers. A row of :data:`DEMOS` (its key the demo's name) says what it shows
+(the first line of its help), names its function (``"module:function"``, imported only when the demo runs),
+its options as data (:class:`Option`), the files it writes, and turns the returned numbers into printed rows.
+:mod:`tumble.cli.demo` makes one ``tumble demo NAME [-o DIRECTORY] [options]`` command per row; this module
+imports nothing of the CLI.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
-__all__ = ["DEMOS", "Demo"]
+from tumble.viz._rows import summary
+
+__all__ = ["DEMOS", "Demo", "Option", "resolve"]
 
 Rows = Callable[[dict], list[tuple[str, str]]]
 
 
+def resolve(target: str) -> Callable[..., Any]:
+    """The function that ``"module:function"`` names, its module imported now."""
+    module, function = target.split(":")
+    return getattr(importlib.import_module(module), function)
+
+
+@dataclass(frozen=True)
+class Option:
+    """An option ``FLAG VALUE`` of a demo, passed to its function as the keyword argument ``keyword``.
+
+    flag    : the command-line spelling, e.g. ``"--duration"``
+    keyword : the keyword argument of the demo's function that it sets
+    type    : ``float`` or ``int``
+    default : the value when the option is not given (the function's own default)
+    help    : one line for ``--help``, with the unit
+    check   : ``"module:function"``, a function ``(value, name) -> value`` that refuses a bad value with a
+              :class:`~tumble.ValidationError` naming ``name`` (the CLI passes the flag), before the demo runs
+    """
+
+    flag: str
+    keyword: str
+    type: type
+    default: float | int
+    help: str
+    check: str = "tumble._validate:require_positive"
+
+
 @dataclass(frozen=True)
 class Demo:
-    """One ``tumble demo`` command.
+    """One ``tumble demo NAME`` command.
 
-    target : ``"module:function"``, a function ``(out_dir) -> dict`` that writes its files in ``out_dir``
-    help   : the command's help (its first line is the summary of ``tumble demo --help``)
-    rows   : the printed rows ``(label, text)`` of the returned dict (the CLI adds the files written)
+    target   : ``"module:function"``, a function ``(out_dir, **options) -> dict`` that writes ``files`` in
+               ``out_dir``
+    help     : the command's help; its first line says what the demo shows (``tumble demo --list``)
+    rows     : the printed rows ``(label, text)`` of the returned dict (the CLI adds the files written)
+    files    : the names of the files it writes in ``out_dir`` (checked before it runs, printed after)
+    options  : its options beside ``-o DIRECTORY``
+    progress : whether the function takes ``progress=`` (a callback ``(done, total)``: the CLI draws a
+               progress bar on a terminal, off with ``--quiet``)
     """
 
     target: str
     help: str
     rows: Rows
+    files: tuple[str, ...]
+    options: tuple[Option, ...] = ()
+    progress: bool = False
 
+    @property
+    def shows(self) -> str:
+        """What the demo shows: the first line of its help."""
+        return self.help.strip().splitlines()[0]
+
+
+def _racket_rows(s: dict) -> list[tuple[str, str]]:
+    mean = (f", mean time between flips {s['mean_flip_interval_s']:.6g} s"
+            if s["mean_flip_interval_s"] is not None else "")
+    return [*summary(s["trajectory"]), ("flips", f"{s['flips']} in {s['duration_s']:g} s{mean}"),
+            ("predicted", f"time between flips 2K/lambda = {s['predicted_flip_interval_s']:.6g} s (exact solution)")]
+
+
+_DURATION = "Simulated time, s."
 
 DEMOS: dict[str, Demo] = {
+    "racket": Demo(
+        "tumble.viz.racket:demo_racket",
+        """Tennis-racket (Dzhanibekov) effect: a T-handle spun about its intermediate axis flips over and over.
+
+        The default RigidBody.t_handle() starts at 10 rad/s about its intermediate principal axis
+        with 1e-3 rad/s about the other two, integrated by dop853 at rtol = atol = 1e-12. A flip
+        is a sign change of the intermediate-axis rate; the command prints their number, the
+        mean time between them, and the time between flips predicted by the exact (elliptic)
+        solution, 2K(m)/lambda. Writes racket.nc (the run), racket.png (the rates, flips marked)
+        and racket.html (the offline 3-D viewer) in the directory.
+        """,
+        _racket_rows,
+        ("racket.nc", "racket.png", "racket.html"),
+        (Option("--duration", "duration", float, 20.0, _DURATION, "tumble.viz.racket:check_duration"),),
+        progress=True,
+    ),
+    "polhode": Demo(
+        "tumble.viz.polhode:demo_polhode",
+        """Poinsot's construction: polhodes on the energy ellipsoid and the herpolhode of a T-handle.
+
+        RigidBody.t_handle() spinning at 10 rad/s about its intermediate principal axis and 1 rad/s
+        about each of the other two. The figure (tumble.viz.polhode.polhode_figure) shows the energy
+        ellipsoid with a family of polhodes, the separatrix and this motion's polhode, and the
+        herpolhode on the invariable plane; the command prints the stability of the axes and the
+        predicted times. Writes polhode.png and polhode.html (the 3-D viewer of one polhode period:
+        the T-handle turning, omega and L, and its polhode on the energy ellipsoid) in the directory.
+        """,
+        lambda s: [
+            ("body", "T-handle, principal moments " + ", ".join(f"{m:.4g}" for m in s["moments"]) + " kg m^2"),
+            ("axes", ", ".join(f"{i + 1}: {kind}" for i, kind in enumerate(s["axis_stability"]))),
+            ("omega", "[" + ", ".join(f"{w:g}" for w in s["omega_principal"]) + "] rad/s (principal axes), "
+                      f"regime {s['regime']!r}"),
+            ("timing", f"flips every 2K/lambda = {s['flip_interval_s']:.6g} s, "
+                       f"polhode period 4K/lambda = {s['polhode_period_s']:.6g} s"),
+        ],
+        ("polhode.png", "polhode.html"),
+    ),
+    "top": Demo(
+        "tumble.viz.top:demo_top",
+        """Heavy symmetric top: simulation (gravity torque on a pivot) against the exact theory.
+
+        A spinning top released at 60 deg from the vertical nutates between two angles while it
+        precesses (docs/heavy_top.md). Prints the nutation bounds, the nutation period and the mean
+        precession rate, exact and measured. Writes top.nc, top.png and top.html (the 3-D viewer of
+        the run) in the directory.
+        """,
+        lambda s: [
+            ("nutation", f"theta from {s['theta_min_deg']:.6g} to {s['theta_max_deg']:.6g} deg (exact), "
+                         f"{s['theta_min_deg_measured']:.6g} to {s['theta_max_deg_measured']:.6g} deg (simulated)"),
+            ("period", f"{s['nutation_period_s']:.6g} s (exact), {s['nutation_period_s_measured']:.6g} s (simulated)"),
+            ("rate", f"mean precession rate {s['mean_precession_rate']:.6g} rad/s (exact), "
+                     f"{s['mean_precession_rate_measured']:.6g} rad/s (simulated)"),
+            ("spin", f"{s['spin']:.6g} rad/s (critical spin {s['critical_spin']:.6g} rad/s: "
+                     "the upright top is stable above it)"),
+        ],
+        ("top.nc", "top.png", "top.html"),
+        (Option("--duration", "duration", float, 1.5, _DURATION),),
+    ),
     "diver": Demo(
         "tumble.viz.diver:demo_diver",
         """A diver's twisting somersaults: a segment model (de Leva 1996) whose arms move in flight.
@@ -56,6 +166,7 @@ DEMOS: dict[str, Demo] = {
                     f"{max(s['dive_momentum_drift'], s['twisting_somersault_momentum_drift']):.1e} "
                     "(torque-free flight: L is conserved)"),
         ],
+        ("diver_twisting_somersault.png", "diver_twist_rule.png", "diver_513xd.png", "diver_513xd.nc", "diver_513xd.html"),
     ),
     "flexible": Demo(
         "tumble.viz.flexible:demo_flexible",
@@ -73,6 +184,7 @@ DEMOS: dict[str, Demo] = {
                        f"{s['rate_jitter_peak_arcsec_per_s']:.4g} arcsec/s peak (rigid body: "
                        f"{s['rigid_pointing_error_arcsec']:.2g} arcsec)"),
         ],
+        ("flexible.nc", "flexible.png", "flexible.html"),
     ),
     "slosh": Demo(
         "tumble.viz.slosh:demo_slosh",
@@ -90,6 +202,7 @@ DEMOS: dict[str, Demo] = {
                        f"{s['energy_flat_spin']:.7g} J, monotonic: {s['energy_monotonic']}"),
             ("|H|", f"largest relative drift {s['momentum_norm_drift']:.1e}"),
         ],
+        ("slosh.nc", "slosh.png", "slosh.html"),
     ),
     "gyro": Demo(
         "tumble.viz.ins:demo_gyroscope",
@@ -108,6 +221,7 @@ DEMOS: dict[str, Demo] = {
             ("drift", f"against the laws: imbalance {s['imbalance_drift_error_rad']:.2g} rad, spin drag "
                       f"{s['spin_drag_drift_error_rad']:.2g} rad, pivot friction {s['pivot_tilt_error_rad']:.2g} rad"),
         ],
+        ("ins_gyro_precession.png", "ins_gyro_precession.html", "ins_gyro_drift.png"),
     ),
     "coning": Demo(
         "tumble.viz.ins:demo_coning",
@@ -120,6 +234,7 @@ DEMOS: dict[str, Demo] = {
         """,
         lambda s: [(algorithm, f"measured drift within {s[algorithm]['max_relative_deviation']:.1%} of its law")
                    for algorithm in ("none", "one-sample", "two-sample", "three-sample")],
+        ("ins_coning.png", "ins_coning.html"),
     ),
     "ins": Demo(
         "tumble.viz.ins:demo_ins",
@@ -139,6 +254,7 @@ DEMOS: dict[str, Demo] = {
                       + f"; B {s['bias_instability']:.3g} -> recovered "
                       + ", ".join(f"{v:.3g}" for v in s["bias_instability_recovered"])),
         ],
+        ("ins_error.png", "ins_truth.html", "ins_allan.png"),
     ),
     "explorer1": Demo(
         "tumble.viz.passive:demo_explorer1",
@@ -159,6 +275,7 @@ DEMOS: dict[str, Demo] = {
             ("|L|", f"largest relative drift {s['momentum_drift']:.1e} (magnitude), {s['momentum_vector_drift']:.1e} "
                     "(inertial vector), hub and damper together"),
         ],
+        ("explorer1.nc", "explorer1.png", "explorer1.html"),
     ),
     "gravity-gradient": Demo(
         "tumble.viz.passive:demo_gravity_gradient",
@@ -174,6 +291,7 @@ DEMOS: dict[str, Demo] = {
                           + f" n (orbit period {s['orbit_period_s']:.6g} s)"),
             ("libration", f"largest roll/pitch/yaw angle {s['max_angle_deg']:.3g} deg"),
         ],
+        ("gravity_gradient.nc", "gravity_gradient.png", "passive_gg_regions.png", "gravity_gradient.html"),
     ),
     "budget": Demo(
         "tumble.viz.budget:demo_budget",
@@ -198,6 +316,7 @@ DEMOS: dict[str, Demo] = {
             ("Monte Carlo", f"peak |h| over an orbit: median {s['monte_carlo_median']:.3g}, 95th percentile "
                             f"{s['monte_carlo_p95']:.3g} N m s ({s['monte_carlo_samples']} draws)"),
         ],
+        ("budget.png",),
     ),
     "lorentz": Demo(
         "tumble.viz.lorentz:demo_lorentz",
@@ -212,6 +331,7 @@ DEMOS: dict[str, Demo] = {
             *[(shape, f"I and L {s[shape]['moment']:+.3%}, kinetic energy {s[shape]['energy']:+.3%} "
                       "against Newton") for shape in ("sphere", "shell", "ring")],
         ],
+        ("lorentz.png",),
     ),
     "chaos": Demo(
         "tumble.viz.chaos:demo_chaos",
@@ -225,6 +345,8 @@ DEMOS: dict[str, Demo] = {
         lambda s: [(name, f"largest exponent {value:.3g} 1/s after {s['duration_s']:g} s, "
                           f"{s['section_points'][name]} section points")
                    for name, value in s["largest_exponent"].items()],
+        ("chaos.png",),
+        (Option("--duration", "duration", float, 2000.0, "Integrated time of each top, s."),),
     ),
     "space-arm": Demo(
         "tumble.viz.space_arm:demo_space_arm",
@@ -239,6 +361,7 @@ DEMOS: dict[str, Demo] = {
                    ("tracking", f"largest joint error {s['max_tracking_error_rad']:.3g} rad"),
                    ("momentum", f"largest |L| {s['max_angular_momentum']:.2g} N m s, |p| "
                                 f"{s['max_linear_momentum']:.2g} N s (exactly 0: internal torques)")],
+        ("space_arm.nc", "space_arm.png"),
     ),
     "estimation": Demo(
         "tumble.viz.estimation:demo_estimation",
@@ -253,5 +376,6 @@ DEMOS: dict[str, Demo] = {
                                "the filter's 3 sigma"),
                    ("pointing", f"fine pointing RMS: knowledge {s['knowledge_rms_rad']:.2g} rad, control "
                                 f"{s['control_rms_rad']:.2g} rad (correlation {s['correlation']:.2f})")],
+        ("estimation_loop.png", "estimation_spectra.png"),
     ),
 }

@@ -6,27 +6,33 @@ around the axis of smallest moment; orange: around the largest), the
 separatrix through the intermediate axis (black) and the polhode of this motion
 (red, bold, from its start point); (b) the herpolhode, the path of ``ω`` on the
 invariable plane, between the circles that bound it. Geometry and equations:
-:mod:`tumble.analytic._geometry` and ``docs/stability.md``.
+:mod:`tumble.analytic._geometry` and ``docs/stability.md``. :func:`demo_polhode` is ``tumble demo polhode``:
+the figure of a T-handle and its motion in the offline 3-D viewer.
 """
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble._files import write_atomic_all
 from tumble._validate import ValidationError, as_array
 from tumble.analytic._free import torque_free
 from tumble.analytic._geometry import herpolhode, polhode_family, polhode_through, separatrix
 from tumble.analytic._stability import stability
 from tumble.rigid_body import RigidBody
+from tumble.simulate import simulate
 from tumble.trajectory import Trajectory
+from tumble.viz._output import out_directory, png_writer, text_writer
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-__all__ = ["polhode_figure"]
+__all__ = ["demo_polhode", "polhode_figure", "write_polhode"]
 
 _CURVE_POINTS = 721          # points per drawn polhode
 _MOTION_PERIODS = 2.0        # a default trajectory spans this many polhode periods ...
@@ -35,6 +41,12 @@ _FALLBACK_TURNS = 20.0       # without a period (steady rotation, separatrix): t
 _VIEW = (22.0, -50.0)        # elevation, azimuth of the 3-D panel (deg)
 _COLOURS = {"minor": "tab:blue", "major": "tab:orange", "separatrix": "black", "motion": "crimson"}
 _HIDDEN_ALPHA = 0.18         # opacity of the parts of curves behind the ellipsoid
+# The demo's motion: the T-handle at 10 rad/s about its intermediate principal axis and 1 rad/s about each of
+# the others (principal axes), just inside the "major" regime, so that its polhode stands apart from the
+# separatrix; its viewer page shows one polhode period (4K/λ) in the viewer's default frame budget.
+DEMO_OMEGA = (1.0, 10.0, 1.0)
+_DEMO_FRAMES = 600
+_DEMO_TOLERANCE = 1e-12
 
 
 def polhode_figure(body: RigidBody, omega: ArrayLike, trajectory: Trajectory | None = None, *,
@@ -205,3 +217,33 @@ def _title(body: RigidBody, report) -> str:
               if np.isfinite(report.flip_interval) else "no flips")
     return (f"{name}moments {moments} kg m², ω = [{w}] rad/s (principal axes), regime '{report.regime}'\n"
             f"T = {report.energy:.4g} J, |L| = {report.momentum:.4g} N m s; {timing}")
+
+
+def write_polhode(output: str | os.PathLike[str]) -> dict:
+    """:func:`polhode_figure` of :meth:`RigidBody.t_handle` at ω = ``body.axes @ DEMO_OMEGA`` (rad/s) written
+    to ``output`` (PNG) and, beside it with ``.html``, one polhode period of the motion (dop853,
+    rtol = atol = 1e-12) in the offline 3-D viewer, together and atomically. Returns the principal moments
+    (kg m²), the stability of each axis, the regime, the time between flips 2K/λ and the polhode period
+    4K/λ (s), and the paths written."""
+    from tumble.viz.viewer import Cylinder, html_page
+    from tumble.viz.racket import T_HANDLE_PIECES
+
+    page = Path(output).with_suffix(".html")
+    body = RigidBody.t_handle()
+    omega0 = body.axes @ np.array(DEMO_OMEGA)
+    report = stability(body, omega0)
+    figure = polhode_figure(body, omega0)
+    traj = simulate(body, omega0, t=np.linspace(0.0, report.polhode_period, _DEMO_FRAMES),
+                    method="dop853", rtol=_DEMO_TOLERANCE, atol=_DEMO_TOLERANCE)
+    html = html_page(traj, model=body, shape=[Cylinder(**piece) for piece in T_HANDLE_PIECES])
+    write_atomic_all([(output, png_writer(figure)), (page, text_writer(html))])
+    return {"moments": tuple(float(m) for m in report.moments), "axis_stability": tuple(report.axis_stability),
+            "regime": report.regime, "flip_interval_s": report.flip_interval,
+            "polhode_period_s": report.polhode_period, "omega_principal": DEMO_OMEGA,
+            "png": os.fspath(output), "html": os.fspath(page)}
+
+
+def demo_polhode(out_dir: str | os.PathLike[str]) -> dict:
+    """``tumble demo polhode``: :func:`write_polhode` into ``polhode.png`` and ``polhode.html`` of ``out_dir``
+    (an existing directory)."""
+    return write_polhode(os.path.join(out_directory(out_dir), "polhode.png"))

@@ -18,8 +18,8 @@ from tumble.kernels.featherstone.layout import (ABA_ACCELERATION, ARTICULATED_IN
                                                 BIAS_ACCELERATION, BIAS_FORCE, COORDINATE, FIRST_MOMENT, INERTIA,
                                                 JIT, JOINT_FORCE, JOINT_INERTIA, JOINT_TYPE, MASS, NO_REFCOUNT,
                                                 ORIGIN, PARENT, PARENT_POSE, REVOLUTE, SPATIAL_PAIR,
-                                                TRANSMITTED_BIAS, VELOCITY, WIDTH, body_scratch, floating,
-                                                state_copy, state_fits, state_offset)
+                                                TRANSMITTED_BIAS, VELOCITY, WIDTH, all_finite, body_scratch,
+                                                floating, state_copy, state_fits, state_offset)
 from tumble.kernels.featherstone.spatial import (bias_force, external_wrench, force_to_parent, free_transform,
                                                  gravity_in_body0, joint, joint_transform, motion_to_child,
                                                  subspace)
@@ -162,7 +162,6 @@ def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
                                 W[i, pa + 4], W[i, pa + 5])
             for k in range(6):
                 W[par, pA + k] += f[k]
-    ok = True
     a = ABA_ACCELERATION
     for i in range(nb):  # pass 3: accelerations (a' = a − a_g, a_g = (0, g): gravity as a fictitious acceleration)
         par = int(P[i, PARENT])
@@ -175,8 +174,6 @@ def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
             gx, gy, gz = gravity_in_body0(W, g)
             qdd[0], qdd[1], qdd[2] = W[0, a], W[0, a + 1], W[0, a + 2]
             qdd[3], qdd[4], qdd[5] = W[0, a + 3] + gx, W[0, a + 4] + gy, W[0, a + 5] + gz
-            for r in range(6):
-                ok = ok and math.isfinite(qdd[r])
             continue
         if par < 0:
             ax, ay, az, lx, ly, lz = motion_to_child(W, i, 0.0, 0.0, 0.0, -g[0], -g[1], -g[2])
@@ -192,13 +189,12 @@ def aba_one(P, q, qd, tau, g, fext, W, X, T, qdd):
         c = int(P[i, COORDINATE])
         x = (W[i, JOINT_FORCE] - Ua) / W[i, JOINT_INERTIA]
         qdd[c] = x
-        ok = ok and math.isfinite(x)
         if P[i, JOINT_TYPE] == REVOLUTE:  # a += S q̈
             az += x
         else:
             lz += x
         W[i, a], W[i, a + 1], W[i, a + 2], W[i, a + 3], W[i, a + 4], W[i, a + 5] = ax, ay, az, lx, ly, lz
-    return ok
+    return all_finite(qdd)
 
 
 @njit(**JIT)
@@ -224,10 +220,7 @@ def forward_one(P, q, qd, tau, g, fext, W, X, T, M, zero, qdd):
         qdd[k] = tau[k] - qdd[k]
     crba_one(P, q, W, M)
     cholesky_solve(M, qdd)
-    ok = True
-    for k in range(qdd.shape[0]):
-        ok = ok and math.isfinite(qdd[k])
-    return ok
+    return all_finite(qdd)
 
 
 @njit(**NO_REFCOUNT)

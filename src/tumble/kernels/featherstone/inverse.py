@@ -7,15 +7,13 @@ of ``P`` and ``W`` are those of :mod:`.layout`.
 
 from __future__ import annotations
 
-import math
-
 from numba import njit, prange
 
 from tumble.kernels.featherstone.layout import (ACCELERATION, COMPOSITE_INERTIA, COMPOSITE_MASS, COMPOSITE_MOMENT,
                                                 COMPOSITE_PRODUCT, COORDINATE, FORCE, INLINE, JIT, JOINT_TYPE, MASS,
                                                 MULTIPLIER, NO_REFCOUNT, ORIGIN, PARENT, PARENT_POSE, REVOLUTE,
-                                                RIGID_INERTIA, VELOCITY, body_scratch, fits, floating, scratch,
-                                                state_copy, state_fits, state_offset)
+                                                RIGID_INERTIA, VELOCITY, all_finite, body_scratch, fits, floating,
+                                                scratch, state_copy, state_fits, state_offset)
 from tumble.kernels.featherstone.spatial import (bias_force, external_wrench, force_to_parent, free_transform,
                                                  gravity_in_body0, inertia_times, joint, joint_transform,
                                                  motion_to_child, rotate, subspace)
@@ -86,10 +84,7 @@ def rnea_one(P, q, qd, qdd, g, fext, W, tau):
                                 W[i, FORCE + 3], W[i, FORCE + 4], W[i, FORCE + 5])
             for k in range(6):
                 W[par, FORCE + k] += r[k]
-    ok = True
-    for k in range(tau.shape[0]):
-        ok = ok and math.isfinite(tau[k])
-    return ok
+    return all_finite(tau)
 
 
 @njit(**NO_REFCOUNT)
@@ -234,11 +229,7 @@ def crba(P, q, S, M):
     if not (fits(P, S, q, nv) and M.shape[1] == nv):
         return False
     crba_one(P, state_copy(q, S, state_offset(P, nv)), body_scratch(P, S), M)
-    ok = True
-    for r in range(nv):
-        for c in range(nv):
-            ok = ok and math.isfinite(M[r, c])
-    return ok
+    return all_finite(M)
 
 
 @njit(**NO_REFCOUNT)

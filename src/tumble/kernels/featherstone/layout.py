@@ -73,6 +73,8 @@ too (:data:`JIT`, :data:`INLINE`, :data:`NO_REFCOUNT`), below them all.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -189,3 +191,13 @@ def state_copy(x, S, o):
     for k in range(x.shape[0]):
         S[o + k] = x[k]
     return S[o:o + x.shape[0]]
+
+
+@njit(**INLINE)
+def all_finite(x):
+    """True when every entry of ``x`` (any shape: torques, accelerations, a mass matrix) is finite: the check of
+    every result of the single-state entries and sweeps (a NaN or inf means an input they could not use)."""
+    for value in x.flat:
+        if not math.isfinite(value):
+            return False
+    return True

@@ -3,18 +3,19 @@
 A builder is ``scene(traj, idx, model, options) -> Scene``: the trajectory,
 the indices of its samples shown as frames, the model that made it (or
 None: what a trajectory alone cannot tell — a robot's links, a spacecraft's
-wheels, a diver's segments — needs it) and the :class:`Options`. A model
-without a row is drawn by :mod:`.rigid` from its attitude, when it has one.
-Adding a model to the viewer is one module here and one row of
-:data:`BUILDERS`.
+wheels, a diver's segments — needs it) and the :class:`Options`. The registry of
+model kinds names each kind's glyph (:data:`tumble._kinds.MODEL_KINDS`): a
+module here, read into :data:`BUILDERS`. A model without one is drawn by
+:mod:`.rigid` from its attitude, when it has one.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, NamedTuple
 
-from tumble.viz.viewer.scenes import flexible, human, rigid, robot, slosh, spacecraft
+from tumble._kinds import ATTITUDE, MODEL_KINDS
 
 if TYPE_CHECKING:
     import numpy as np
@@ -34,12 +35,7 @@ class Options(NamedTuple):
     title: str
 
 
-#: Trajectory.model → the builder of its scene.
+#: Trajectory.model → the builder of its scene: the ``scene`` of the module here that the kind's glyph names.
 BUILDERS: dict[str, Callable[[Trajectory, np.ndarray, Any, Options], Scene]] = {
-    "RigidBody": rigid.scene,
-    "Spacecraft": spacecraft.scene,
-    "SerialChain": robot.scene,
-    "MovingHuman": human.scene,
-    "FlexibleBody": flexible.scene,
-    "SloshBody": slosh.scene,
-}
+    name: importlib.import_module(f"{__name__}.{kind.glyph}").scene
+    for name, kind in MODEL_KINDS.items() if kind.glyph not in (None, ATTITUDE)}
