@@ -3,8 +3,8 @@ kinds read it.
 
 Each row is checked for its model class, its kernel, its scenario table, its viewer glyph and its warm-up
 example without compiling (the fast tests: building a model and its kernel's `provides` compiles nothing).
-That the example runs for the default method (dop853) compiles each kind's integrator: tens of CPU s for the
-spacecraft on a cold cache, so that test is slow.
+Running the examples is `tumble warmup`'s and `benchmarks/bench_startup.py`'s (it compiles every kind: minutes on a
+cold cache); each kind's own test module runs it under its methods.
 """
 
 import inspect
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble import _kinds, _warmup, integrate
+from tumble import _kinds, _warmup
 from tumble._kinds import ATTITUDE, MODEL_KINDS, SCENARIOS, resolve
 from tumble._validate import ValidationError
 from tumble.scenario import Scenario
@@ -96,16 +96,3 @@ def test_the_registry_imports_none_of_its_pieces():
     assert [line for line in source.splitlines() if line.startswith(("import ", "from "))] == [
         "from __future__ import annotations", "import importlib", "from dataclasses import dataclass",
         "from typing import Any"]
-
-
-@pytest.mark.slow  # compiles each kind's dop853 path (the spacecraft's: 33-44 CPU s on a cold cache)
-@pytest.mark.parametrize("name", MODEL_KINDS)
-def test_the_example_runs_for_the_default_method(name, examples):
-    model, state = examples[name]
-    traj = tumble.simulate(model, t=[0.0, 0.02, 0.04], **state)
-    assert traj.method == "dop853" and traj.model == name
-    assert np.array_equal(traj.t, [0.0, 0.02, 0.04])
-    assert integrate.METHODS["dop853"].needs <= model.compile(None, 0.0).provides
-    glyph = MODEL_KINDS[name].glyph
-    if glyph in (None, ATTITUDE):  # the glyph's declaration against the run: drawn from its attitude, or none
-        assert (traj.q is not None) == (glyph == ATTITUDE)
