@@ -35,7 +35,7 @@ IMPORT = "import tumble"
 DEFAULT_METHOD = "dop853"  # simulate's
 SIMULATE = "from tumble._warmup import kind_path; kind_path({kind!r}, {method!r})()"
 # the kinds and the methods each provides, as tumble warmup finds them (in the tumble measured)
-KINDS = "from tumble._warmup import KINDS, methods; print(repr({kind: methods(kind) for kind in KINDS}))"
+KINDS = "from tumble._kinds import MODEL_KINDS; from tumble._warmup import methods; print(repr({kind: methods(kind) for kind in MODEL_KINDS}))"
 RACKET = "import sys; from tumble.cli import app; sys.argv = ['tumble', 'demo', 'racket', '-q', '-o', {out!r}, " \
          "'--plot', {png!r}]; app()"
 
