@@ -36,8 +36,7 @@ DEFAULT_METHOD = "dop853"  # simulate's
 SIMULATE = "from tumble._warmup import kind_path; kind_path({kind!r}, {method!r})()"
 # the kinds and the methods each provides, as tumble warmup finds them (in the tumble measured)
 KINDS = "from tumble._kinds import MODEL_KINDS; from tumble._warmup import methods; print(repr({kind: methods(kind) for kind in MODEL_KINDS}))"
-RACKET = "import sys; from tumble.cli import app; sys.argv = ['tumble', 'demo', 'racket', '-q', '-o', {out!r}, " \
-         "'--plot', {png!r}]; app()"
+RACKET = "import sys; from tumble.cli import app; sys.argv = ['tumble', 'demo', 'racket', '-q', '-o', {out!r}]; app()"
 
 
 def run(code: str, env: dict) -> tuple[float, float]:
@@ -86,7 +85,7 @@ def main() -> None:
     print(f"{'':<28} {'cold wall':^17}  {'cold CPU':^17}   {'warm wall':^17}  {'warm CPU':^17}   goal (cold wall)")
     row("import tumble", IMPORT, env, repeats, "<= 0.3 s")
     with tempfile.TemporaryDirectory() as out:
-        row("tumble demo racket", RACKET.format(out=f"{out}/racket.nc", png=f"{out}/racket.png"), env, repeats,
+        row("tumble demo racket", RACKET.format(out=out), env, repeats,
             "<= 3 s")
     for kind, provided in kinds.items():
         if args.kinds is not None and kind not in args.kinds:
