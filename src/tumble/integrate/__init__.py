@@ -187,7 +187,8 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     solver options the method reads (:class:`Run`).
     A model whose ``calls_python`` is true runs body after body on one core.
     ``progress(done, total)`` is called after each chunk of output samples.
-    ``device="cuda"`` runs ``rk4`` or ``cf4`` on an NVIDIA GPU (models that provide ``"cuda"``).
+    ``device="cuda"`` runs ``rk4`` or ``cf4`` on an NVIDIA GPU (models that provide ``"cuda"``); ``y0`` may
+    be a device array there, and the states are then left on the device.
 
     Bounded before anything runs: a fixed-step run needing more than ``max_steps`` steps per body is
     refused (:func:`._fixed.landing_steps`), and so are states that would not fit in memory
@@ -198,17 +199,14 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     instead of copied, as ``scipy.linalg``'s ``overwrite_a``: a caller that made ``y0`` for the run saves
     a copy (:func:`tumble.simulate`; 56 bytes per rigid body).
     """
+    if device == "cuda":
+        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
+
+        return _cuda.solve(model, y0, t, method=method, **options)
     run = Run(model, y0, t, method=method, overwrite_y0=overwrite_y0, **options)
     y, n_out = run.y, run.t.shape[0]
     require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
                    f"member(s) × {y.shape[1]} values")
-    if device == "cuda":
-        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
-
-        states, n_steps = _cuda.solve_cuda(model, y, run.t, run.options["dt"], run.options["max_steps"],
-                                           method=run.method.name)
-        _raise_on_divergence(states, method)
-        return Solution(states, n_steps, 0, run.method.evaluations * n_steps)
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     bounds = [0, n_out - 1]
     if progress is not None and n_out > 2 and run.method.stepper:

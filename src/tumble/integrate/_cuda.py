@@ -65,7 +65,7 @@ from numba.extending import overload, register_jitable
 
 from tumble import torques
 from tumble.dynamics import rigid_rates
-from tumble._validate import ValidationError
+from tumble._validate import ValidationError, require_memory
 from tumble.integrate import _fixed, _liegroup, _rk4
 from tumble.integrate._fixed import landing_steps
 from tumble.integrate._method import MAX_STEPS
@@ -83,6 +83,49 @@ THREADS_PER_BLOCK = 128
 def cuda_available() -> bool:
     """True when ``numba.cuda`` finds a usable GPU (or runs its simulator)."""
     return cuda.is_available()
+
+
+def require_gpu() -> None:
+    """Raise :class:`~tumble._validate.ValidationError` naming ``device`` when no GPU is found."""
+    if not cuda_available():
+        raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
+
+
+def on_device(a):
+    """``a`` on the GPU: a NumPy array (or array_like) copied there as C-ordered float64, a device array
+    (numba.cuda's, or any array with ``__cuda_array_interface__``: CuPy's) as it is, without a copy."""
+    if hasattr(a, "copy_to_host"):  # numba.cuda's, and the simulator's stand-ins
+        return a
+    if hasattr(a, "__cuda_array_interface__"):
+        return cuda.as_cuda_array(a)
+    return cuda.to_device(np.ascontiguousarray(a, dtype=np.float64))
+
+
+def is_on_device(a) -> bool:
+    """Whether ``a`` is a device array (numba.cuda's or another with ``__cuda_array_interface__``)."""
+    return hasattr(a, "copy_to_host") or hasattr(a, "__cuda_array_interface__")
+
+
+@cuda.jit(cache=True)
+def _first_not_finite_kernel(states, first):
+    """``first[0] ← min(first[0], b)`` for each member ``b`` of ``states`` (n, N, size) with a value that is
+    not finite."""
+    b = cuda.grid(1)
+    if b >= states.shape[1]:
+        return
+    for k in range(states.shape[0]):
+        for i in range(states.shape[2]):
+            if not math.isfinite(states[k, b, i]):
+                cuda.atomic.min(first, 0, b)
+                return
+
+
+def all_finite(states) -> bool:
+    """Whether every value of the device array ``states`` (n, N, size) is finite: one flag copied back."""
+    first = cuda.to_device(np.array([states.shape[1]], dtype=np.int64))
+    _first_not_finite_kernel[max(1, math.ceil(states.shape[1] / THREADS_PER_BLOCK)), THREADS_PER_BLOCK](
+        states, first)
+    return int(first.copy_to_host()[0]) == states.shape[1]
 
 
 def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
@@ -272,12 +315,31 @@ def check(kernel, method: str, who: str) -> None:
 
 
 def _to_device(model):
-    """``model`` (a kernel: a NamedTuple) with its arrays copied to the GPU."""
+    """``model`` (a kernel: a NamedTuple) with its arrays copied to the GPU (those there already kept)."""
     return type(model)(*(cuda.to_device(np.ascontiguousarray(f)) if isinstance(f, np.ndarray) else f
                          for f in model))
 
 
-def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.ndarray, int]:
+def solve(model, y0, t, *, method: str, **options):
+    """:func:`tumble.integrate.solve` on the GPU: the :class:`~tumble.integrate.Solution` of ``model`` from
+    ``y0`` (N, n) through ``t`` by :func:`solve_cuda`, its states left on the device when ``y0`` is there
+    (copied back otherwise). A state that stops being finite raises :class:`~tumble.integrate.Diverged`, as
+    on the CPU (the states are copied back for its message)."""
+    from tumble import integrate
+
+    m = integrate.check_method(method, model.provides, f"a {type(model).__name__}")
+    options = m.resolve(options)
+    host = not is_on_device(y0)
+    if host:
+        require_memory(8 * len(t) * y0.shape[0] * y0.shape[1], "t", f"the states at {len(t)} output "
+                                 f"times × {y0.shape[0]} member(s) × {y0.shape[1]} values")
+    states, n_steps = solve_cuda(model, y0, t, options["dt"], options["max_steps"], method=m.name, keep=True)
+    if not all_finite(states):
+        integrate._raise_on_divergence(states.copy_to_host(), method)
+    return integrate.Solution(states.copy_to_host() if host else states, n_steps, 0, m.evaluations * n_steps)
+
+
+def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4", keep=False) -> tuple[np.ndarray, int]:
     """Integrate a batch of states of the compiled ``model`` with a fixed-step ``method`` on the GPU.
 
     Returns the states (len(t_out), N, n) at the output times and the number
@@ -289,6 +351,7 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.n
     dt : the longest step (s)
     max_steps : the most steps per body (default :data:`tumble.integrate.MAX_STEPS`), checked before the run
     method : ``"rk4"`` or ``"cf4"`` (:data:`SCHEMES`)
+    keep : return the states as a device array, left on the GPU (``y0`` may be one too)
 
     The states equal those of ``tumble.integrate.solve(model, y0, t_out, method=method, dt=dt)``
     to the rounding of fused multiply–adds (bitwise under the CUDA simulator).
@@ -296,25 +359,25 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.n
     (:func:`check`), and when no GPU is found.
     """
     check(model, method, f"a {type(model).__name__}")
-    if not cuda_available():
-        raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
-    y0 = np.ascontiguousarray(y0, dtype=np.float64)
+    require_gpu()
+    y0 = on_device(y0)
     t_out = np.ascontiguousarray(t_out, dtype=np.float64)
     m, h = landing_steps(t_out, float(dt), MAX_STEPS if max_steps is None else max_steps)
     steps = y0.shape[0] * int(m.sum())
     if method == "rk4" and "rigid_fields" in model.provides:  # rigid bodies: the fused kernel reads their fields
-        return _solve_rigid_rk4(model, y0, t_out, m, h), steps
-    work = tuple(cuda.device_array((y0.shape[0], *w.shape)) for w in _workspace_of_one(SCHEMES[method], model,
-                                                                                       y0[0].copy()))
-    out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
-    _protocol_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
-        SCHEMES[method], _to_device(model), cuda.to_device(y0), cuda.to_device(t_out), cuda.to_device(m),
-        cuda.to_device(h), out, work)
-    return out.copy_to_host(), steps
+        out = _solve_rigid_rk4(model, y0, t_out, m, h)
+    else:
+        work = tuple(cuda.device_array((y0.shape[0], *w.shape)) for w in _workspace_of_one(
+            SCHEMES[method], model, np.array(y0[0], dtype=np.float64)))
+        out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
+        _protocol_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
+            SCHEMES[method], _to_device(model), y0, cuda.to_device(t_out), cuda.to_device(m),
+            cuda.to_device(h), out, work)
+    return (out if keep else out.copy_to_host()), steps
 
 
-def _solve_rigid_rk4(model, y0, t_out, m, h) -> np.ndarray:
-    """The states (len(t_out), N, 7) of the rigid bodies of ``model`` by :func:`_rk4_kernel`.
+def _solve_rigid_rk4(model, y0, t_out, m, h):
+    """The states (len(t_out), N, 7) of the rigid bodies of ``model`` by :func:`_rk4_kernel`, on the GPU.
 
     It reads the fields of a kernel that provides ``"rigid_fields"`` (:class:`tumble.kernels.rigid.RigidModel`):
 
@@ -323,20 +386,21 @@ def _solve_rigid_rk4(model, y0, t_out, m, h) -> np.ndarray:
     params : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes : int64 torque-program codes, or None for torque-free bodies
 
-    and ``y0`` (N, 7) the initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s).
+    (host or device arrays) and ``y0`` (N, 7) the initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s), on
+    the device.
     """
     # torque-free: an empty tuple, and the kernel compiles without torque code (see _torque)
     codes = model.codes
     program = () if codes is None else cuda.to_device(np.ascontiguousarray(codes, dtype=np.int64))
     out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
     _rk4_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
-        cuda.to_device(np.ascontiguousarray(model.coefficients, dtype=np.float64)),
-        cuda.to_device(np.ascontiguousarray(model.params, dtype=np.float64)),
+        on_device(model.coefficients),
+        on_device(model.params),
         program,
-        cuda.to_device(y0),
+        y0,
         cuda.to_device(t_out),
         cuda.to_device(m),
         cuda.to_device(h),
         out,
     )
-    return out.copy_to_host()
+    return out
