@@ -298,8 +298,16 @@ def _protocol_kernel(scheme, model, Y, t_out, m, h, out, work):
 
 
 @njit(cache=True)
-def _workspace_of_one(scheme, model, y):
+def _workspace_of_one_host(scheme, model, y):
     return _fixed.workspace(scheme, model, 0, y)
+
+
+def _workspace_of_one(scheme, model, y):
+    """The method's workspace of one member (host arrays): what the launch allocates once per member. A
+    model's fields on the device (a rigid batch set up there) stand in by host arrays of their shapes, not
+    filled: the workspace depends on the model's types and sizes, not its values."""
+    host = type(model)(*(np.empty(f.shape, f.dtype) if is_on_device(f) else f for f in model))
+    return _workspace_of_one_host(scheme, host, y)
 
 
 def check(kernel, method: str, who: str) -> None:

@@ -125,13 +125,10 @@ def principal_axes_of_one(tensor, work, moments, axes):
         moments[i] = work[i, i]
     sort_ascending(moments, axes)
     canonical(moments, axes)
-    status = 0
     if not moments[0] > _DEFINITE_RTOL * moments[2] or \
             moments[0] + moments[1] < moments[2] * (1.0 - _TRIANGLE_RTOL):
-        status |= BROKEN
-    if moments[0] < limits.THIN_RATIO * moments[2]:
-        status |= THIN
-    return status
+        return BROKEN
+    return THIN if moments[0] < limits.THIN_RATIO * moments[2] else 0
 
 
 @cuda.jit(cache=True)
