@@ -1,4 +1,4 @@
-"""Rigid bodies set up on the GPU and their results kept there (tumble.integrate._cuda_rigid), without a GPU.
+"""Rigid bodies set up on the GPU and their results kept there (tumble._rigid_cuda), without a GPU.
 
 The set-up's per-body functions are plain Python until compiled (``register_jitable``), so the first tests run
 them here against the CPU's set-up (LAPACK's ``eigh``, :func:`tumble._inertia.principal_axes`). The front door
@@ -27,7 +27,7 @@ from tumble._inertia import principal_axes
 from tumble.spacecraft import MRPFeedback, Spacecraft, pyramid_wheels
 
 pytest.importorskip("numba.cuda")
-from tumble.integrate._cuda_rigid import BROKEN, THIN, principal_axes_of_one  # noqa: E402
+from tumble._rigid_cuda import BROKEN, THIN, principal_axes_of_one  # noqa: E402
 
 EPS = np.finfo(np.float64).eps
 T = np.array([0.0, 0.03, 0.05])  # 3 and 2 steps of DT

@@ -34,7 +34,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("estimators", ("tumble.estimation",)),
     ("kernels", ("tumble.kernels",)),
     ("integrate", ("tumble.integrate",)),
-    ("front door", ("tumble", "tumble.model", "tumble.rigid", "tumble.simulate")),
+    ("front door", ("tumble", "tumble.model", "tumble.rigid", "tumble._rigid_cuda", "tumble.simulate")),
     ("domain", ("tumble.analytic", "tumble.analysis", "tumble.flexible", "tumble.frames", "tumble.ins",
                 "tumble.lorentz", "tumble.robot", "tumble.slosh", "tumble.spacecraft", "tumble.variable")),
     ("sweeps", ("tumble.ensemble", "tumble.sweep", "tumble.sweeps")),

@@ -153,7 +153,7 @@ def _eigh(tensors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 @register_jitable
 def symmetrize(tensor, out):
     """``out = (I + Iᵀ)/2`` of one tensor ``I`` (3, 3); returns ``(max |Iᵢⱼ|, max |Iᵢⱼ − Iⱼᵢ|)``. Plain
-    Python until compiled: the GPU's set-up (:mod:`tumble.integrate._cuda_rigid`) calls it too."""
+    Python until compiled: the GPU's set-up (:mod:`tumble._rigid_cuda`) calls it too."""
     s = a = 0.0
     for i in range(3):
         for j in range(3):

@@ -61,7 +61,7 @@ def to_principal_axes(q0, omega0, q_bp, axes, y0, b, j):
     body ``j``'s ``q_BP`` and ``R_BP``: ``q_NP = q_NB ⊗ q_BP`` into ``y0[b, :4]`` (bit for bit
     :func:`tumble.attitude.multiply`'s product), ``ω_P = R_BPᵀ ω_B`` into ``y0[b, 4:]`` with
     ``ω_i = (R_0i ω_0 + R_1i ω_1) + R_2i ω_2`` in that order. Plain Python until compiled: the GPU's
-    set-up (:mod:`tumble.integrate._cuda_rigid`) calls it too."""
+    set-up (:mod:`tumble._rigid_cuda`) calls it too."""
     w, x, y, z = qmul(q0[b, 0], q0[b, 1], q0[b, 2], q0[b, 3], q_bp[j, 0], q_bp[j, 1], q_bp[j, 2], q_bp[j, 3])
     y0[b, 0], y0[b, 1], y0[b, 2], y0[b, 3] = w, x, y, z
     for i in range(3):

@@ -144,12 +144,12 @@ def simulate(
         raise ValidationError(f"output: must be 'host', or 'device' with device='cuda'; got output={output!r} "
                               f"with device={device!r}")
     if device == "cuda":
-        from tumble.integrate import _cuda_rigid  # imports numba.cuda: only when asked for
+        from tumble import _rigid_cuda  # imports numba.cuda: only when asked for
 
-        model = _cuda_rigid.as_device_model(model, method)
+        model = _rigid_cuda.as_device_model(model, method)
     else:
         model = as_model(model)
-    if output == "device" and not isinstance(model, _cuda_rigid.DeviceRigidBodies):
+    if output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies):
         raise ValidationError(f"output: 'device' keeps the results of rigid bodies on the GPU; a {model.kind}'s "
                               "outputs are made on the host: use output='host'")
     times = output_times(t)
@@ -193,7 +193,7 @@ def simulate(
             raise _divergence(model, kernel, grid, diverged) from None
         out = model.outputs(kernel, times, solution.states if kept is None else solution.states[kept])
         if output == "host" and device == "cuda":
-            out = _cuda_rigid.to_host(out)
+            out = _rigid_cuda.to_host(out)
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
     return _trajectory(model, m.name, times, out, info, single=n is None)

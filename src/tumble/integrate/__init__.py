@@ -202,7 +202,7 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     if device == "cuda":
         from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
 
-        return _cuda.solve(model, y0, t, method=method, **options)
+        return _solve_on_gpu(_cuda, model, y0, t, method, options)
     run = Run(model, y0, t, method=method, overwrite_y0=overwrite_y0, **options)
     y, n_out = run.y, run.t.shape[0]
     require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
@@ -219,6 +219,23 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     if n_out == 1:
         out[0] = y
     return run.solution(out)
+
+
+def _solve_on_gpu(gpu, model: Any, y0, t: np.ndarray, method: str, options: dict) -> Solution:
+    """:func:`solve` on the GPU (``gpu``: :mod:`tumble.integrate._cuda`, imported by the caller): the states
+    left on the device when ``y0`` is there, copied back otherwise. A state that stops being finite raises
+    :class:`Diverged` as on the CPU (found on the device; the states copied back for its message)."""
+    m = check_method(method, model.provides, f"a {type(model).__name__}")
+    options = m.resolve(options)
+    host = not gpu.is_on_device(y0)
+    if host:
+        require_memory(8 * len(t) * y0.shape[0] * y0.shape[1], "t", f"the states at {len(t)} output times × "
+                       f"{y0.shape[0]} member(s) × {y0.shape[1]} values")
+    states: Any
+    states, n_steps = gpu.solve_cuda(model, y0, t, options["dt"], options["max_steps"], method=m.name, keep=True)
+    if not gpu.all_finite(states):
+        _raise_on_divergence(states.copy_to_host(), method)
+    return Solution(states.copy_to_host() if host else states, n_steps, 0, m.evaluations * n_steps)
 
 
 def _raise_on_divergence(states, method, lo=0, hi=None):

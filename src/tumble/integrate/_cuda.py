@@ -65,7 +65,7 @@ from numba.extending import overload, register_jitable
 
 from tumble import torques
 from tumble.dynamics import rigid_rates
-from tumble._validate import ValidationError, require_memory
+from tumble._validate import ValidationError
 from tumble.integrate import _fixed, _liegroup, _rk4
 from tumble.integrate._fixed import landing_steps
 from tumble.integrate._method import MAX_STEPS
@@ -326,25 +326,6 @@ def _to_device(model):
     """``model`` (a kernel: a NamedTuple) with its arrays copied to the GPU (those there already kept)."""
     return type(model)(*(cuda.to_device(np.ascontiguousarray(f)) if isinstance(f, np.ndarray) else f
                          for f in model))
-
-
-def solve(model, y0, t, *, method: str, **options):
-    """:func:`tumble.integrate.solve` on the GPU: the :class:`~tumble.integrate.Solution` of ``model`` from
-    ``y0`` (N, n) through ``t`` by :func:`solve_cuda`, its states left on the device when ``y0`` is there
-    (copied back otherwise). A state that stops being finite raises :class:`~tumble.integrate.Diverged`, as
-    on the CPU (the states are copied back for its message)."""
-    from tumble import integrate
-
-    m = integrate.check_method(method, model.provides, f"a {type(model).__name__}")
-    options = m.resolve(options)
-    host = not is_on_device(y0)
-    if host:
-        require_memory(8 * len(t) * y0.shape[0] * y0.shape[1], "t", f"the states at {len(t)} output "
-                                 f"times × {y0.shape[0]} member(s) × {y0.shape[1]} values")
-    states, n_steps = solve_cuda(model, y0, t, options["dt"], options["max_steps"], method=m.name, keep=True)
-    if not all_finite(states):
-        integrate._raise_on_divergence(states.copy_to_host(), method)
-    return integrate.Solution(states.copy_to_host() if host else states, n_steps, 0, m.evaluations * n_steps)
 
 
 def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4", keep=False) -> tuple[np.ndarray, int]:

@@ -65,7 +65,7 @@ import os
 import shutil
 import warnings
 from collections.abc import Iterable, Iterator
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -313,7 +313,7 @@ class SweepStore:
         plan = self.plan
         p = np.asarray(percentiles, dtype=np.float64)
         data: dict[str, tuple] = {}  # name → (dims, values)
-        gpu = None
+        gpu: Any = None
         if device == "cuda":
             from tumble.sweeps import device as gpu  # imports numba.cuda: only when asked for
         for name in plan.series:

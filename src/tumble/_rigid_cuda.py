@@ -46,8 +46,9 @@ from tumble._inertia import (_DEFINITE_RTOL, _LARGEST, _SYMMETRY_RTOL, _TRIANGLE
 from tumble._quat import qfrom_matrix
 from tumble._validate import ValidationError
 from tumble.dynamics import euler_coefficients
-from tumble.integrate._cuda import THREADS_PER_BLOCK, on_device, require_gpu
+from tumble.integrate._cuda import SCHEMES, THREADS_PER_BLOCK, on_device, require_gpu
 from tumble.kernels import rigid as _kernel
+from tumble.model import Model, Outputs
 from tumble.rigid import _STACKLEVEL, RigidBodies, to_body_axes, to_principal_axes
 
 __all__ = ["DeviceRigidBodies", "as_device_model"]
@@ -193,7 +194,7 @@ def _blocks(n: int) -> int:
 class DeviceRigidBodies(RigidBodies):
     """:class:`tumble.rigid.RigidBodies` whose arrays live on the GPU: ``inertia`` (symmetrised), ``moments``,
     ``axes`` (R_BP), ``q_bp`` and the Euler ``coefficients`` are device arrays; the initial states and the
-    outputs are converted there (:mod:`this module <tumble.integrate._cuda_rigid>`)."""
+    outputs are converted there (:mod:`tumble._rigid_cuda`)."""
 
     __slots__ = ("coefficients", "thin")
 
@@ -266,8 +267,6 @@ class DeviceRigidBodies(RigidBodies):
 
     def outputs(self, kernel, t: np.ndarray, states):
         """``q`` (n, N, 4) and ``omega`` (n, N, 3) in body axes, on the GPU, from the states there."""
-        from tumble.model import Outputs
-
         if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
             self._check_motion(states[states.shape[0] - 1, :, 4:])
         q, omega = cuda.device_array(states.shape[:-1] + (4,)), cuda.device_array(states.shape[:-1] + (3,))
@@ -285,14 +284,11 @@ def _is_tensor_batch(model) -> bool:
     return isinstance(model, np.ndarray) and model.ndim == 3 and model.dtype.kind == "f"
 
 
-def as_device_model(model, method: str):
+def as_device_model(model, method: str) -> Model:
     """The model of ``simulate(model, ..., device="cuda")``: a batch of inertia tensors (N, 3, 3) set up on
     the GPU (:meth:`DeviceRigidBodies.of_tensors`), the rigid bodies of a :class:`tumble.RigidBody` or a
     sequence of them copied there (:meth:`DeviceRigidBodies.of_host`), any other model as it is (its states
     are converted on the CPU). A method without a GPU kernel, or no GPU, is refused first."""
-    from tumble.integrate._cuda import SCHEMES
-    from tumble.simulate import as_model
-
     if method not in SCHEMES:
         raise ValidationError(f"device: 'cuda' runs the methods {', '.join(map(repr, SCHEMES))}; got "
                               f"method={method!r}")
@@ -303,7 +299,7 @@ def as_device_model(model, method: str):
         if shape[1:] != (3, 3):
             raise ValidationError(f"inertia: must have shape (3, 3) or (N, 3, 3), got {shape}")
         return DeviceRigidBodies.of_tensors(model)
-    model = as_model(model)
+    model = model if isinstance(model, Model) else RigidBodies.of(model)
     if type(model) is RigidBodies:
         require_gpu()
         return DeviceRigidBodies.of_host(model)
