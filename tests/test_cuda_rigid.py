@@ -198,3 +198,46 @@ def test_a_broken_tensor_is_refused_with_the_cpus_message(simulated):
         tumble.simulate(bad, cases["omega0"], t=T, method="rk4", dt=DT)
     assert str(gpu["refusal"]) == str(cpu.value)
     assert str(cpu.value).startswith("inertia[1]: must be symmetric")
+
+
+def _nvvm_available():
+    from numba.core import config
+
+    if config.ENABLE_CUDASIM:
+        return False
+    from numba.cuda.cudadrv import nvvm
+
+    return nvvm.is_available()
+
+
+def _compile_ptx(monkeypatch, kernel, signature):
+    """``kernel`` compiled to PTX for sm_90 (numba.cuda compiles the @njit callees for the current device;
+    without one, its compute capability is named)."""
+    from types import SimpleNamespace
+
+    from numba import cuda
+    from numba.cuda import dispatcher
+
+    if not hasattr(dispatcher, "get_current_device"):
+        pytest.skip("this numba.cuda does not look up the device where these tests expect")
+    monkeypatch.setattr(dispatcher, "get_current_device", lambda: SimpleNamespace(compute_capability=(9, 0)))
+    ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=(9, 0))
+    return ptx
+
+
+@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.parametrize("name", ["_principal_axes_kernel", "_coefficients_kernel", "_to_principal_kernel",
+                                  "_to_body_kernel"])
+def test_set_up_kernels_compile_for_a_gpu(monkeypatch, name):
+    """What the simulator cannot see: each kernel types and compiles for sm_90, calling no Python and
+    allocating nothing (no ``malloc``: its 3×3 scratch is per-thread local memory)."""
+    from numba import float64, int8
+
+    from tumble import _rigid_cuda
+
+    a2, a3 = float64[:, ::1], float64[:, :, ::1]
+    signatures = {"_principal_axes_kernel": (a3, a3, a2, a3, a2, a2, int8[::1]), "_coefficients_kernel": (a2, a2),
+                  "_to_principal_kernel": (a2, a2, a2, a3, a2), "_to_body_kernel": (a3, a2, a3, a3, a3)}
+    ptx = _compile_ptx(monkeypatch, getattr(_rigid_cuda, name), signatures[name])
+    assert ptx.count(".entry") == 1
+    assert "malloc" not in ptx

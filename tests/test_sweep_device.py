@@ -21,6 +21,8 @@ import pytest
 import tumble
 from tumble.sweeps import Component, Final, Inertia, Max, Normal, PointingError, sweep
 
+from test_cuda_rigid import _compile_ptx, _nvvm_available
+
 EPS = np.finfo(np.float64).eps
 P = (0.0, 1.0, 5.0, 33.3, 50.0, 95.0, 99.0, 100.0)
 T = np.array([0.0, 0.02, 0.05])
@@ -135,3 +137,20 @@ def test_a_device_sweep_refuses_what_it_cannot_run():
     with pytest.raises(tumble.ValidationError, match=r"^device: must be 'cpu' or 'cuda', got 'tpu'$"):
         sweep(body, device="tpu", method="rk4", dt=DT, **arguments)
 
+
+
+@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.parametrize("name", ["_block_moments_kernel", "_bitonic_kernel", "_count_kernel", "_gather_kernel"])
+def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
+    """What the simulator cannot see: each reduction kernel types and compiles for sm_90, allocating nothing."""
+    from numba import float64, int64
+
+    from tumble.sweeps import device
+
+    a2 = float64[:, ::1]
+    signatures = {"_block_moments_kernel": (a2, int64, float64[:, :, ::1]), "_bitonic_kernel": (a2, int64, int64),
+                  "_count_kernel": (a2, int64[::1]),
+                  "_gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
+    ptx = _compile_ptx(monkeypatch, getattr(device, name), signatures[name])
+    assert ptx.count(".entry") == 1
+    assert "malloc" not in ptx

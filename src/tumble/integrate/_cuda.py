@@ -209,8 +209,10 @@ def _smaller(a, b):
     return b if b < a else a
 
 
-_MAX = {2: _larger, 3: lambda a, b, c: _larger(_larger(a, b), c)}
-_MIN = {2: _smaller, 3: lambda a, b, c: _smaller(_smaller(a, b), c)}
+_MAX = {2: _larger, 3: lambda a, b, c: _larger(_larger(a, b), c),
+        4: lambda a, b, c, d: _larger(_larger(_larger(a, b), c), d)}  # a quaternion's largest (_quat.qnorm)
+_MIN = {2: _smaller, 3: lambda a, b, c: _smaller(_smaller(a, b), c),
+        4: lambda a, b, c, d: _smaller(_smaller(_smaller(a, b), c), d)}
 
 
 @overload(max, target="cuda", strict=False)
