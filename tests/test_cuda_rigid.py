@@ -115,6 +115,7 @@ import tumble
 from tumble import torques
 cases = np.load(sys.argv[1])
 inertia, omega0, q0, t, dt = (cases[k] for k in ("inertia", "omega0", "q0", "t", "dt"))
+THIN = np.stack([np.diag([1e-10, 1.0, 1.0])] * 2)
 out = {}
 run = tumble.simulate(inertia, omega0, q0=q0, t=t, method="rk4", dt=float(dt), device="cuda", output="device")
 out["on_device"] = run.on_device and hasattr(run.q, "copy_to_host") and not isinstance(run.q, np.ndarray)
@@ -130,6 +131,11 @@ out["torque_q"], out["torque_omega"] = pushed.q, pushed.omega
 body = tumble.RigidBody(inertia[0])
 one = tumble.simulate(body, omega0[0], t=t, method="cf4", dt=float(dt), device="cuda", output="device").to_host()
 out["body_q"], out["body_omega"] = one.q, one.omega
+import warnings
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    tumble.simulate(THIN, omega0[:2], t=t, method="rk4", dt=float(dt), device="cuda")
+out["thin_warning"] = [str(w.message) for w in caught if type(w.message).__name__ == "RigidityWarning"]
 bad = inertia.copy()
 bad[1, 0, 1] += 1e-6
 try:
@@ -187,6 +193,15 @@ def test_a_body_set_up_on_the_host_converts_on_the_device_bit_for_bit(simulated)
     cpu = tumble.simulate(tumble.RigidBody(cases["inertia"][0]), cases["omega0"][0], t=T, method="cf4", dt=DT)
     np.testing.assert_array_equal(gpu["body_q"], cpu.q)  # the CPU's set-up, the conversions' own arithmetic
     np.testing.assert_array_equal(gpu["body_omega"], cpu.omega)
+
+
+@pytest.mark.slow
+def test_a_thin_body_set_up_on_the_device_is_warned_as_on_the_cpu(simulated):
+    cases, gpu = simulated
+    with pytest.warns(tumble.limits.RigidityWarning) as cpu:
+        tumble.simulate(np.stack([np.diag([1e-10, 1.0, 1.0])] * 2), cases["omega0"][:2], t=T, method="rk4", dt=DT)
+    assert list(gpu["thin_warning"]) == [str(w.message) for w in cpu]
+    assert "practically a line" in gpu["thin_warning"][0]
 
 
 @pytest.mark.slow

@@ -16,8 +16,9 @@ asked, the results back:
 
 * **principal axes** (:func:`principal_axes_of_one`): the tensor symmetrised
   and checked by the CPU's rules (:func:`tumble._inertia.symmetrize`), then
-  diagonalised by cyclic Jacobi rotations (:func:`jacobi`; G. H. Golub & C. F.
-  Van Loan, *Matrix Computations*, 4th ed., §8.5.2, Algorithm 8.5.2), sorted
+  diagonalised by cyclic Jacobi rotations (:func:`jacobi`: each 2×2 symmetric
+  Schur rotation, cyclic by rows; G. H. Golub & C. F. Van Loan, *Matrix
+  Computations*, 4th ed., §8.5), sorted
   and signed as the CPU's (:func:`tumble._inertia.sort_ascending`,
   :func:`tumble._inertia.canonical`), its quaternion by Shepperd's method
   (:func:`tumble._quat.qfrom_matrix`). Eigenvectors are defined up to sign
@@ -250,10 +251,12 @@ class DeviceRigidBodies(RigidBodies):
             return _kernel.RigidModel(self.coefficients, np.zeros((1, 0)), None, self.moments)
         return _kernel.from_principal(np.asarray(self.moments), np.asarray(self.axes), program)
 
-    def _check_motion(self, omega_principal) -> None:
-        """:func:`tumble.limits.check_rigid_motion` where it can warn: a thin body, or speeds with masses."""
+    def _check_motion(self, states) -> None:
+        """:func:`tumble.limits.check_rigid_motion` of the states (N, 7) on the device where it can warn (a thin
+        body, or speeds with masses): then they are copied back (whole: a view of some columns is not
+        contiguous)."""
         if self.thin or self.masses is not None:
-            limits.check_rigid_motion(np.asarray(self.moments), np.asarray(omega_principal), self.masses,
+            limits.check_rigid_motion(np.asarray(self.moments), states.copy_to_host()[:, 4:], self.masses,
                                       stacklevel=_STACKLEVEL + 1)
 
     def initial_states(self, kernel, values: dict[str, np.ndarray], t0: float):
@@ -262,13 +265,13 @@ class DeviceRigidBodies(RigidBodies):
         y0 = cuda.device_array((n, _kernel.STATE_SIZE))
         _to_principal_kernel[_blocks(n), THREADS_PER_BLOCK](on_device(values["q0"]), on_device(values["omega0"]),
                                                             self.q_bp, self.axes, y0)
-        self._check_motion(y0[:, 4:])
+        self._check_motion(y0)
         return y0
 
     def outputs(self, kernel, t: np.ndarray, states):
         """``q`` (n, N, 4) and ``omega`` (n, N, 3) in body axes, on the GPU, from the states there."""
         if kernel.codes is not None:  # a torque may have spun the body up: check where it ended
-            self._check_motion(states[states.shape[0] - 1, :, 4:])
+            self._check_motion(states[states.shape[0] - 1])
         q, omega = cuda.device_array(states.shape[:-1] + (4,)), cuda.device_array(states.shape[:-1] + (3,))
         _to_body_kernel[_blocks(states.shape[1]), THREADS_PER_BLOCK](states, self.q_bp, self.axes, q, omega)
         return Outputs(q=q, omega=omega, inertia=self.inertia, extras={}, totals={}, info={})
