@@ -40,10 +40,12 @@ def _sweep_arguments():
 
 
 _CHILD = """
+import os
 import sys
 import numpy as np
 import runpy
 from tumble.sweeps import device, sweep
+sys.path.insert(0, os.path.dirname(sys.argv[1]))  # the tests' folder: this file imports a sibling
 module = runpy.run_path(sys.argv[1])
 tables = np.load(sys.argv[2])
 device.BLOCK = 16  # several blocks of samples, merged
