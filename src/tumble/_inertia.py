@@ -13,6 +13,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numba
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 from numpy.typing import ArrayLike
 
 from tumble import _quat
@@ -149,18 +150,25 @@ def _eigh(tensors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate([m for m, _ in parts]), np.concatenate([v for _, v in parts])
 
 
+@register_jitable
+def symmetrize(tensor, out):
+    """``out = (I + Iᵀ)/2`` of one tensor ``I`` (3, 3); returns ``(max |Iᵢⱼ|, max |Iᵢⱼ − Iⱼᵢ|)``. Plain
+    Python until compiled: the GPU's set-up (:mod:`tumble._rigid_cuda`) calls it too."""
+    s = a = 0.0
+    for i in range(3):
+        for j in range(3):
+            s = max(s, abs(tensor[i, j]))
+            a = max(a, abs(tensor[i, j] - tensor[j, i]))
+            out[i, j] = 0.5 * (tensor[i, j] + tensor[j, i])
+    return s, a
+
+
 @njit(cache=True)
 def _symmetrized(inertia, out, scale, asym):
     """Per tensor ``n`` of ``inertia`` (n, 3, 3): ``out[n] = (I + Iᵀ)/2``, ``scale[n] = max |Iᵢⱼ|`` and
-    ``asym[n] = max |Iᵢⱼ − Iⱼᵢ|``."""
+    ``asym[n] = max |Iᵢⱼ − Iⱼᵢ|`` (:func:`symmetrize`)."""
     for n in range(out.shape[0]):
-        s = a = 0.0
-        for i in range(3):
-            for j in range(3):
-                s = max(s, abs(inertia[n, i, j]))
-                a = max(a, abs(inertia[n, i, j] - inertia[n, j, i]))
-                out[n, i, j] = 0.5 * (inertia[n, i, j] + inertia[n, j, i])
-        scale[n], asym[n] = s, a
+        scale[n], asym[n] = symmetrize(inertia[n], out[n])
 
 
 @njit(cache=True)
@@ -180,43 +188,54 @@ def _diagonal_decomposition(inertia, moments, axes, diagonal):
             m[i] = a[i, i]
             for j in range(3):
                 v[i, j] = 1.0 if i == j else 0.0
-        for i in range(2):
-            k = i
-            for j in range(i + 1, 3):
-                if m[j] < m[k]:
-                    k = j
-            if k != i:
-                m[i], m[k] = m[k], m[i]
-                for r in range(3):
-                    v[r, i], v[r, k] = v[r, k], v[r, i]
+        sort_ascending(m, v)
+
+
+@register_jitable
+def sort_ascending(m, v):
+    """In place: the moments ``m`` (3,) sorted ascending by selection (the smallest of the rest swapped into
+    place, the first of equals), as LAPACK sorts, with the columns of ``v`` (3, 3) (their axes)."""
+    for i in range(2):
+        k = i
+        for j in range(i + 1, 3):
+            if m[j] < m[k]:
+                k = j
+        if k != i:
+            m[i], m[k] = m[k], m[i]
+            for r in range(3):
+                v[r, i], v[r, k] = v[r, k], v[r, i]
 
 
 @njit(cache=True)
 def _canonical(moments, axes):
-    """In place, per body ``n``: ascending ``moments[n]`` within ``_DEGENERATE_RTOL`` × the largest of a
-    neighbour replaced by the mean of their group (a pair, or all three); each column of ``axes[n]`` (the
+    """In place, per body ``n``: :func:`canonical` of ``moments[n]`` and ``axes[n]``."""
+    for n in range(moments.shape[0]):
+        canonical(moments[n], axes[n])
+
+
+@register_jitable
+def canonical(m, a):
+    """In place, for one body: ascending moments ``m`` (3,) within ``_DEGENERATE_RTOL`` × the largest of a
+    neighbour replaced by the mean of their group (a pair, or all three); each column of ``a`` (3, 3) (the
     eigenvectors) signed so that its largest-magnitude component (the first of equals) is positive, then
     the third negated where ``det < 0``, for a right-handed frame."""
-    for n in range(moments.shape[0]):
-        m = moments[n]
-        tol = _DEGENERATE_RTOL * abs(m[2])
-        lower, upper = m[1] - m[0] <= tol, m[2] - m[1] <= tol
-        if lower and upper:
-            m[0] = m[1] = m[2] = (m[0] + m[1] + m[2]) / 3.0
-        elif lower:
-            m[0] = m[1] = 0.5 * (m[0] + m[1])
-        elif upper:
-            m[1] = m[2] = 0.5 * (m[1] + m[2])
-        a = axes[n]
-        for j in range(3):
-            largest = 0
-            for i in range(1, 3):
-                if abs(a[i, j]) > abs(a[largest, j]):
-                    largest = i
-            if a[largest, j] < 0.0:
-                a[0, j], a[1, j], a[2, j] = -a[0, j], -a[1, j], -a[2, j]
-        if mdet(a) < 0.0:
-            a[0, 2], a[1, 2], a[2, 2] = -a[0, 2], -a[1, 2], -a[2, 2]
+    tol = _DEGENERATE_RTOL * abs(m[2])
+    lower, upper = m[1] - m[0] <= tol, m[2] - m[1] <= tol
+    if lower and upper:
+        m[0] = m[1] = m[2] = (m[0] + m[1] + m[2]) / 3.0
+    elif lower:
+        m[0] = m[1] = 0.5 * (m[0] + m[1])
+    elif upper:
+        m[1] = m[2] = 0.5 * (m[1] + m[2])
+    for j in range(3):
+        largest = 0
+        for i in range(1, 3):
+            if abs(a[i, j]) > abs(a[largest, j]):
+                largest = i
+        if a[largest, j] < 0.0:
+            a[0, j], a[1, j], a[2, j] = -a[0, j], -a[1, j], -a[2, j]
+    if mdet(a) < 0.0:
+        a[0, 2], a[1, 2], a[2, 2] = -a[0, 2], -a[1, 2], -a[2, 2]
 
 
 def as_rotation(rotation, name: str) -> np.ndarray:

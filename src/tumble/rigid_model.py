@@ -27,6 +27,7 @@ from typing import cast
 
 import numpy as np
 from numba import njit
+from numba.extending import register_jitable
 from numpy.typing import ArrayLike
 
 from tumble import attitude, limits, torques
@@ -54,38 +55,51 @@ def _state_fields() -> tuple[StateField, ...]:
     )
 
 
+@register_jitable
+def to_principal_axes(q0, omega0, q_bp, axes, y0, b, j):
+    """Member ``b``'s initial state in principal axes from ``q0[b]`` and ``omega0[b]`` in body axes, with
+    body ``j``'s ``q_BP`` and ``R_BP``: ``q_NP = q_NB ⊗ q_BP`` into ``y0[b, :4]`` (bit for bit
+    :func:`tumble.attitude.multiply`'s product), ``ω_P = R_BPᵀ ω_B`` into ``y0[b, 4:]`` with
+    ``ω_i = (R_0i ω_0 + R_1i ω_1) + R_2i ω_2`` in that order. Plain Python until compiled: the GPU's
+    set-up (:mod:`tumble._rigid_cuda`) calls it too."""
+    w, x, y, z = qmul(q0[b, 0], q0[b, 1], q0[b, 2], q0[b, 3], q_bp[j, 0], q_bp[j, 1], q_bp[j, 2], q_bp[j, 3])
+    y0[b, 0], y0[b, 1], y0[b, 2], y0[b, 3] = w, x, y, z
+    for i in range(3):
+        y0[b, 4 + i] = axes[j, 0, i] * omega0[b, 0] + axes[j, 1, i] * omega0[b, 1] + axes[j, 2, i] * omega0[b, 2]
+
+
+@register_jitable
+def to_body_axes(states, q_bp, axes, q, omega, k, b, j):
+    """Member ``b``'s state at output ``k`` from principal to body axes, with body ``j``'s ``q_BP`` and
+    ``R_BP``: ``q_NB = q_NP ⊗ q_BP*`` into ``q[k, b]`` (bit for bit :func:`tumble.attitude.multiply`'s
+    product), ``ω_B = R_BP ω_P`` into ``omega[k, b]`` with ``ω_i = (R_i0 ω_0 + R_i1 ω_1) + R_i2 ω_2`` in that
+    order. Plain Python until compiled, as :func:`to_principal_axes`."""
+    w, x, y, z = qmul(states[k, b, 0], states[k, b, 1], states[k, b, 2], states[k, b, 3],
+                      q_bp[j, 0], -q_bp[j, 1], -q_bp[j, 2], -q_bp[j, 3])
+    q[k, b, 0], q[k, b, 1], q[k, b, 2], q[k, b, 3] = w, x, y, z
+    for i in range(3):
+        omega[k, b, i] = axes[j, i, 0] * states[k, b, 4] + axes[j, i, 1] * states[k, b, 5] \
+            + axes[j, i, 2] * states[k, b, 6]
+
+
 @njit(cache=True)
 def _to_principal_axes(q0, omega0, q_bp, axes, y0):
     """The initial states (N, 7) in principal axes from ``q0`` (N, 4) and ``omega0`` (N, 3) in body axes, in
-    one pass: ``q_NP = q_NB ⊗ q_BP`` into ``y0[:, :4]``, ``ω_P = R_BPᵀ ω_B`` into ``y0[:, 4:]``, with ``q_BP``
-    (B, 4) and ``R_BP`` (B, 3, 3) of B = 1 body or one per member. ``q_NP`` is bit for bit
-    :func:`tumble.attitude.multiply`'s product; ``ω_i = (R_0i ω_0 + R_1i ω_1) + R_2i ω_2`` in that order."""
+    one pass (:func:`to_principal_axes`), with ``q_BP`` (B, 4) and ``R_BP`` (B, 3, 3) of B = 1 body or one
+    per member."""
     shared = q_bp.shape[0] == 1
     for b in range(y0.shape[0]):
-        j = 0 if shared else b
-        w, x, y, z = qmul(q0[b, 0], q0[b, 1], q0[b, 2], q0[b, 3], q_bp[j, 0], q_bp[j, 1], q_bp[j, 2], q_bp[j, 3])
-        y0[b, 0], y0[b, 1], y0[b, 2], y0[b, 3] = w, x, y, z
-        for i in range(3):
-            y0[b, 4 + i] = axes[j, 0, i] * omega0[b, 0] + axes[j, 1, i] * omega0[b, 1] + axes[j, 2, i] * omega0[b, 2]
+        to_principal_axes(q0, omega0, q_bp, axes, y0, b, 0 if shared else b)
 
 
 @njit(cache=True)
 def _to_body_axes(states, q_bp, axes, q, omega):
-    """The states (n, N, 7) in principal axes to body axes, in one pass: ``q_NB = q_NP ⊗ q_BP*`` into ``q``
-    (n, N, 4), ``ω_B = R_BP ω_P`` into ``omega`` (n, N, 3), with ``q_BP`` (B, 4) and ``R_BP`` (B, 3, 3) of
-    B = 1 body or one per member. ``q`` is bit for bit :func:`tumble.attitude.multiply`'s product;
-    ``ω_i = (R_i0 ω_0 + R_i1 ω_1) + R_i2 ω_2`` in that order."""
+    """The states (n, N, 7) in principal axes to body axes, in one pass (:func:`to_body_axes`): ``q`` (n, N, 4)
+    and ``omega`` (n, N, 3), with ``q_BP`` (B, 4) and ``R_BP`` (B, 3, 3) of B = 1 body or one per member."""
     shared = q_bp.shape[0] == 1
     for k in range(states.shape[0]):
         for b in range(states.shape[1]):
-            j = 0 if shared else b
-            w, x, y, z = qmul(states[k, b, 0], states[k, b, 1], states[k, b, 2], states[k, b, 3],
-                              q_bp[j, 0], -q_bp[j, 1], -q_bp[j, 2], -q_bp[j, 3])
-            q[k, b, 0], q[k, b, 1], q[k, b, 2], q[k, b, 3] = w, x, y, z
-            for i in range(3):
-                omega[k, b, i] = axes[j, i, 0] * states[k, b, 4] + axes[j, i, 1] * states[k, b, 5] \
-                    + axes[j, i, 2] * states[k, b, 6]
-
+            to_body_axes(states, q_bp, axes, q, omega, k, b, 0 if shared else b)
 
 
 class RigidBodies(Model):

@@ -73,6 +73,7 @@ def simulate(
     torque: TorqueLike | ArrayLike = None,
     progress: Callable[[int, int], None] | None = None,
     device: str = "cpu",
+    output: str = "host",
     store: str | os.PathLike[str] | None = None,
     **initial_state: ArrayLike | None,
 ) -> Trajectory:
@@ -112,7 +113,12 @@ def simulate(
     device : {"cpu", "cuda"}
         ``"cuda"``: ``method="rk4"`` or ``"cf4"`` on an NVIDIA GPU, one thread
         per batch member, for every model whose compiled functions run there
-        (compiled torques and laws; ``docs/gpu.md``).
+        (compiled torques and laws; ``docs/gpu.md``). Rigid bodies are set up there too: the principal
+        axes of a batch of inertia tensors (N, 3, 3), which may be a device array, and the changes of axes.
+    output : {"host", "device"}
+        ``"device"`` (with ``device="cuda"``, rigid bodies): the Trajectory's ``q``, ``omega`` and
+        ``inertia`` stay on the GPU as device arrays (``__cuda_array_interface__``: CuPy and DLPack
+        consumers take them without a copy); ``traj.to_host()`` or ``np.asarray`` copies them back.
     store : path of a Zarr store, optional
         Deprecated (to be removed in 0.5): use
         :func:`tumble.sweeps.simulate_to_store`, which this then calls and
@@ -132,7 +138,20 @@ def simulate(
         extras, the energy and angular momentum of the whole system, and
         ``info`` (method, options, statistics).
     """
-    model = as_model(model)
+    if device not in ("cpu", "cuda"):
+        raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
+    if output not in ("host", "device") or (output == "device" and device != "cuda"):
+        raise ValidationError(f"output: must be 'host', or 'device' with device='cuda'; got output={output!r} "
+                              f"with device={device!r}")
+    if device == "cuda":
+        from tumble import _rigid_cuda  # imports numba.cuda: only when asked for
+
+        model = _rigid_cuda.as_device_model(model, method)
+    else:
+        model = as_model(model)
+    if output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies):
+        raise ValidationError(f"output: 'device' keeps the results of rigid bodies on the GPU; a {model.kind}'s "
+                              "outputs are made on the host: use output='host'")
     times = output_times(t)
     if omega0 is not None:
         initial_state["omega0"] = omega0
@@ -148,8 +167,6 @@ def simulate(
                                  dt=dt, rtol=rtol, atol=atol, max_steps=max_steps, torque=torque, device=device,
                                  progress=progress, **state)
     m, options = _solver_options(model, method, dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
-    if device not in ("cpu", "cuda"):
-        raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
     if torque is not None and model.torque is None:
         raise ValidationError(f"torque: a {model.kind} takes no torque argument")
     values, n = _initial_values(model, initial_state)
@@ -175,6 +192,8 @@ def simulate(
         except integrate.Diverged as diverged:
             raise _divergence(model, kernel, grid, diverged) from None
         out = model.outputs(kernel, times, solution.states if kept is None else solution.states[kept])
+        if output == "host" and device == "cuda":
+            out = _rigid_cuda.to_host(out)
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
     return _trajectory(model, m.name, times, out, info, single=n is None)
@@ -317,8 +336,8 @@ def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: di
     them (fresh C-ordered float64 arrays, as the models' outputs are), copied otherwise (a view of the states
     would keep them alive)."""
     def pick(a, name):
-        if a is None:
-            return None
+        if a is None or not isinstance(a, np.ndarray):  # None, or a device array (checked finite there)
+            return None if a is None else a[:, 0] if single else a
         if not (a.flags.owndata and a.flags.c_contiguous and a.dtype == np.float64):
             a = np.array(a, dtype=np.float64)
         a.setflags(write=False)  # before picking: a view of a read-only array is read-only

@@ -266,17 +266,36 @@ class Trajectory:
         there: ``t`` (n,) strictly increasing and finite, ``q`` (n, [N,] 4) and ``omega`` (n, [N,] 3) finite
         float64 of the shapes of a run, arrays the caller owns and hands over. They are marked
         read-only, not copied nor checked again; ``inertia`` is shared when read-only (a model's own), copied
-        otherwise; ``info``, ``extras`` and ``totals`` are checked as by the constructor."""
+        otherwise; ``info``, ``extras`` and ``totals`` are checked as by the constructor. ``q``, ``omega`` and
+        ``inertia`` may be device arrays (``simulate(..., output="device")``), kept as they are."""
         self = object.__new__(cls)
-        if inertia is not None and inertia.flags.writeable:
+        if isinstance(inertia, np.ndarray) and inertia.flags.writeable:
             inertia = np.array(inertia, dtype=np.float64)
-        for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):
-            object.__setattr__(self, name, None if value is None else _readonly(value))
+        for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):  # device arrays as given
+            object.__setattr__(self, name, _readonly(value) if isinstance(value, np.ndarray) else value)
         for name, given in (("method", method), ("info", info), ("extras", extras), ("totals", totals),
                             ("model", model)):
             object.__setattr__(self, name, given)
         self._check_rest(q.shape[:-1] if q is not None else np.shape(totals["energy"]))
         return self
+
+    @property
+    def on_device(self) -> bool:
+        """Whether ``q``, ``omega`` and ``inertia`` are GPU device arrays (``simulate(..., output="device")``):
+        numba.cuda's, which implement ``__cuda_array_interface__`` (``cupy.asarray(traj.q)`` takes them
+        without a copy). The invariants, views and files read host arrays: :meth:`to_host` first."""
+        return self.q is not None and not isinstance(self.q, np.ndarray)
+
+    def to_host(self) -> Trajectory:
+        """This trajectory with its device arrays copied to the host (itself when they are there already)."""
+        if not self.on_device:
+            return self
+
+        def host(a):
+            return a.copy_to_host() if hasattr(a, "copy_to_host") else np.array(a, dtype=np.float64)
+
+        return Trajectory._of_run(self.t, host(self.q), host(self.omega), host(self.inertia), self.method,
+                                  dict(self.info), self.extras, self.totals, self.model)
 
     def __getattr__(self, name: str):
         """``traj.NAME`` is ``traj.extras[NAME].data`` for the model's named outputs (e.g. ``traj.wheel_speed``)."""

@@ -187,7 +187,8 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     solver options the method reads (:class:`Run`).
     A model whose ``calls_python`` is true runs body after body on one core.
     ``progress(done, total)`` is called after each chunk of output samples.
-    ``device="cuda"`` runs ``rk4`` or ``cf4`` on an NVIDIA GPU (models that provide ``"cuda"``).
+    ``device="cuda"`` runs ``rk4`` or ``cf4`` on an NVIDIA GPU (models that provide ``"cuda"``); ``y0`` may
+    be a device array there, and the states are then left on the device.
 
     Bounded before anything runs: a fixed-step run needing more than ``max_steps`` steps per body is
     refused (:func:`._fixed.landing_steps`), and so are states that would not fit in memory
@@ -198,17 +199,14 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     instead of copied, as ``scipy.linalg``'s ``overwrite_a``: a caller that made ``y0`` for the run saves
     a copy (:func:`tumble.simulate`; 56 bytes per rigid body).
     """
+    if device == "cuda":
+        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
+
+        return _solve_on_gpu(_cuda, model, y0, t, method, options)
     run = Run(model, y0, t, method=method, overwrite_y0=overwrite_y0, **options)
     y, n_out = run.y, run.t.shape[0]
     require_memory(n_out * y.shape[0] * y.shape[1] * 8, "t", f"the states at {n_out} output times × {y.shape[0]} "
                    f"member(s) × {y.shape[1]} values")
-    if device == "cuda":
-        from tumble.integrate import _cuda  # imports numba.cuda: only when asked for
-
-        states, n_steps = _cuda.solve_cuda(model, y, run.t, run.options["dt"], run.options["max_steps"],
-                                           method=run.method.name)
-        _raise_on_divergence(states, method)
-        return Solution(states, n_steps, 0, run.method.evaluations * n_steps)
     out = np.empty((n_out, y.shape[0], y.shape[1]))
     bounds = [0, n_out - 1]
     if progress is not None and n_out > 2 and run.method.stepper:
@@ -221,6 +219,23 @@ def solve(model: Any, y0: np.ndarray, t: np.ndarray, *, method: str, progress: C
     if n_out == 1:
         out[0] = y
     return run.solution(out)
+
+
+def _solve_on_gpu(gpu, model: Any, y0, t: np.ndarray, method: str, options: dict) -> Solution:
+    """:func:`solve` on the GPU (``gpu``: :mod:`tumble.integrate._cuda`, imported by the caller): the states
+    left on the device when ``y0`` is there, copied back otherwise. A state that stops being finite raises
+    :class:`Diverged` as on the CPU (found on the device; the states copied back for its message)."""
+    m = check_method(method, model.provides, f"a {type(model).__name__}")
+    options = m.resolve(options)
+    host = not gpu.is_on_device(y0)
+    if host:
+        require_memory(8 * len(t) * y0.shape[0] * y0.shape[1], "t", f"the states at {len(t)} output times × "
+                       f"{y0.shape[0]} member(s) × {y0.shape[1]} values")
+    states: Any
+    states, n_steps = gpu.solve_cuda(model, y0, t, options["dt"], options["max_steps"], method=m.name, keep=True)
+    if not gpu.all_finite(states):
+        _raise_on_divergence(states.copy_to_host(), method)
+    return Solution(states.copy_to_host() if host else states, n_steps, 0, m.evaluations * n_steps)
 
 
 def _raise_on_divergence(states, method, lo=0, hi=None):

@@ -85,6 +85,49 @@ def cuda_available() -> bool:
     return cuda.is_available()
 
 
+def require_gpu() -> None:
+    """Raise :class:`~tumble._validate.ValidationError` naming ``device`` when no GPU is found."""
+    if not cuda_available():
+        raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
+
+
+def on_device(a):
+    """``a`` on the GPU: a NumPy array (or array_like) copied there as C-ordered float64, a device array
+    (numba.cuda's, or any array with ``__cuda_array_interface__``: CuPy's) as it is, without a copy."""
+    if hasattr(a, "copy_to_host"):  # numba.cuda's, and the simulator's stand-ins
+        return a
+    if hasattr(a, "__cuda_array_interface__"):
+        return cuda.as_cuda_array(a)
+    return cuda.to_device(np.ascontiguousarray(a, dtype=np.float64))
+
+
+def is_on_device(a) -> bool:
+    """Whether ``a`` is a device array (numba.cuda's or another with ``__cuda_array_interface__``)."""
+    return hasattr(a, "copy_to_host") or hasattr(a, "__cuda_array_interface__")
+
+
+@cuda.jit(cache=True)
+def _first_not_finite_kernel(states, first):
+    """``first[0] ← min(first[0], b)`` for each member ``b`` of ``states`` (n, N, size) with a value that is
+    not finite."""
+    b = cuda.grid(1)
+    if b >= states.shape[1]:
+        return
+    for k in range(states.shape[0]):
+        for i in range(states.shape[2]):
+            if not math.isfinite(states[k, b, i]):
+                cuda.atomic.min(first, 0, b)
+                return
+
+
+def all_finite(states) -> bool:
+    """Whether every value of the device array ``states`` (n, N, size) is finite: one flag copied back."""
+    first = cuda.to_device(np.array([states.shape[1]], dtype=np.int64))
+    _first_not_finite_kernel[max(1, math.ceil(states.shape[1] / THREADS_PER_BLOCK)), THREADS_PER_BLOCK](
+        states, first)
+    return int(first.copy_to_host()[0]) == states.shape[1]
+
+
 def _torque(t, qw, qx, qy, qz, w1, w2, w3, P, row, codes):
     """The torque (N·m, principal axes) of the program ``codes``, or None (torque-free) for ``codes = ()``.
 
@@ -166,8 +209,10 @@ def _smaller(a, b):
     return b if b < a else a
 
 
-_MAX = {2: _larger, 3: lambda a, b, c: _larger(_larger(a, b), c)}
-_MIN = {2: _smaller, 3: lambda a, b, c: _smaller(_smaller(a, b), c)}
+_MAX = {2: _larger, 3: lambda a, b, c: _larger(_larger(a, b), c),
+        4: lambda a, b, c, d: _larger(_larger(_larger(a, b), c), d)}  # a quaternion's largest (_quat.qnorm)
+_MIN = {2: _smaller, 3: lambda a, b, c: _smaller(_smaller(a, b), c),
+        4: lambda a, b, c, d: _smaller(_smaller(_smaller(a, b), c), d)}
 
 
 @overload(max, target="cuda", strict=False)
@@ -255,8 +300,16 @@ def _protocol_kernel(scheme, model, Y, t_out, m, h, out, work):
 
 
 @njit(cache=True)
-def _workspace_of_one(scheme, model, y):
+def _workspace_of_one_host(scheme, model, y):
     return _fixed.workspace(scheme, model, 0, y)
+
+
+def _workspace_of_one(scheme, model, y):
+    """The method's workspace of one member (host arrays): what the launch allocates once per member. A
+    model's fields on the device (a rigid batch set up there) stand in by host arrays of their shapes, not
+    filled: the workspace depends on the model's types and sizes, not its values."""
+    host = type(model)(*(np.empty(f.shape, f.dtype) if is_on_device(f) else f for f in model))
+    return _workspace_of_one_host(scheme, host, y)
 
 
 def check(kernel, method: str, who: str) -> None:
@@ -272,12 +325,12 @@ def check(kernel, method: str, who: str) -> None:
 
 
 def _to_device(model):
-    """``model`` (a kernel: a NamedTuple) with its arrays copied to the GPU."""
+    """``model`` (a kernel: a NamedTuple) with its arrays copied to the GPU (those there already kept)."""
     return type(model)(*(cuda.to_device(np.ascontiguousarray(f)) if isinstance(f, np.ndarray) else f
                          for f in model))
 
 
-def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.ndarray, int]:
+def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4", keep=False) -> tuple[np.ndarray, int]:
     """Integrate a batch of states of the compiled ``model`` with a fixed-step ``method`` on the GPU.
 
     Returns the states (len(t_out), N, n) at the output times and the number
@@ -289,6 +342,7 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.n
     dt : the longest step (s)
     max_steps : the most steps per body (default :data:`tumble.integrate.MAX_STEPS`), checked before the run
     method : ``"rk4"`` or ``"cf4"`` (:data:`SCHEMES`)
+    keep : return the states as a device array, left on the GPU (``y0`` may be one too)
 
     The states equal those of ``tumble.integrate.solve(model, y0, t_out, method=method, dt=dt)``
     to the rounding of fused multiply–adds (bitwise under the CUDA simulator).
@@ -296,25 +350,25 @@ def solve_cuda(model, y0, t_out, dt, max_steps=None, method="rk4") -> tuple[np.n
     (:func:`check`), and when no GPU is found.
     """
     check(model, method, f"a {type(model).__name__}")
-    if not cuda_available():
-        raise ValidationError("device: 'cuda' needs an NVIDIA GPU with its driver, and numba.cuda finds none")
-    y0 = np.ascontiguousarray(y0, dtype=np.float64)
+    require_gpu()
+    y0 = on_device(y0)
     t_out = np.ascontiguousarray(t_out, dtype=np.float64)
     m, h = landing_steps(t_out, float(dt), MAX_STEPS if max_steps is None else max_steps)
     steps = y0.shape[0] * int(m.sum())
     if method == "rk4" and "rigid_fields" in model.provides:  # rigid bodies: the fused kernel reads their fields
-        return _solve_rigid_rk4(model, y0, t_out, m, h), steps
-    work = tuple(cuda.device_array((y0.shape[0], *w.shape)) for w in _workspace_of_one(SCHEMES[method], model,
-                                                                                       y0[0].copy()))
-    out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
-    _protocol_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
-        SCHEMES[method], _to_device(model), cuda.to_device(y0), cuda.to_device(t_out), cuda.to_device(m),
-        cuda.to_device(h), out, work)
-    return out.copy_to_host(), steps
+        out = _solve_rigid_rk4(model, y0, t_out, m, h)
+    else:
+        work = tuple(cuda.device_array((y0.shape[0], *w.shape)) for w in _workspace_of_one(
+            SCHEMES[method], model, np.array(y0[0], dtype=np.float64)))
+        out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
+        _protocol_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
+            SCHEMES[method], _to_device(model), y0, cuda.to_device(t_out), cuda.to_device(m),
+            cuda.to_device(h), out, work)
+    return (out if keep else out.copy_to_host()), steps
 
 
-def _solve_rigid_rk4(model, y0, t_out, m, h) -> np.ndarray:
-    """The states (len(t_out), N, 7) of the rigid bodies of ``model`` by :func:`_rk4_kernel`.
+def _solve_rigid_rk4(model, y0, t_out, m, h):
+    """The states (len(t_out), N, 7) of the rigid bodies of ``model`` by :func:`_rk4_kernel`, on the GPU.
 
     It reads the fields of a kernel that provides ``"rigid_fields"`` (:class:`tumble.kernels.rigid.RigidModel`):
 
@@ -323,20 +377,21 @@ def _solve_rigid_rk4(model, y0, t_out, m, h) -> np.ndarray:
     params : (N or 1, n_p) torque-program parameters in each body's principal axes
     codes : int64 torque-program codes, or None for torque-free bodies
 
-    and ``y0`` (N, 7) the initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s).
+    (host or device arrays) and ``y0`` (N, 7) the initial states ``[q_NP (4), ω_P (3)]`` (ω in rad/s), on
+    the device.
     """
     # torque-free: an empty tuple, and the kernel compiles without torque code (see _torque)
     codes = model.codes
     program = () if codes is None else cuda.to_device(np.ascontiguousarray(codes, dtype=np.int64))
     out = cuda.device_array((t_out.shape[0], *y0.shape), dtype=np.float64)
     _rk4_kernel[math.ceil(y0.shape[0] / THREADS_PER_BLOCK), THREADS_PER_BLOCK](
-        cuda.to_device(np.ascontiguousarray(model.coefficients, dtype=np.float64)),
-        cuda.to_device(np.ascontiguousarray(model.params, dtype=np.float64)),
+        on_device(model.coefficients),
+        on_device(model.params),
         program,
-        cuda.to_device(y0),
+        y0,
         cuda.to_device(t_out),
         cuda.to_device(m),
         cuda.to_device(h),
         out,
     )
-    return out.copy_to_host()
+    return out

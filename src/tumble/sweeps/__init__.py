@@ -100,6 +100,7 @@ def sweep(
     workers: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     retries: int = 2,
+    device: str = "cpu",
     **initial_state: ArrayLike,
 ) -> xarray.Dataset:
     """Run ``samples`` simulations of ``model`` with dispersed inputs on Dask; return their outcomes.
@@ -151,6 +152,10 @@ def sweep(
         Called with the number of chunks done (the store's included).
     retries : int
         Retries of a task that raised (a killed worker's tasks are rescheduled by Dask regardless).
+    device : {"cpu", "cuda"}
+        ``"cuda"``: each chunk is simulated on the GPU (``method="rk4"`` or ``"cf4"``; ``docs/gpu.md``), in
+        this process (or on ``client``'s workers, one per GPU), and the statistics and percentiles are reduced
+        there (:mod:`tumble.sweeps.device`: the percentiles bit for bit those of the reduction on the CPU).
     **initial_state
         Initial states shared by every sample (e.g. ``q0=[1, 0, 0, 0]``).
 
@@ -173,6 +178,15 @@ def sweep(
                                  dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if workers is not None and int(workers) < 0:
         raise ValidationError(f"workers: must be >= 0 (0: in this process), got {workers}")
+    if device not in ("cpu", "cuda"):
+        raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
+    if device == "cuda":
+        if m.name not in ("rk4", "cf4"):
+            raise ValidationError(f"device: 'cuda' runs the methods 'rk4', 'cf4'; got method={m.name!r}")
+        if client is None and workers not in (None, 0):
+            raise ValidationError(f"workers: device='cuda' runs the chunks in this process, on its GPU (workers=0), "
+                                  f"or on a client's cluster of one worker per GPU; got workers={workers}")
+        workers = 0 if client is None else workers
     percentiles = tuple(float(p) for p in percentiles)
     if any(not 0.0 <= p <= 100.0 for p in percentiles):
         raise ValidationError(f"percentiles: must lie in [0, 100], got {list(percentiles)}")
@@ -180,7 +194,8 @@ def sweep(
         chunk = stored_chunk(store)  # resuming: the store's, whatever the cluster now
     plan = make_plan(model, dispersions or {}, samples=samples, seed=seed, chunk=chunk, t=times, method=m.name,
                      options=options, torque=torque, outcomes=dict(outcomes or {}), series=dict(statistics or {}),
-                     fixed=initial_state, trajectories=trajectories, parallel=_parallel(client, workers))
+                     fixed=initial_state, trajectories=trajectories, parallel=_parallel(client, workers),
+                     device=device)
     require_memory(plan.client_bytes(in_memory=store is None), "samples",
                    f"{plan.samples} samples (the store's sample index and the outcomes' percentiles"
                    f"{'; in memory, every value kept' if store is None else ''})")
@@ -188,7 +203,7 @@ def sweep(
         result = SweepStore(store, plan)
         computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
         if computed or not result.complete or not result.has_percentiles(percentiles):
-            result.finalize(percentiles)
+            result.finalize(percentiles, device)
     ds = result.dataset()
     ds.attrs["chunks_computed"] = computed
     return ds

@@ -80,6 +80,7 @@ class Plan:
     t, method, options, torque : the arguments of :func:`tumble.simulate`
     outcomes, series : name → function of a chunk's trajectory (:mod:`tumble.sweeps.outcomes`)
     trajectories : keep every sample's trajectory (``q``, ``omega``, the extras and totals) too
+    device : where the chunks are simulated (``"cpu"`` or ``"cuda"``, :func:`tumble.simulate`'s ``device``)
     """
 
     model: object
@@ -96,6 +97,7 @@ class Plan:
     outcomes: dict
     series: dict
     trajectories: bool = False
+    device: str = "cpu"
     grid: tuple = field(init=False)
 
     def __post_init__(self):
@@ -157,11 +159,11 @@ class Plan:
         m = len(next(iter(inputs.values()))) if inputs else 0
         state = {**self.fixed, **{name: inputs[name].reshape(m, -1) for name in self.states}}
         parameters = {name: v for name, v in inputs.items() if name not in self.states}
-        run = dict(t=self.t, method=self.method, torque=self.torque, **self.options)
+        run = dict(t=self.t, method=self.method, torque=self.torque, device=self.device, **self.options)
         if not _is_builder(self.model):
             model: Any = self.model  # not a builder: anything tumble.simulate takes as a model
-            if "inertia" in parameters:
-                model = RigidBodies.of(parameters["inertia"])
+            if "inertia" in parameters:  # on a GPU, the tensors are set up there
+                model = parameters["inertia"] if self.device == "cuda" else RigidBodies.of(parameters["inertia"])
             elif not any(np.ndim(v) == 2 for v in state.values()):
                 state = {name: np.broadcast_to(v, (m, np.size(v))) for name, v in state.items()}
             return simulate(model, **run, **state)
@@ -204,6 +206,7 @@ class Plan:
             "outcomes": {name: describe(f) for name, f in self.outcomes.items()},
             "statistics": {name: describe(f) for name, f in self.series.items()},
             "trajectories": self.trajectories,
+            **({"device": self.device} if self.device != "cpu" else {}),  # a GPU's results differ in the last bits
         }
 
     def token(self) -> str:
@@ -281,7 +284,7 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
               chunk: int | None, t: np.ndarray, method: str, options: dict[str, Any], torque: TorqueLike | ArrayLike,
               outcomes: dict[str, Callable[[Trajectory], np.ndarray]],
               series: dict[str, Callable[[Trajectory], np.ndarray]], fixed: Mapping[str, ArrayLike],
-              trajectories: bool = False, parallel: int = 1) -> Plan:
+              trajectories: bool = False, parallel: int = 1, device: str = "cpu") -> Plan:
     """Check a sweep's inputs and make its :class:`Plan` (see :func:`tumble.sweeps.sweep`); ``parallel``: the
     chunks the cluster runs at once (for the default chunk)."""
     if not isinstance(dispersions, Mapping):
@@ -312,7 +315,7 @@ def make_plan(model: Any, dispersions: Mapping[str, Dispersion | ArrayLike], *, 
     return Plan(model=model if builder or "inertia" in drawn else as_model(model),
                 dispersions=drawn, states=states, fixed=dict(fixed), seed=int(seed), samples=samples,
                 chunk=chunk, t=np.asarray(t, dtype=np.float64), method=method, options=options, torque=torque,
-                outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories))
+                outcomes=dict(outcomes), series=dict(series), trajectories=bool(trajectories), device=device)
 
 
 def _sizes(dispersions: dict, samples, chunk, n_times: int, parallel: int) -> tuple[int, int]:

@@ -65,7 +65,7 @@ import os
 import shutil
 import warnings
 from collections.abc import Iterable, Iterator
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -304,31 +304,38 @@ class SweepStore:
 
     # -- statistics -------------------------------------------------------------------
 
-    def finalize(self, percentiles: Iterable[float]) -> None:
-        """Write the per-time statistics and the percentiles once every chunk is done (idempotent)."""
+    def finalize(self, percentiles: Iterable[float], device: str = "cpu") -> None:
+        """Write the per-time statistics and the percentiles once every chunk is done (idempotent); with
+        ``device="cuda"``, reduced on the GPU (:mod:`tumble.sweeps.device`: the same percentiles bit for bit,
+        the moments to rounding)."""
         import xarray as xr
 
         plan = self.plan
         p = np.asarray(percentiles, dtype=np.float64)
         data: dict[str, tuple] = {}  # name → (dims, values)
+        gpu: Any = None
+        if device == "cuda":
+            from tumble.sweeps import device as gpu  # imports numba.cuda: only when asked for
         for name in plan.series:
             series = self._array(name)
-            stats: list[np.ndarray] | None = None
-            for lo, hi in plan.chunks:
-                part = moments(series[lo:hi].T)
-                stats = part if stats is None else merge(stats, part)
-            assert stats is not None  # a sweep has at least one chunk
+            if gpu is not None:
+                values = series[:]
+                stats, band = gpu.moments(values), gpu.percentiles(values, p)
+            else:
+                stats, band = self._moments(series), self._percentiles(series, p)
             for stat, value in zip(STATISTICS, summary(stats), strict=True):
                 data[f"{name}_{stat}"] = ("time", value)
-            block = max(1, _BLOCK_WORDS // plan.samples)
-            bands = [_percentiles(series[:, a:a + block], p) for a in range(0, len(plan.t), block)]
-            data[f"{name}_percentiles"] = ("percentile", "time"), np.concatenate(bands, axis=1)
+            data[f"{name}_percentiles"] = ("percentile", "time"), band
         for name in plan.outcomes:
             values = self._array(name)[:]
             dims = tuple(f"{name}_dim{k}" for k in range(values.ndim - 1))
-            with warnings.catch_warnings():  # an outcome no sample reached: NaN percentiles, said by its count
-                warnings.simplefilter("ignore", RuntimeWarning)
-                data[f"{name}_percentiles"] = ("percentile", *dims), np.nanpercentile(values, p, axis=0)
+            if gpu is not None:
+                band = gpu.percentiles(values.reshape(values.shape[0], -1), p, ignore_nan=True)
+                data[f"{name}_percentiles"] = ("percentile", *dims), band.reshape(p.size, *values.shape[1:])
+            else:
+                with warnings.catch_warnings():  # an outcome no sample reached: NaN percentiles, said by its count
+                    warnings.simplefilter("ignore", RuntimeWarning)
+                    data[f"{name}_percentiles"] = ("percentile", *dims), np.nanpercentile(values, p, axis=0)
             data[f"{name}_count"] = dims, np.count_nonzero(~np.isnan(values), axis=0)
         ds = xr.Dataset(data, coords={"percentile": p})
         if self._memory is not None:
@@ -340,6 +347,22 @@ class SweepStore:
                     del group[name]
             ds.to_zarr(self.path, mode="a", consolidated=False, zarr_format=3)
         (self._memory if self._memory is not None else self._group()).attrs[COMPLETE_ATTR] = True
+
+    def _moments(self, series) -> list[np.ndarray]:
+        """``[count, mean, M₂, min, max]`` per output time of the stored ``series`` (S, n), the chunks' moments
+        merged in chunk order."""
+        stats: list[np.ndarray] | None = None
+        for lo, hi in self.plan.chunks:
+            part = moments(series[lo:hi].T)
+            stats = part if stats is None else merge(stats, part)
+        assert stats is not None  # a sweep has at least one chunk
+        return stats
+
+    def _percentiles(self, series, p: np.ndarray) -> np.ndarray:
+        """The percentiles ``p`` per output time of the stored ``series`` (S, n), read in blocks of times."""
+        block = max(1, _BLOCK_WORDS // self.plan.samples)
+        return np.concatenate([_percentiles(series[:, a:a + block], p) for a in range(0, len(self.plan.t), block)],
+                              axis=1)
 
     def dataset(self) -> xarray.Dataset:
         """The store as an :class:`xarray.Dataset`: lazily (Dask arrays) for a store on disk; in memory, the

@@ -1,0 +1,158 @@
+"""A sweep on the GPU (``tumble.sweep(..., device="cuda")``) and its reductions (tumble.sweeps.device), without a GPU.
+
+Under Numba's CUDA simulator (``NUMBA_ENABLE_CUDASIM=1``, read when Numba is imported: in a child process) the
+kernels run as Python, one thread each, with the CPU's rounding. The percentiles are compared with NumPy's bit
+for bit: the device only sorts and gathers, the host interpolates with NumPy's arithmetic. The moments are sums
+in another order than NumPy's pairwise ones (blocks of samples summed in order, merged by Chan et al.'s update),
+so the mean and standard deviation agree to rounding: within 4 ε relative here (sums of 40 numbers of one
+sign and magnitude; each order's error is at most (n − 1) ε of the sum and in practice a few ε); the minimum and
+maximum are exact.
+"""
+
+import os
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble.sweeps import Component, Final, Inertia, Max, Normal, PointingError, sweep
+
+from test_cuda_rigid import _compile_ptx, _nvvm_available
+
+EPS = np.finfo(np.float64).eps
+P = (0.0, 1.0, 5.0, 33.3, 50.0, 95.0, 99.0, 100.0)
+T = np.array([0.0, 0.02, 0.05])
+DT = 0.01
+
+
+def _sweep_arguments():
+    """A sweep of 5 rigid bodies with dispersed inertia and rates, two chunks, series and outcomes."""
+    return dict(dispersions={"inertia": Inertia([1.0, 2.0, 2.4], [0.05, 0.05, 0.05], angle=0.3),
+                             "omega0": Normal([0.2, 1.0, 0.0], 0.1)},
+                samples=5, seed=11, chunk=3, t=T, method="rk4", dt=DT,
+                statistics={"wy": Component("omega", 1)},
+                outcomes={"pointing": Final(PointingError()), "peak": Max(Component("omega", 0))},
+                percentiles=P, workers=0)
+
+
+_CHILD = """
+import os
+import sys
+import numpy as np
+import runpy
+from tumble.sweeps import device, sweep
+sys.path.insert(0, os.path.dirname(sys.argv[1]))  # the tests' folder: this file imports a sibling
+module = runpy.run_path(sys.argv[1])
+tables = np.load(sys.argv[2])
+device.BLOCK = 16  # several blocks of samples, merged
+out = {}
+for name in ("table", "with_nan"):
+    values = tables[name]
+    out[name + "/percentiles"] = device.percentiles(values, module["P"])
+    out[name + "/nanpercentiles"] = device.percentiles(values, module["P"], ignore_nan=True)
+    out[name + "/moments"] = np.array(device.moments(values))
+ds = sweep(module["tumble"].RigidBody(np.diag([1.0, 2.0, 2.5])), device="cuda", **module["_sweep_arguments"]())
+for name in ds.data_vars:
+    out["sweep/" + name] = ds[name].values
+np.savez(sys.argv[3], **out)
+"""
+
+
+@pytest.fixture(scope="module")
+def simulated(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("sweep_device")
+    rng = np.random.default_rng(5)
+    table = rng.uniform(1.0, 2.0, (40, 3))
+    table[7, 0] = table[3, 0]  # a tie
+    with_nan = table.copy()
+    with_nan[[2, 9, 30], 1] = np.nan
+    with_nan[:, 2] = np.nan
+    tables = {"table": table, "with_nan": with_nan}
+    np.savez(tmp / "tables.npz", **tables)
+    env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1")
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(tumble.__file__).parents[1]), env.get("PYTHONPATH", "")])
+    subprocess.run([sys.executable, "-c", _CHILD, __file__, str(tmp / "tables.npz"), str(tmp / "out.npz")], env=env,
+                   check=True, timeout=900)
+    with np.load(tmp / "out.npz") as out:
+        return tables, {key: out[key] for key in out.files}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["table", "with_nan"])
+def test_percentiles_on_the_device_equal_numpys_bit_for_bit(simulated, name):
+    tables, gpu = simulated
+    with warnings.catch_warnings():  # a column of NaN only: NumPy warns, and gives NaN
+        warnings.simplefilter("ignore", RuntimeWarning)
+        nan_percentiles = np.nanpercentile(tables[name], P, axis=0)
+    np.testing.assert_array_equal(gpu[f"{name}/percentiles"], np.percentile(tables[name], P, axis=0))
+    np.testing.assert_array_equal(gpu[f"{name}/nanpercentiles"], nan_percentiles)
+    if name == "with_nan":  # a NaN makes the column's percentiles NaN; ignored, the others' are numbers
+        assert np.isnan(gpu[f"{name}/percentiles"][:, 1:]).all()
+        assert np.isfinite(gpu[f"{name}/nanpercentiles"][:, :2]).all()
+
+
+@pytest.mark.slow
+def test_moments_on_the_device_equal_numpys_to_rounding(simulated):
+    tables, gpu = simulated
+    values = tables["table"]
+    count, mean, m2, low, high = gpu["table/moments"]
+    np.testing.assert_array_equal(count, [40.0] * 3)
+    np.testing.assert_allclose(mean, values.mean(axis=0), rtol=4 * EPS, atol=0)
+    np.testing.assert_allclose(np.sqrt(m2 / count), values.std(axis=0), rtol=4 * EPS, atol=0)
+    np.testing.assert_array_equal(low, values.min(axis=0))
+    np.testing.assert_array_equal(high, values.max(axis=0))
+    _, mean, _, low, high = gpu["with_nan/moments"]  # NaN propagates, as NumPy's min and max say
+    assert np.isnan(mean[1:]).all() and np.isnan(low[1:]).all() and np.isnan(high[1:]).all()
+    assert np.isfinite([mean[0], low[0], high[0]]).all()
+
+
+@pytest.mark.slow
+def test_the_sweep_on_the_device_writes_the_cpus_store(simulated):
+    _, gpu = simulated
+    cpu = sweep(tumble.RigidBody(np.diag([1.0, 2.0, 2.5])), **_sweep_arguments())
+    assert {key.removeprefix("sweep/") for key in gpu if key.startswith("sweep/")} == set(cpu.data_vars)
+    for name in ("inertia", "omega0", "done"):  # the inputs: the same draws
+        np.testing.assert_array_equal(gpu[f"sweep/{name}"], cpu[name].values)
+    # the outcomes: each sample's run, its principal axes found by Jacobi on the device (tests/test_cuda_rigid.py)
+    for name in ("wy", "pointing", "peak", "wy_mean", "wy_min", "wy_max"):
+        np.testing.assert_allclose(gpu[f"sweep/{name}"], cpu[name].values, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(gpu["sweep/wy_std"], cpu["wy_std"].values, rtol=0, atol=1e-14)
+    assert np.ptp(cpu["wy"].values[:, -1]) > 1e-3  # the samples differ
+    # the percentiles are those of the stored values, bit for bit
+    np.testing.assert_array_equal(gpu["sweep/wy_percentiles"], np.percentile(gpu["sweep/wy"], P, axis=0))
+    np.testing.assert_array_equal(gpu["sweep/pointing_percentiles"], np.nanpercentile(gpu["sweep/pointing"], P))
+    np.testing.assert_array_equal(gpu["sweep/pointing_count"], cpu["pointing_count"].values)
+
+
+def test_a_device_sweep_refuses_what_it_cannot_run():
+    body = tumble.RigidBody(np.diag([1.0, 2.0, 2.5]))
+    arguments = dict(dispersions={"omega0": Normal([0.2, 1.0, 0.0], 0.1)}, samples=2, t=T)
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' runs the methods 'rk4', 'cf4'; "
+                                                     r"got method='dop853'$"):
+        sweep(body, device="cuda", **arguments)
+    with pytest.raises(tumble.ValidationError, match=r"^workers: device='cuda' runs the chunks in this process"):
+        sweep(body, device="cuda", method="rk4", dt=DT, workers=2, **arguments)
+    with pytest.raises(tumble.ValidationError, match=r"^device: must be 'cpu' or 'cuda', got 'tpu'$"):
+        sweep(body, device="tpu", method="rk4", dt=DT, **arguments)
+
+
+
+@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.parametrize("name", ["_block_moments_kernel", "_bitonic_kernel", "_count_kernel", "_gather_kernel"])
+def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
+    """What the simulator cannot see: each reduction kernel types and compiles for sm_90, allocating nothing."""
+    from numba import float64, int64
+
+    from tumble.sweeps import device
+
+    a2 = float64[:, ::1]
+    signatures = {"_block_moments_kernel": (a2, int64, float64[:, :, ::1]), "_bitonic_kernel": (a2, int64, int64),
+                  "_count_kernel": (a2, int64[::1]),
+                  "_gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
+    ptx = _compile_ptx(monkeypatch, getattr(device, name), signatures[name])
+    assert ptx.count(".entry") == 1
+    assert "malloc" not in ptx
