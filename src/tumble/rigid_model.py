@@ -56,7 +56,8 @@ def _state_fields() -> tuple[StateField, ...]:
 
 
 @register_jitable
-def to_principal_axes(q0, omega0, q_bp, axes, y0, b, j):
+def to_principal_axes(q0: np.ndarray, omega0: np.ndarray, q_bp: np.ndarray, axes: np.ndarray, y0: np.ndarray,
+                      b: int, j: int) -> None:
     """Member ``b``'s initial state in principal axes from ``q0[b]`` and ``omega0[b]`` in body axes, with
     body ``j``'s ``q_BP`` and ``R_BP``: ``q_NP = q_NB ⊗ q_BP`` into ``y0[b, :4]`` (bit for bit
     :func:`tumble.attitude.multiply`'s product), ``ω_P = R_BPᵀ ω_B`` into ``y0[b, 4:]`` with
@@ -69,7 +70,8 @@ def to_principal_axes(q0, omega0, q_bp, axes, y0, b, j):
 
 
 @register_jitable
-def to_body_axes(states, q_bp, axes, q, omega, k, b, j):
+def to_body_axes(states: np.ndarray, q_bp: np.ndarray, axes: np.ndarray, q: np.ndarray, omega: np.ndarray,
+                 k: int, b: int, j: int) -> None:
     """Member ``b``'s state at output ``k`` from principal to body axes, with body ``j``'s ``q_BP`` and
     ``R_BP``: ``q_NB = q_NP ⊗ q_BP*`` into ``q[k, b]`` (bit for bit :func:`tumble.attitude.multiply`'s
     product), ``ω_B = R_BP ω_P`` into ``omega[k, b]`` with ``ω_i = (R_i0 ω_0 + R_i1 ω_1) + R_i2 ω_2`` in that

@@ -30,8 +30,10 @@ Import this module only when a GPU run is asked for: it imports ``numba.cuda``.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 from numba import cuda
 
 from tumble.integrate._cuda import THREADS_PER_BLOCK, on_device
@@ -76,7 +78,7 @@ def _block_moments_kernel(values, block, parts):
     parts[k, 0, c], parts[k, 1, c], parts[k, 2, c], parts[k, 3, c], parts[k, 4, c] = n, mean, m2, low, high
 
 
-def moments(values) -> list[np.ndarray]:
+def moments(values: ArrayLike) -> list[np.ndarray]:
     """Statistics ``[count, mean, M₂, min, max]`` (each (m,)) of ``values`` (S, m) over the samples (axis 0),
     ``M₂ = Σ (x − x̄)²``, reduced on the GPU (see the module docstring)."""
     table = on_device(values)
@@ -139,7 +141,7 @@ def _gather_kernel(keys, previous, following, out):
     out[1, p, c] = keys[c, following[p, c]]
 
 
-def sorted_columns(values):
+def sorted_columns(values: ArrayLike) -> Any:
     """The columns of ``values`` (S, m) sorted ascending on the GPU, as rows of a device array (m, 2^⌈log₂ S⌉)
     padded with NaN (NaN sorts last)."""
     host = np.asarray(values, dtype=np.float64)
@@ -174,7 +176,7 @@ def _linear_indices(n: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return previous, following, gamma
 
 
-def percentiles(values, p, *, ignore_nan: bool = False) -> np.ndarray:
+def percentiles(values: ArrayLike, p: ArrayLike, *, ignore_nan: bool = False) -> np.ndarray:
     """``numpy.percentile(values, p, axis=0)`` (or ``numpy.nanpercentile`` with ``ignore_nan``) of ``values``
     (S, m), (len(p), m), bit for bit, with the columns sorted on the GPU (see the module docstring). A column
     with a NaN gives NaN (without ``ignore_nan``); a column of NaN only, NaN."""

@@ -84,7 +84,8 @@ def _tumble_dispatchers() -> list[tuple[object, str]]:
     from numba.core.caching import Cache
     from numba.core.dispatcher import Dispatcher
 
-    held = [d for d in gc.get_objects() if isinstance(d, Dispatcher) and d.overloads
+    # type(), not isinstance(): an object the collector holds may be a proxy whose __class__ lookup raises
+    held = [d for d in gc.get_objects() if issubclass(type(d), Dispatcher) and d.overloads
             and isinstance(getattr(d, "_cache", None), Cache)]
     return [(d, source) for d in held if (source := _relative_source(d.py_func.__code__.co_filename)) is not None]
 
@@ -193,8 +194,8 @@ class CompiledCode(WorkerPlugin):
     """A worker plugin carrying compiled code (:class:`Entry`) of a client whose tumble has the content key
     ``stamp`` under Python ``python`` (``py311``); :meth:`setup` installs it on each worker as it joins."""
 
-    def __init__(self, stamp: str, python: str, entries: tuple[Entry, ...]):
+    def __init__(self, stamp: str, python: str, entries: tuple[Entry, ...]) -> None:
         self.stamp, self.python, self.entries = stamp, python, entries
 
-    def setup(self, worker=None) -> None:
+    def setup(self, worker: object = None) -> None:
         install(self)
