@@ -47,8 +47,9 @@ moved_modules(_RENAMED)
 # below, and the names of the front door with the module that defines each. `tumble.analytic.torque_free(...)` and
 # `tumble.simulate(...)` work after a plain `import tumble`; so do the old names of the renamed modules
 # (`tumble.analysis`), with their warning at the line that reads them.
-_LAZY = ("attitude", "dynamics", "integrate", "torques", "analytic", "viz", "scenario", "measure", "ensemble",
-         "variable", "flexible", "slosh", "ins", "spacecraft", "robot", "sweep", "sweeps", "examples", "estimation")
+_LAZY = ("attitude", "dynamics", "integrate", "torques", "model", "rigid_body", "rigid_model", "kernels", "analytic",
+         "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft", "robot", "sweep",
+         "sweeps", "examples", "estimation")
 _DEFINED_IN = {
     "Model": "tumble.simulate",
     "RigidBody": "tumble.rigid_body",
