@@ -120,3 +120,27 @@ def test_import_tumble_imports_nothing_heavy_and_compiles_nothing(tmp_path):
     done = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120,
                           check=True)
     assert done.stdout == "[] 0\n"
+
+
+# the modules `import tumble` must not load: Numba (and its compiler llvmlite) load with the first compiled module
+COMPILER = ("numba", "llvmlite", "scipy")
+
+
+def test_import_tumble_loads_no_compiler_and_every_public_name_resolves():
+    probe = ("import sys, tumble\n"
+             f"print(sorted({{m.partition('.')[0] for m in sys.modules}} & set({COMPILER!r})))\n"
+             "import tumble.simulate\n"  # the import system sets tumble.simulate to the module: it stays the function
+             "from tumble import simulate, RigidBody, Trajectory, attitude, SolverError\n"
+             "print(type(tumble.simulate).__name__, simulate is tumble.simulate, RigidBody.__module__,\n"
+             "      Trajectory.__module__, attitude.__name__, issubclass(SolverError, Exception))\n"
+             "print(sorted(set(tumble.__all__) - set(dir(tumble))), [n for n in tumble.__all__ if not hasattr(tumble, n)])\n"
+             # Numba, first loaded by tumble.simulate, was prepared on its import: tumble's locators come first
+             "print(type(attitude.qmul._cache._impl.locator).__name__.startswith('TumbleContentKeyed'))\n")
+    env = {**os.environ, "PYTHONPATH": SRC}
+    done = subprocess.run([sys.executable, "-W", "ignore::DeprecationWarning", "-c", probe], env=env,
+                          capture_output=True, text=True, timeout=120, check=True)
+    assert done.stdout.splitlines() == [
+        "[]",
+        "function True tumble.rigid_body tumble.trajectory tumble.attitude True",
+        "[] []",
+        "True"]

@@ -15,19 +15,20 @@ sloshing and shape-changing bodies, spacecraft, robot arms, gyroscopes)
 implements :class:`tumble.Model` and runs through it.
 """
 
-from tumble._cache import ensure_writable_cache, use_content_key
+import sys as _sys
+import types as _types
+
+from tumble._cache import prepare_when_numba_loads
 from tumble._moved import deprecated, moved_modules
 
-ensure_writable_cache()  # before any compiled module: a read-only install must still import
-use_content_key()  # and compiled code is stale when any source compiled into it changes (docs/architecture.md)
+# Numba is imported by the first compiled module, not here (it alone costs more than the rest of `import tumble`);
+# its cache must then be writable and keyed on content before any function is decorated (docs/architecture.md).
+prepare_when_numba_loads()
 
-from tumble import attitude, dynamics, integrate, limits, torques  # noqa: E402
+from tumble import limits  # noqa: E402
 from tumble._validate import ValidationError  # noqa: E402
 from tumble._version import __version__  # noqa: E402, F401 (tumble.__version__)
-from tumble.rigid_body import RigidBody  # noqa: E402
-from tumble.integrate import SolverError  # noqa: E402
 from tumble.limits import RigidityWarning  # noqa: E402
-from tumble.simulate import Model, as_model, simulate  # noqa: E402
 from tumble.trajectory import Trajectory, load  # noqa: E402
 from tumble.viz import trajectory as _views  # noqa: E402, F401 - fills Trajectory's figure, page and tables
 
@@ -42,11 +43,20 @@ _RENAMED = {
 moved_modules(_RENAMED)
 
 
-# Submodules loaded on first use (PEP 562), so that `import tumble` stays fast:
-# `tumble.analytic.torque_free(...)` works after a plain `import tumble`; so do the old names of the renamed
-# modules (`tumble.analysis`), with their warning at the line that reads them.
-_LAZY = ("analytic", "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft",
-         "robot", "sweep", "sweeps", "examples", "estimation")
+# Loaded on first use (PEP 562), so that `import tumble` stays light (no Numba, no compiled module): the submodules
+# below, and the names of the front door with the module that defines each. `tumble.analytic.torque_free(...)` and
+# `tumble.simulate(...)` work after a plain `import tumble`; so do the old names of the renamed modules
+# (`tumble.analysis`), with their warning at the line that reads them.
+_LAZY = ("attitude", "dynamics", "integrate", "torques", "model", "rigid_body", "rigid_model", "kernels", "analytic",
+         "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft", "robot", "sweep",
+         "sweeps", "examples", "estimation")
+_DEFINED_IN = {
+    "Model": "tumble.simulate",
+    "RigidBody": "tumble.rigid_body",
+    "SolverError": "tumble.integrate",
+    "as_model": "tumble.simulate",
+    "simulate": "tumble.simulate",
+}
 
 
 def __getattr__(name):
@@ -54,10 +64,32 @@ def __getattr__(name):
 
     if name in _LAZY:
         return importlib.import_module(f"tumble.{name}")
+    if name in _DEFINED_IN:
+        value = getattr(importlib.import_module(_DEFINED_IN[name]), name)
+        globals()[name] = value  # found directly from now on
+        return value
     if f"tumble.{name}" in _RENAMED:
         deprecated(f"tumble.{name}", _RENAMED[f"tumble.{name}"])
         return importlib.import_module(_RENAMED[f"tumble.{name}"])
     raise AttributeError(f"module 'tumble' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
+
+class _Package(_types.ModuleType):
+    """The ``tumble`` module's type: the import system sets a package's attribute to each submodule it loads,
+    which would make ``tumble.simulate`` the module :mod:`tumble.simulate` once anything imports it; the name
+    stays the function, as ``from tumble import simulate`` gives it."""
+
+    def __setattr__(self, name, value):
+        if isinstance(value, _types.ModuleType) and _DEFINED_IN.get(name) == value.__name__:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+_sys.modules[__name__].__class__ = _Package
 
 __all__ = [
     "Model",

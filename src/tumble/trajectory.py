@@ -50,8 +50,6 @@ from . import _netcdf
 from ._files import require_regular, write_atomic
 from ._netcdf import CONVENTIONS, UNIT_Q_TOL
 from ._validate import ValidationError, as_array
-from .attitude import rotate
-from .dynamics import angular_momentum, kinetic_energy
 
 if TYPE_CHECKING:
     import pandas
@@ -387,6 +385,8 @@ class Trajectory:
         """
         if "energy" in self.totals:
             return self.totals["energy"]
+        from .dynamics import kinetic_energy  # compiled: loaded on first use, so that `import tumble` stays light
+
         return _readonly(kinetic_energy(cast(np.ndarray, self.inertia), cast(np.ndarray, self.omega)))
 
     @cached_property
@@ -401,6 +401,8 @@ class Trajectory:
         if self.q is None:
             raise ValidationError(f"momentum_body: this {self.model or 'model'} trajectory has no angular momentum "
                                   "(no single attitude; see its extras and energy)")
+        from .dynamics import angular_momentum
+
         return _readonly(angular_momentum(cast(np.ndarray, self.inertia), cast(np.ndarray, self.omega)))
 
     @cached_property
@@ -409,6 +411,8 @@ class Trajectory:
 
         Constant when no external torque acts.
         """
+        from .attitude import rotate
+
         body = self.momentum_body
         return _readonly(rotate(cast(np.ndarray, self.q), body))
 
