@@ -142,17 +142,17 @@ def test_a_device_sweep_refuses_what_it_cannot_run():
 
 
 @pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
-@pytest.mark.parametrize("name", ["_block_moments_kernel", "_bitonic_kernel", "_count_kernel", "_gather_kernel"])
+@pytest.mark.parametrize("name", ["block_moments_kernel", "bitonic_kernel", "count_kernel", "gather_kernel"])
 def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
     """What the simulator cannot see: each reduction kernel types and compiles for sm_90, allocating nothing."""
     from numba import float64, int64
 
-    from tumble.sweeps import device
+    from tumble.integrate import _cuda_reductions as device
 
     a2 = float64[:, ::1]
-    signatures = {"_block_moments_kernel": (a2, int64, float64[:, :, ::1]), "_bitonic_kernel": (a2, int64, int64),
-                  "_count_kernel": (a2, int64[::1]),
-                  "_gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
+    signatures = {"block_moments_kernel": (a2, int64, float64[:, :, ::1]), "bitonic_kernel": (a2, int64, int64),
+                  "count_kernel": (a2, int64[::1]),
+                  "gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
     ptx = _compile_ptx(monkeypatch, getattr(device, name), signatures[name])
     assert ptx.count(".entry") == 1
     assert "malloc" not in ptx

@@ -17,6 +17,7 @@ implements :class:`tumble.Model` and runs through it.
 
 import sys as _sys
 import types as _types
+import typing as _typing
 
 from tumble._cache import prepare_when_numba_loads
 from tumble._moved import deprecated, moved_modules
@@ -50,6 +51,11 @@ moved_modules(_RENAMED)
 _LAZY = ("attitude", "dynamics", "integrate", "torques", "model", "rigid_body", "rigid_model", "kernels", "analytic",
          "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft", "robot", "sweep",
          "sweeps", "examples", "estimation")
+if _typing.TYPE_CHECKING:  # what a type checker reads (mypy does not run __getattr__); imported on first use
+    from tumble import attitude, dynamics, integrate, torques  # noqa: F401
+    from tumble.integrate import SolverError  # noqa: F401
+    from tumble.rigid_body import RigidBody  # noqa: F401
+    from tumble.simulate import Model, as_model, simulate  # noqa: F401
 _DEFINED_IN = {
     "Model": "tumble.simulate",
     "RigidBody": "tumble.rigid_body",
