@@ -446,6 +446,7 @@ def test_a_sweep_whose_index_and_outcomes_outgrow_memory_is_refused_at_once(tmp_
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.slow  # its Dask workers load or compile the rigid body's dop853 (~4 CPU s in their processes on a cold cache)
 def test_a_sweep_of_more_chunks_than_its_window_holds_a_window_of_tasks_at_a_time(scheduler_file):
     # 40 chunks of one sample, a window of 32 (tumble.sweeps.runner.IN_FLIGHT): each completed chunk submits one
     args = dict(dispersions=DISPERSIONS, samples=40, seed=1, chunk=1, **RUN)
