@@ -73,7 +73,7 @@ def test_methods_are_registered_with_their_torque_support(name):
 
 
 @pytest.mark.parametrize("method", METHODS)
-@pytest.mark.slow  # compiles exact_split for a torque-free body (~2.5 CPU s on a cold cache), which no other fast test runs
+@pytest.mark.slow  # compiles exact_split for a torque-free body, which no other fast test runs (~2.5 CPU s cold)
 def test_torque_free_is_the_exact_motion(method):
     t = np.linspace(0.0, 20.0, 41)
     exact = tumble.simulate(FULL, OMEGA0, q0=Q0, t=t, method="exact")
