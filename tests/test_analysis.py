@@ -50,6 +50,8 @@ def test_a_zero_sample_counts_as_positive(rate, expected):
 
 def test_a_batch_is_refused():
     body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
-    batch = tumble.simulate(body, [[0.0, 1.0, 0.0], [0.0, 2.0, 0.0]], t=np.linspace(0.0, 1.0, 3))
+    t = np.linspace(0.0, 1.0, 3)
+    rates = np.stack([np.zeros((3, 2)), np.tile([1.0, 2.0], (3, 1)), np.zeros((3, 2))], axis=-1)  # (n, 2 bodies, 3)
+    batch = tumble.Trajectory(t=t, q=np.tile([1.0, 0.0, 0.0, 0.0], (3, 2, 1)), omega=rates, inertia=body.inertia)
     with pytest.raises(tumble.ValidationError, match="trajectory: must hold a single body"):
         flip_times(batch, body)

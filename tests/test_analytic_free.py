@@ -304,6 +304,22 @@ def test_exact_matches_dop853(case, rotated, random_rotation):
     assert_motion_close(exact, numeric, TOL_VS_DOP853)
 
 
+def test_a_lone_body_and_a_batch_share_one_compiled_exact_task():
+    # a lone short run calls the task itself, a batch calls it from its parallel loop with an int64 task,
+    # as the lone run does (docs/architecture.md, "One signature per path"): one compiled copy per model type
+    from numba import typeof
+
+    from tumble.integrate import _exact
+
+    body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+    t = np.linspace(0.0, 1.0, 3)
+    lone = tumble.simulate(body, [0.1, 1.0, 0.0], t=t, method="exact")
+    batch = tumble.simulate(body, [[0.3, 1.0, 0.0], [0.1, 1.0, 0.0]], t=t, method="exact")
+    assert np.array_equal(batch.q[:, 1], lone.q) and np.array_equal(batch.omega[:, 1], lone.omega)
+    model = typeof(tumble.as_model(body).compile(None, 0.0))
+    assert [signature[0] for signature in _exact.exact_task.signatures].count(model) == 1
+
+
 def test_closest_to_the_intermediate_axis_against_dop853():
     body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
     omega0 = (1e-3, 1.0, 1e-3)

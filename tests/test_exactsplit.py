@@ -73,6 +73,7 @@ def test_methods_are_registered_with_their_torque_support(name):
 
 
 @pytest.mark.parametrize("method", METHODS)
+@pytest.mark.slow  # compiles exact_split for a torque-free body, which no other fast test runs (~2.5 CPU s cold)
 def test_torque_free_is_the_exact_motion(method):
     t = np.linspace(0.0, 20.0, 41)
     exact = tumble.simulate(FULL, OMEGA0, q0=Q0, t=t, method="exact")
@@ -125,6 +126,7 @@ def test_heavy_top_energy_error_bounded_and_vertical_momentum_kept(method, steps
 
 @pytest.mark.parametrize("shared", [True, False], ids=["one body", "a body per member"])
 @pytest.mark.parametrize("method", METHODS)
+@pytest.mark.slow  # compiles the parallel batch driver of exact_split under gravity (~6 CPU s on a cold cache)
 def test_batch_across_blocks_equals_single_runs(method, shared):
     # LANES + 3 bodies: a full block and a short one, in parallel.
     n = _fixed.LANES + 3

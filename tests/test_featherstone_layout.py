@@ -50,6 +50,7 @@ def test_the_scratch_blocks_an_algorithm_holds_at_once_are_apart_and_inside_the_
     assert min(owners) == 0 and max(owners) < L.WIDTH
 
 
+@pytest.mark.slow  # compiles the robot's kinematics (~2 CPU s on a cold cache)
 def test_a_tree_holds_under_each_name_what_the_name_says():
     tree = robot.RobotTree.from_urdf(tumble.examples.path("panda.urdf"))
     P = tree.params

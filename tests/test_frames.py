@@ -53,6 +53,7 @@ def test_frame_equations_are_euler_equations_seen_from_a_turning_frame():
                                dynamics.omega_dot_principal([i_t, i_t, i_s], omega), rtol=1e-15, atol=1e-15)
 
 
+@pytest.mark.slow  # compiles dop853 for the axisymmetric frame model (~3 CPU s on a cold cache)
 def test_torque_free_equals_the_closed_form_over_1000_spin_periods():
     # The reference is the body-frame closed form (method "exact", rounding-level at any time); dop853 in the
     # body frame itself drifts by ~1e-11 over 6283 rad of spin (the rounding of ~3e4 steps), so it would not
@@ -67,6 +68,7 @@ def test_torque_free_equals_the_closed_form_over_1000_spin_periods():
 
 
 @pytest.mark.parametrize("frame_spin", [1.0, 0.37, -2.0])
+@pytest.mark.slow  # compiles dop853 for the axisymmetric frame model (~3 CPU s on a cold cache)
 def test_any_frame_rate_about_the_axis_gives_the_same_motion(frame_spin):
     # κ = 1: the body's own axes (ψ stays 0); any other κ only moves the split between q_NF and ψ.
     t = np.linspace(0.0, 20 * _PERIOD, 5)
@@ -92,6 +94,7 @@ def _top_runs(t, rtol):
     return frame, (body, inputs)
 
 
+@pytest.mark.slow  # compiles dop853 for the axisymmetric frame model under a torque (~3 CPU s on a cold cache)
 def test_heavy_top_equals_the_body_frame_simulation_over_1000_spin_periods():
     period = 2.0 * np.pi / _TOP.spin
     t = np.linspace(0.0, 1000 * period, 11)
@@ -107,6 +110,7 @@ def test_heavy_top_equals_the_body_frame_simulation_over_1000_spin_periods():
     assert np.abs(motion.u - _TOP.u(t)).max() < 1e-10
 
 
+@pytest.mark.slow  # compiles dop853 for the axisymmetric frame model under a torque (~5 CPU s on a cold cache)
 def test_heavy_top_nutation_bounds_are_the_exact_ones():
     # 2000 samples per nutation period: the parabola through three samples locates a turning point to
     # (2λh)⁴/48 (u₂ − u₁) ≈ 1e-16 (docs/heavy_top.md), far below the 1e-10 asked

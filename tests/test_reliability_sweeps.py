@@ -417,6 +417,7 @@ def _done(store):
 # -- 9. the default chunk shares a small sweep between the workers ---------------------------------
 
 
+@pytest.mark.slow  # a sweep on a Dask worker process, compiling rk4's batch on a cold cache (~12 CPU s there)
 def test_a_small_sweeps_default_chunk_gives_every_worker_a_chunk_and_a_resume_keeps_it(scheduler_file, tmp_path):
     store = tmp_path / "mc.zarr"
     args = dict(dispersions=DISPERSIONS, samples=N, seed=1, **RUN)
@@ -446,6 +447,7 @@ def test_a_sweep_whose_index_and_outcomes_outgrow_memory_is_refused_at_once(tmp_
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.slow  # a sweep on a Dask worker process, which loads or compiles rk4's batch (~4 CPU s there, cold)
 def test_a_sweep_of_more_chunks_than_its_window_holds_a_window_of_tasks_at_a_time(scheduler_file):
     # 40 chunks of one sample, a window of 32 (tumble.sweeps.runner.IN_FLIGHT): each completed chunk submits one
     args = dict(dispersions=DISPERSIONS, samples=40, seed=1, chunk=1, **RUN)

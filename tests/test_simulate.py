@@ -262,6 +262,22 @@ def test_batch_equals_single_runs(method, torque, random_batch):
         assert np.abs(state(batch)[:, k] - state(single)).max() <= TOL_BATCH
 
 
+def test_a_lone_body_and_a_batch_share_one_compiled_dop853_path():
+    # the path of one body gets the same argument types from a lone run as from the parallel batch
+    # (docs/architecture.md, "One signature per path"): one compiled copy per model type, not two
+    from numba import typeof
+
+    from tumble.integrate import _dop853
+
+    body = tumble.RigidBody(np.diag([1.0, 2.0, 3.0]))
+    t = np.linspace(0.0, 1.0, 3)
+    lone = tumble.simulate(body, [0.1, 1.0, 0.0], t=t)
+    batch = tumble.simulate(body, [[0.3, 1.0, 0.0], [0.1, 1.0, 0.0]], t=t)
+    assert np.array_equal(batch.q[:, 1], lone.q) and np.array_equal(batch.omega[:, 1], lone.omega)
+    model = typeof(tumble.as_model(body).compile(None, 0.0))
+    assert [signature[0] for signature in _dop853.dop853_path.signatures].count(model) == 1
+
+
 @pytest.mark.slow  # compiles the parallel rk4 batch driver (~7 CPU s on a cold cache)
 @pytest.mark.parametrize("extra", [1, 3], ids=["lone body in the last block", "partial last block"])
 @pytest.mark.parametrize("torque", ["torque-free", "ConstantInertial + Tabulated"])

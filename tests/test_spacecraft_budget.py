@@ -43,6 +43,7 @@ def test_gravity_gradient_builds_pitch_momentum_at_exactly_3_n2_jxz(three_hours)
     assert np.abs(h[:, [0, 2]]).max() < 1e-12 * expected[-1]
 
 
+@pytest.mark.slow  # simulates a spacecraft: compiles it (~37 CPU s on a cold cache)
 def test_every_source_is_within_a_factor_2_of_smads_estimate(three_hours):
     orbit, env, budget = three_hours
     estimates = smad_estimates(SmallSat(), orbit, float(np.mean(env.density)))
@@ -56,6 +57,7 @@ def test_every_source_is_within_a_factor_2_of_smads_estimate(three_hours):
         assert 1.0 / SMAD_FACTOR < momentum / expected < SMAD_FACTOR, source
 
 
+@pytest.mark.slow  # simulates a spacecraft: compiles it (~37 CPU s on a cold cache)
 def test_the_wheels_share_the_momentum_exactly(three_hours):
     from tumble.spacecraft import pyramid_wheels
 
@@ -86,6 +88,7 @@ def test_demo_budget_runs_from_the_command_line(tmp_path):
     assert "SMAD" in result.stdout and "Monte Carlo" in result.stdout
 
 
+@pytest.mark.slow  # simulates a spacecraft: compiles it (~38 CPU s on a cold cache)
 def test_demo_budget_reduced(tmp_path):
     summary = demo_budget(tmp_path, hours=1.0, samples=2)
     assert summary["hours"] == pytest.approx(1.0, abs=10 / 3600)

@@ -43,7 +43,7 @@ from numba.extending import overload, register_jitable
 from numpy.typing import ArrayLike
 
 from tumble import _callback, _gravity, _quat
-from tumble._validate import ValidationError, as_array, increasing_times, require_positive
+from tumble._validate import ValidationError, as_array, increasing_times, readonly, require_positive
 from tumble.attitude import rotate_inverse
 from tumble._inertia import principal_axes
 
@@ -270,7 +270,7 @@ class PythonTorque(TorqueModel):
                                            returns="3 finite numbers (body torque, N·m)")
 
     def _params(self, axes):
-        q_bp = np.array(_quat.qfrom_matrix(axes))
+        q_bp = np.array(_quat.qfrom_matrix(readonly(axes)))  # one compiled copy, for a body's or a batch's axes
         return _PYTHON, np.concatenate([[self.callback.slot], axes.ravel(), q_bp])
 
     def __repr__(self):

@@ -50,7 +50,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.signal import lfilter
 
 from tumble._validate import ValidationError, as_array, require_non_negative
 from tumble.ins.increments import Increments, from_trajectory
@@ -120,6 +119,8 @@ class SensorErrors:
         if self.white_noise:
             out += self.white_noise * math.sqrt(dt) * rng.standard_normal((K, 3))
         if self.bias_instability:
+            from scipy.signal import lfilter  # here: scipy.signal imports scipy.stats (~0.8 CPU s), not for import
+
             variance = self.bias_instability**2 * math.log(FLICKER_SPACING) / math.pi
             for T in self.correlation_times():
                 phi = math.exp(-dt / T)

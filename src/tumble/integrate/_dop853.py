@@ -154,9 +154,11 @@ def initial_step(model, b, t, y, f0, rtol, atol, span):
 
 @njit(cache=True)
 def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
-    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[k]`` = state at ``t_out[k]``.
+    """Advance body ``b``'s state ``y`` (in place) through ``t_out``; ``out[k, b]`` = state at ``t_out[k]``.
 
-    ``tab`` is :func:`tableau`.
+    ``tab`` is :func:`tableau`. ``out`` is the whole batch's output (times × bodies × state), so that a lone
+    body and a member of a parallel batch reach this function with the same argument types, and it is
+    compiled once for both.
     ``stats`` = [steps, rejected steps, evaluations, status, next step size]:
     the step size is carried in and out, so a run split in chunks continues
     exactly as one run would (0 on entry means "choose a starting step"). On
@@ -167,7 +169,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
     n = state_size(model)
     K = np.empty((_STAGES + 1, n))
     y_new, tmp = np.empty(n), np.empty(n)
-    store(out[0], y)
+    store(out[0, b], y)
     t = t_out[0]
     rhs(model, b, t, y, K[0])
     stats[2] += 1
@@ -211,7 +213,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
             store(K[0], K[_STAGES])  # by loops: a row assignment's shape check compiles a message formatter
             rejected_last = False
             if landing:
-                store(out[k], y)
+                store(out[k, b], y)
                 k += 1
         else:
             stats[1] += 1
@@ -242,7 +244,7 @@ def dop853_batch(model, y, t_out, rtol, atol, max_steps, tab, out, stats):
     for i in prange(y.shape[0]):
         b = np.int64(i)  # prange indices may be unsigned
         if stats[b, 3] == OK:
-            dop853_path(model, b, y[b], t_out, rtol, atol, max_steps, tab, out[:, b, :], stats[b])
+            dop853_path(model, b, y[b], t_out, rtol, atol, max_steps, tab, out, stats[b])
 
 
 class Adaptive(Driver):
@@ -262,7 +264,7 @@ class Adaptive(Driver):
         t = t[lo:hi + 1]
         if serial:
             for b in range(y.shape[0]):
-                dop853_path(model, b, y[b], t, rtol, atol, max_steps, tab, out[:, b], stats[b])
+                dop853_path(model, b, y[b], t, rtol, atol, max_steps, tab, out, stats[b])
         else:
             dop853_batch(model, y, t, rtol, atol, max_steps, tab, out, stats)
 

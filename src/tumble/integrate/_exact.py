@@ -48,7 +48,7 @@ def exact_batch(model, y, t, out):
     """
     n_chunks = (t.shape[0] + CHUNK - 1) // CHUNK
     for task in prange(y.shape[0] * n_chunks):
-        exact_task(model, y, t, out, task)
+        exact_task(model, y, t, out, np.int64(task))  # prange indices may be unsigned: one signature with run's
 
 
 def run(model, y, t, out):
