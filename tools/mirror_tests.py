@@ -72,12 +72,13 @@ KIND_FOLDERS = ("spacecraft", "robot")
 #: (file after the move, text before, text after): the fixes the general rules do not make.
 PATCHES = (
     # the Dask workers and the killed client import this module and helpers.py: both folders on their path
-    ("tests/sweeps/test_sweep_dask.py",
-     'str(root / "src"), str(Path(__file__).parent)])',
-     'str(root / "src"), str(Path(__file__).parent), str(Path(__file__).parents[1])])'),
+    ("tests/sweeps/test_sweep_dask.py", "TIMEOUT = 60  # s:",
+     "TESTS = [str(Path(__file__).parent), str(Path(__file__).parents[1])]  # this module's folder; helpers.py's\n"
+     "TIMEOUT = 60  # s:"),
+    ("tests/sweeps/test_sweep_dask.py", 'str(root / "src"), str(Path(__file__).parent)])',
+     'str(root / "src"), *TESTS])'),
     ("tests/sweeps/test_sweep_dask.py", "sys.path.insert(0, {tests!r})", "sys.path[:0] = {tests!r}"),
-    ("tests/sweeps/test_sweep_dask.py", "tests=str(Path(__file__).parent),",
-     "tests=[str(Path(__file__).parent), str(Path(__file__).parents[1])],"),
+    ("tests/sweeps/test_sweep_dask.py", "tests=str(Path(__file__).parent),", "tests=TESTS,"),
     # the benchmarks that reuse a test module's data
     ("benchmarks/bench_estimation.py",
      'sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))\n',
