@@ -42,7 +42,7 @@ from _timing import best_of, cpu_times, machine
 from tumble import _free_flow, attitude
 from tumble.analytic._free import free_parameters, torque_free
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "analytic"))
 from test_analytic_free import taylor_reference  # noqa: E402  (the 80-bit reference of the tests)
 
 EPS = np.finfo(np.float64).eps

@@ -1,4 +1,4 @@
-"""Reference numbers for tests/test_robot.py and tests/test_robot_urdf.py, computed once with Pinocchio 4.1.0.
+"""Reference numbers for tests/robot/test_robot.py and tests/robot/test_robot_urdf.py, computed once with Pinocchio 4.1.0.
 
 Run from the repository root: ``python benchmarks/robot_pinocchio_reference.py`` (NumPy 2.4.6).
 
@@ -58,7 +58,7 @@ report(puma, [
     ([0.2, -0.4, 0.6, -0.8, 1.0, -1.2], [1.0, 0.5, -0.5, 0.8, -0.3, 1.2], [0.3, -0.6, 0.9, -1.2, 1.5, -1.8]),
 ])
 
-sys.path.insert(0, "tests")
+sys.path.insert(0, "tests/robot")
 from test_robot_urdf import PEER_STATE, PEER_URDF  # noqa: E402
 
 arm = pin.buildModelFromXML(PEER_URDF)

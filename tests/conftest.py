@@ -10,11 +10,11 @@ import pytest
 os.environ.setdefault("TUMBLE_QUIET", "1")
 
 
-#: Test modules whose tests compile the same model kind, by the start of their path: the spacecraft's assembled
+#: Test folders whose modules compile the same model kind: the spacecraft's assembled
 #: right-hand side and sample are compiled into each spacecraft driver and not kept on disk apart from them
 #: (docs/architecture.md, "The test suite and what it compiles"), so each process that compiles a spacecraft
 #: driver compiles them again (~50 CPU s); the robot's kernels are shared by its modules.
-KINDS = {"spacecraft": "tests/test_spacecraft_", "robot": "tests/test_robot"}
+KINDS = ("tests/spacecraft/", "tests/robot/")
 
 
 def pytest_xdist_make_scheduler(config, log):
@@ -27,7 +27,7 @@ def pytest_xdist_make_scheduler(config, log):
     class KindScheduling(LoadFileScheduling):
         def _split_scope(self, nodeid):
             module = super()._split_scope(nodeid)
-            return next((kind for kind, start in KINDS.items() if module.startswith(start)), module)
+            return next((kind for kind in KINDS if module.startswith(kind)), module)
 
     return KindScheduling(config, log)
 

@@ -112,3 +112,30 @@ def numba_cache_files() -> list[str]:
     from numba.core import config
 
     return sorted(path.name for path in Path(config.CACHE_DIR).rglob("*.nb[ic]"))
+
+
+def nvvm_available():
+    """Whether NVIDIA's NVVM (a CUDA toolkit) is here to compile kernels to PTX (never under the simulator)."""
+    from numba.core import config
+
+    if config.ENABLE_CUDASIM:
+        return False
+    from numba.cuda.cudadrv import nvvm
+
+    return nvvm.is_available()
+
+
+def compile_ptx(monkeypatch, function, signature):
+    """``function`` (a kernel or its Python function) compiled to PTX for sm_90: numba.cuda
+    compiles the @njit callees for the current device, so without one its compute capability is named."""
+    from types import SimpleNamespace
+
+    import pytest
+    from numba import cuda
+    from numba.cuda import dispatcher
+
+    if not hasattr(dispatcher, "get_current_device"):
+        pytest.skip("this numba.cuda does not look up the device where these tests expect")
+    monkeypatch.setattr(dispatcher, "get_current_device", lambda: SimpleNamespace(compute_capability=(9, 0)))
+    ptx, _ = cuda.compile_ptx(getattr(function, "py_func", function), signature, cc=(9, 0))
+    return ptx

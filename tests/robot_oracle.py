@@ -1,6 +1,6 @@
 """Pinocchio as the live oracle of tumble.robot: one URDF read by both, and the maps between their coordinates.
 
-Used by tests/test_robot_tree.py and tests/test_robot_zoo.py. Tumble's coordinates: a floating base's
+Used by tests/robot/test_robot_tree.py and tests/robot/test_robot_zoo.py. Tumble's coordinates: a floating base's
 ``[r, quat wxyz]`` and ``(ω, v)`` first, then one coordinate per independent 1-dof joint. Pinocchio's: the
 free flyer's ``[r, quat xyzw]`` and ``(v, ω)``, and a continuous joint as ``(cos θ, sin θ)`` in ``q`` (one
 coordinate in ``v``). Joints are matched by name, so the two orders of the joints may differ.

@@ -9,7 +9,7 @@ Rules (docs/README.md, "Examples that run"):
   shell lines (pip, pytest, scripts of the repository) are not run, but for ``mkdir DIR``.
 * A ``toml`` block whose first line is ``# NAME.toml`` is a file the page's commands read: it is written
   there before the next block runs. (``# examples/NAME.toml`` shows an installed example file, which
-  ``tumble examples copy examples`` puts there; tests/test_scenario*.py check that the two agree.)
+  ``tumble examples copy examples`` puts there; tests/scenario/test_scenario*.py check that the two agree.)
 * A Python block that starts a local Dask cluster (``tumble.sweep(...)``, ``sweep_scenario(...)`` or
   ``local_cluster(...)`` without ``workers=0``) must guard its entry point with ``if __name__ ==
   "__main__":``, and runs as a script in a new Python process (``python block.py``): the cluster's

@@ -28,7 +28,7 @@ ROBOTS = tumble.examples.directory() / "robots"
 
 
 def _swimmer(t):
-    """Two 1 kg masses at ±r(t) going once round a circle in the x–y plane of a base body (tests/test_variable.py)."""
+    """Two 1 kg masses at ±r(t) going once round a circle in the x–y plane of a base body (tests/variable/test_variable.py)."""
     u = np.clip(t / 2.0, 0.0, 1.0)
     s = 2.0 * np.pi * u**3 * (10.0 - 15.0 * u + 6.0 * u * u)
     s_dot = 2.0 * np.pi * 30.0 * u * u * (1.0 - u) ** 2 / 2.0
@@ -102,11 +102,11 @@ KEPT["RigidBody"] = {"energy", "momentum_inertial"}
 CASES["Gyroscope"][4].update(exact_split2=1e-9, exact_split4=1e-12)
 # A robot arm (the planar two-link arm of examples/robots) falling under gravity: its invariant is the
 # power balance E − W, the total energy less the work of the joint torques. Measured: dop853 2.2e-13;
-# rk4 1.9e-10, its truncation error at dt = 1 ms (fourth order: tests/test_robot_simulate.py).
+# rk4 1.9e-10, its truncation error at dt = 1 ms (fourth order: tests/robot/test_robot_simulate.py).
 CASES["SerialChain"] = (lambda: robot.load(ROBOTS / "planar_2link.toml"), dict(q0=[0.3, -0.5], qd0=[0.1, 0.2]),
                         1.0, 1e-3, {"dop853": 1e-11, "rk4": 1e-9})
 KEPT["SerialChain"] = {"energy_minus_work"}
-# A spacecraft with three reaction wheels under Schaub's MRP feedback (the craft of tests/test_spacecraft_control.py,
+# A spacecraft with three reaction wheels under Schaub's MRP feedback (the craft of tests/spacecraft/test_spacecraft_control.py,
 # so the compiled type is shared), started off target and with spinning wheels: the law's torque is internal, so
 # the spacecraft keeps its inertial momentum, and its energy changes by the work of the wheel motors only (the
 # wheels spin up: E grows from 26 J to 1.4 kJ, so E − W is measured against its 26 J start). Measured: dop853

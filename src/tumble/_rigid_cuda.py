@@ -24,7 +24,7 @@ asked, the results back:
   (:func:`tumble._quat.qfrom_matrix`). Eigenvectors are defined up to sign
   and, for equal moments, up to a rotation in their plane: the canonical signs
   make the axes those of LAPACK's to rounding where the moments differ, and the
-  motion in body axes does not depend on the choice (tests/test_cuda_rigid.py
+  motion in body axes does not depend on the choice (tests/integrate/test_cuda_rigid.py
   compares both). A tensor that breaks a rule is decomposed again on the CPU,
   which raises the CPU's error naming the member.
 * **conversions** in and out, by the CPU's own per-member functions

@@ -58,7 +58,7 @@ __all__ = ["MAX_STEPS", "MAX_STEPS_LIMIT", "METHODS", "Diverged", "Driver", "Met
            "SolverError", "check_method", "method", "solve"]
 
 #: Every method by name, as the method files declare them (their ``METHODS``), in the order of the table above.
-#: Adding a method is its file and its entry here (and its row in the order test, tests/test_methods.py).
+#: Adding a method is its file and its entry here (and its row in the order test, tests/integrate/test_methods.py).
 METHODS: dict[str, Method] = {m.name: m for module in (_rk4, _dop853, _liegroup, _splitting, _exactsplit, _exact)
                               for m in module.METHODS}
 

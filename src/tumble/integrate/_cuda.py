@@ -48,7 +48,7 @@ bitwise equal: the simulator runs the kernels' Python, and the protocol
 kernel's per-member ``advance`` is the CPU's compiled function
 (:func:`_advance`), so there it checks the launch, the landing, the
 workspace rows and the transfers; that the same kernel compiles for a GPU is
-checked on its PTX (``tests/test_cuda_models.py``).
+checked on its PTX (``tests/integrate/test_cuda_models.py``).
 
 Launch: :data:`THREADS_PER_BLOCK` threads per block, ``⌈N/128⌉`` blocks. Import
 this module only when a GPU run is asked for: it imports ``numba.cuda``.

@@ -21,7 +21,7 @@ prescribes. Valid from 1900-01-01 to 2030-01-01.
 
 :func:`igrf_field_itrs` is the compiled synthesis (``nₘₐₓ = 13``) in Cartesian
 ITRS axes and tesla; :func:`igrf_field` is its NumPy face. They are checked
-against ``ppigrf``'s own values (``tests/test_spacecraft_environment_table.py``).
+against ``ppigrf``'s own values (``tests/spacecraft/test_spacecraft_environment_table.py``).
 """
 
 from __future__ import annotations

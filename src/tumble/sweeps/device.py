@@ -13,7 +13,7 @@ reduces its series and outcomes here when it writes the store
   result does not depend on the launch. The minimum and maximum are exact; the
   mean and ``M₂`` differ from NumPy's (pairwise summation) by rounding only:
   a few units in the last place times ``log₂ S`` (and a GPU fuses
-  multiply–adds), which ``tests/test_sweep_device.py`` bounds.
+  multiply–adds), which ``tests/sweeps/test_sweep_device.py`` bounds.
 * :func:`percentiles`: exact, bit for bit those of ``numpy.percentile`` (or,
   with ``ignore_nan``, ``numpy.nanpercentile``; method ``"linear"``). Each
   column is sorted on the device (a bitonic sorting network over the column

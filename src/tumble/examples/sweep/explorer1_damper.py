@@ -2,7 +2,7 @@
 
 A prolate hub (moments 1, 1, 0.4 kg m²; spin axis z the minor axis) spins at
 2 rad/s with a spherical viscous damper tuned for that spin (the scaled
-Explorer 1 of tests/test_spacecraft_passive_damper.py: sphere J = 0.02 kg m²,
+Explorer 1 of tests/spacecraft/test_spacecraft_passive_damper.py: sphere J = 0.02 kg m²,
 c = J Ω I_s / I_t, energy-sink time constant 87 s). Energy dissipation at
 fixed angular momentum drives the spin into a flat spin about a transverse
 (major) axis. Each sample disperses

@@ -89,7 +89,7 @@ def test_torque_free_is_the_exact_motion(method):
     ("exact_split4", "damping", [0.4, 0.2, 0.1, 0.05]),
 ])
 def test_measured_order_under_each_torque(method, torque, dts):
-    # the declared order (tests/test_methods.py measures every method's on an exact motion)
+    # the declared order (tests/integrate/test_methods.py measures every method's on an exact motion)
     order = integrate.METHODS[method].order
     t = np.array([0.0, 4.0])
     torque = TORQUES[torque]

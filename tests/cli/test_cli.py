@@ -15,7 +15,7 @@ from tumble.cli import app
 from tumble.scenario import load_scenario, run_scenario
 
 EXAMPLES = tumble.examples.directory()
-SRC = Path(__file__).resolve().parents[1] / "src"
+SRC = Path(__file__).resolve().parents[2] / "src"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 runner = CliRunner()
@@ -154,7 +154,7 @@ def test_demo_polhode_writes_the_figure(tmp_path):
     result = invoke("demo", "polhode", "-o", tmp_path)
     assert result.exit_code == 0, result.output
     assert png.read_bytes()[:8] == PNG_MAGIC
-    assert page.read_text()[:15] == "<!DOCTYPE html>"  # the viewer's page (tests/test_viewer*.py check its content)
+    assert page.read_text()[:15] == "<!DOCTYPE html>"  # the viewer's page (tests/viz/test_viewer*.py check its content)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["polhode.html", "polhode.png"]  # no temporary files left
     handle = tumble.RigidBody.t_handle()
     report = stability(handle, handle.axes @ np.array([1.0, 10.0, 1.0]))

@@ -25,7 +25,7 @@ from helpers import assert_same_run
 # Every test here compiles the integrators of several model kinds on a cold Numba cache (tens of CPU s).
 pytestmark = pytest.mark.slow
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = tumble.examples.directory()
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

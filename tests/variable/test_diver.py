@@ -269,7 +269,7 @@ def test_bad_joint_angles_are_refused():
 
 
 def test_documented_example_prints_what_it_claims(capsys):
-    text = (Path(__file__).resolve().parents[1] / "docs" / "diver.md").read_text(encoding="utf-8")
+    text = (Path(__file__).resolve().parents[2] / "docs" / "diver.md").read_text(encoding="utf-8")
     start = text.index("```python") + len("```python")
     exec(compile(text[start:text.index("```", start)], "diver.md", "exec"), {})  # the project's own text
     somersaults, twists, drift = (float(x) for x in capsys.readouterr().out.split())

@@ -223,7 +223,7 @@ def test_malformed_csv_names_line_and_column(tmp_path, text, message):
 
 def test_docs_example(capsys, monkeypatch):
     """The CSV example of docs/ins.md runs, and its errors are the coning laws times 2 s (within 5 %)."""
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     text = (root / "docs" / "ins.md").read_text(encoding="utf-8")
     start = text.index("```python", text.index("**Input from a file.**")) + len("```python")
     monkeypatch.chdir(root)

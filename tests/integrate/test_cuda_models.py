@@ -12,15 +12,14 @@ compile it for sm_90 with NVVM, where the CUDA toolkit is installed.
 """
 
 import os
-import runpy
 import subprocess
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from numba.core import config
+
+from helpers import compile_ptx, nvvm_available
 
 import tumble
 from tumble import torques
@@ -138,29 +137,16 @@ def test_methods_without_a_device_kernel_are_refused():
         tumble.simulate(tumble.RigidBody(INERTIA), OMEGA0[0], t=T, method="splitting2", dt=DT, device="cuda")
 
 
-def _nvvm_available():
-    if config.ENABLE_CUDASIM:
-        return False
-    from numba.cuda.cudadrv import nvvm
-
-    return nvvm.is_available()
-
-
 @pytest.mark.slow
-@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "spacecraft: wheels, MRP feedback, rk4",
                                   "spacecraft: wheels, sampled PD, cf4", "rigid, one body each, cf4"])
 def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""
-    from numba import cuda, typeof
-    from numba.cuda import dispatcher
+    from numba import typeof
 
     from tumble.integrate import _cuda
 
-    # numba.cuda compiles the @njit callees for the current device; without one, name its compute capability
-    if not hasattr(dispatcher, "get_current_device"):
-        pytest.skip("this numba.cuda does not look up the device where these tests expect")
-    monkeypatch.setattr(dispatcher, "get_current_device", lambda: SimpleNamespace(compute_capability=(9, 0)))
     model, method, torque, state = cases()[name]
     kernel = as_model(model).compile(torque, 0.0)
     scheme = _cuda.SCHEMES[method]
@@ -168,7 +154,7 @@ def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     work = tuple(np.zeros((2, *w.shape)) for w in _cuda._workspace_of_one(scheme, kernel, np.zeros(n)))
     signature = tuple(typeof(a) for a in (scheme, kernel, np.zeros((2, n)), T, np.zeros(3, np.int64), T[1:],
                                           np.zeros((4, 2, n)), work))
-    ptx, _ = cuda.compile_ptx(_cuda._protocol_kernel.py_func, signature, cc=(9, 0))
+    ptx = compile_ptx(monkeypatch, _cuda._protocol_kernel, signature)
     assert ptx.count(".entry") == 1
     assert "fma.rn.f64" in ptx  # NVVM's contraction: the GPU's results differ from the CPU's in the last bits
 

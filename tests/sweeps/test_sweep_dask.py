@@ -41,6 +41,7 @@ SWEEP = dict(dispersions={"omega0": Normal([0.0, 0.0, 1.0], 0.05), "q0": Uniform
 CHUNKS = 8
 SRC = str(Path(tumble.__file__).parents[1])
 ENV = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", ""), "NUMBA_NUM_THREADS": "1"}
+TESTS = [str(Path(__file__).parent), str(Path(__file__).parents[1])]  # this module's folder; helpers.py's
 TIMEOUT = 60  # s: the longest a step of these tests may take before it is counted as hung
 
 
@@ -135,7 +136,7 @@ def elsewhere(reference, tmp_path_factory):
     scheduler's file and the copy's root."""
     root = tmp_path_factory.mktemp("elsewhere")
     shutil.copytree(Path(tumble.__file__).parent, root / "src" / "tumble", ignore=shutil.ignore_patterns("__pycache__"))
-    env = {**ENV, "PYTHONPATH": os.pathsep.join([str(root / "src"), str(Path(__file__).parent)])}
+    env = {**ENV, "PYTHONPATH": os.pathsep.join([str(root / "src"), *TESTS])}
     workers = [(name, 1, {"NUMBA_CACHE_DIR": str(root / f"cache-{name}")}) for name in ("w1", "w2")]
     with dask_processes(root / "scheduler.json", workers, env, TIMEOUT) as path:
         yield path, root
@@ -159,7 +160,7 @@ def test_workers_elsewhere_with_empty_caches_load_the_clients_compiled_code(else
 CLIENT = textwrap.dedent("""
     import sys
     import distributed, numpy as np, tumble
-    sys.path.insert(0, {tests!r})
+    sys.path[:0] = {tests!r}
     from test_sweep_dask import BODY, SWEEP
     if __name__ == "__main__":
         with distributed.Client(scheduler_file={scheduler!r}) as client:
@@ -169,7 +170,7 @@ CLIENT = textwrap.dedent("""
 
 def test_a_client_killed_mid_sweep_resumes_computing_only_the_missing_chunks(scheduler_file, reference, tmp_path):
     store = tmp_path / "mc.zarr"
-    script = CLIENT.format(tests=str(Path(__file__).parent), scheduler=str(scheduler_file), store=str(store))
+    script = CLIENT.format(tests=TESTS, scheduler=str(scheduler_file), store=str(store))
     client_process = subprocess.Popen([sys.executable, "-c", script], env=ENV, stdout=subprocess.DEVNULL,
                                       stderr=subprocess.PIPE)
     try:

@@ -16,8 +16,8 @@ from helpers import assert_one_line_error, assert_same_run
 from tumble.cli import app
 from tumble.viz.demos import DEMOS
 
-SRC = Path(__file__).resolve().parents[1] / "src"
-DOCS = Path(__file__).resolve().parents[1] / "docs"
+SRC = Path(__file__).resolve().parents[2] / "src"
+DOCS = Path(__file__).resolve().parents[2] / "docs"
 runner = CliRunner()
 
 

@@ -19,7 +19,7 @@ from helpers import read_by
 pytestmark = pytest.mark.slow
 
 ROBOTS = tumble.examples.directory() / "robots"
-DOCS = Path(__file__).resolve().parents[1] / "docs" / "robot.md"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "robot.md"
 Q0 = np.array([0.1, 0.5, -0.3, 0.2, 0.4, -0.1])
 QD0 = np.array([0.3, -0.2, 0.4, 0.5, -0.6, 0.7])
 TORQUE = np.array([2.0, 30.0, 5.0, 0.1, -0.05, 0.02])  # N·m: about the PUMA's gravity load

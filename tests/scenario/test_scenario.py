@@ -68,7 +68,7 @@ def test_every_example_builds_and_runs(path):
                          ids=lambda p: p.stem)
 def test_every_example_of_every_kind_loads_and_builds(path):
     # `tumble run` runs these (it reads a file with load and checks it with build before running it);
-    # the spacecraft runs themselves are in tests/test_spacecraft_*.py and tests/test_cli.py.
+    # the spacecraft runs themselves are in tests/spacecraft/test_spacecraft_*.py and tests/cli/test_cli.py.
     scenario = load_scenario(path)
     assert scenario.kind == ("spacecraft" if "[spacecraft" in path.read_text(encoding="utf-8") else "rigid")
     problem = scenario.build()

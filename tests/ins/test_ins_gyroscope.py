@@ -144,7 +144,7 @@ def test_a_batch_of_initial_precession_rates_equals_one_by_one():
 
 def test_documented_example_runs(capsys):
     # the gyroscope block of docs/ins.md runs as a script and prints what it claims
-    text = (Path(__file__).resolve().parents[1] / "docs" / "ins.md").read_text(encoding="utf-8")
+    text = (Path(__file__).resolve().parents[2] / "docs" / "ins.md").read_text(encoding="utf-8")
     start = text.index("```python", text.index("### A rotor in gimbals")) + len("```python")
     exec(compile(text[start:text.index("```", start)], "docs/ins.md", "exec"), {})  # the project's own text
     printed = {line.split()[0]: float(line.split()[1]) for line in capsys.readouterr().out.splitlines()}

@@ -1,10 +1,10 @@
 """tumble.sweep in this process (workers=0): dispersions, per-sample reproducibility, outcomes, the store, bad input.
 
 The Dask runs (LocalCluster, scheduler and worker processes, killed workers
-and clients) are in tests/test_sweep_dask.py. Every simulation here is a
+and clients) are in tests/sweeps/test_sweep_dask.py. Every simulation here is a
 batch of rigid bodies under rk4 without torque, the specialization the rest
 of the suite compiles too, and one spacecraft with a damper under dop853 (as
-tests/test_spacecraft_passive_damper.py).
+tests/spacecraft/test_spacecraft_passive_damper.py).
 """
 
 from __future__ import annotations

@@ -12,11 +12,12 @@ import re
 import subprocess
 import sys
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from numba.core import config
+
+from helpers import compile_ptx, nvvm_available
 
 import tumble
 from tumble import attitude, integrate, torques
@@ -160,29 +161,16 @@ def test_no_gpu_is_a_clear_error():
         _cuda.solve_cuda(model, _states(2, 0), T_OUT, DT)
 
 
-def _nvvm_available():
-    if config.ENABLE_CUDASIM:
-        return False
-    from numba.cuda.cudadrv import nvvm
-
-    return nvvm.is_available()
-
-
-@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("torque", [False, True])
 def test_compiles_for_a_gpu(monkeypatch, torque):
     """The kernel types and compiles for sm_90, keeping each body's state in registers (no local memory)."""
-    from numba import cuda, float64, int64, types
-    from numba.cuda import dispatcher
+    from numba import float64, int64, types
 
-    # numba.cuda compiles the @njit callees for the current device; without one, name its compute capability
-    if not hasattr(dispatcher, "get_current_device"):
-        pytest.skip("this numba.cuda does not look up the device where these tests expect")
-    monkeypatch.setattr(dispatcher, "get_current_device", lambda: SimpleNamespace(compute_capability=(9, 0)))
     codes = int64[::1] if torque else types.Tuple(())
     signature = (float64[:, ::1], float64[:, ::1], codes, float64[:, ::1], float64[::1], int64[::1], float64[::1],
                  float64[:, :, ::1])
-    ptx, _ = cuda.compile_ptx(_cuda._rk4_kernel.py_func, signature, cc=(9, 0))
+    ptx = compile_ptx(monkeypatch, _cuda._rk4_kernel, signature)
     assert ptx.count(".entry") == 1
     # The kernel keeps every state in registers. The one local array allowed is
     # libdevice's Payne–Hanek argument reduction for sin/cos of huge angles

@@ -21,7 +21,7 @@ import pytest
 import tumble
 from tumble.sweeps import Component, Final, Inertia, Max, Normal, PointingError, sweep
 
-from test_cuda_rigid import _compile_ptx, _nvvm_available
+from helpers import compile_ptx, nvvm_available
 
 EPS = np.finfo(np.float64).eps
 P = (0.0, 1.0, 5.0, 33.3, 50.0, 95.0, 99.0, 100.0)
@@ -117,7 +117,7 @@ def test_the_sweep_on_the_device_writes_the_cpus_store(simulated):
     assert {key.removeprefix("sweep/") for key in gpu if key.startswith("sweep/")} == set(cpu.data_vars)
     for name in ("inertia", "omega0", "done"):  # the inputs: the same draws
         np.testing.assert_array_equal(gpu[f"sweep/{name}"], cpu[name].values)
-    # the outcomes: each sample's run, its principal axes found by Jacobi on the device (tests/test_cuda_rigid.py)
+    # the outcomes: each sample's run, its principal axes found by Jacobi on the device (tests/integrate/test_cuda_rigid.py)
     for name in ("wy", "pointing", "peak", "wy_mean", "wy_min", "wy_max"):
         np.testing.assert_allclose(gpu[f"sweep/{name}"], cpu[name].values, rtol=0, atol=1e-14)
     np.testing.assert_allclose(gpu["sweep/wy_std"], cpu["wy_std"].values, rtol=0, atol=1e-14)
@@ -141,7 +141,7 @@ def test_a_device_sweep_refuses_what_it_cannot_run():
 
 
 
-@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["block_moments_kernel", "bitonic_kernel", "count_kernel", "gather_kernel"])
 def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
     """What the simulator cannot see: each reduction kernel types and compiles for sm_90, allocating nothing."""
@@ -153,6 +153,6 @@ def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
     signatures = {"block_moments_kernel": (a2, int64, float64[:, :, ::1]), "bitonic_kernel": (a2, int64, int64),
                   "count_kernel": (a2, int64[::1]),
                   "gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
-    ptx = _compile_ptx(monkeypatch, getattr(device, name), signatures[name])
+    ptx = compile_ptx(monkeypatch, getattr(device, name), signatures[name])
     assert ptx.count(".entry") == 1
     assert "malloc" not in ptx

@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from helpers import compile_ptx, nvvm_available
+
 import tumble
 from tumble import attitude
 from tumble._inertia import principal_axes
@@ -215,32 +217,7 @@ def test_a_broken_tensor_is_refused_with_the_cpus_message(simulated):
     assert str(cpu.value).startswith("inertia[1]: must be symmetric")
 
 
-def _nvvm_available():
-    from numba.core import config
-
-    if config.ENABLE_CUDASIM:
-        return False
-    from numba.cuda.cudadrv import nvvm
-
-    return nvvm.is_available()
-
-
-def _compile_ptx(monkeypatch, kernel, signature):
-    """``kernel`` compiled to PTX for sm_90 (numba.cuda compiles the @njit callees for the current device;
-    without one, its compute capability is named)."""
-    from types import SimpleNamespace
-
-    from numba import cuda
-    from numba.cuda import dispatcher
-
-    if not hasattr(dispatcher, "get_current_device"):
-        pytest.skip("this numba.cuda does not look up the device where these tests expect")
-    monkeypatch.setattr(dispatcher, "get_current_device", lambda: SimpleNamespace(compute_capability=(9, 0)))
-    ptx, _ = cuda.compile_ptx(kernel.py_func, signature, cc=(9, 0))
-    return ptx
-
-
-@pytest.mark.skipif(not _nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["_principal_axes_kernel", "_coefficients_kernel", "_to_principal_kernel",
                                   "_to_body_kernel"])
 def test_set_up_kernels_compile_for_a_gpu(monkeypatch, name):
@@ -253,6 +230,6 @@ def test_set_up_kernels_compile_for_a_gpu(monkeypatch, name):
     a2, a3 = float64[:, ::1], float64[:, :, ::1]
     signatures = {"_principal_axes_kernel": (a3, a3, a2, a3, a2, a2, int8[::1]), "_coefficients_kernel": (a2, a2),
                   "_to_principal_kernel": (a2, a2, a2, a3, a2), "_to_body_kernel": (a3, a2, a3, a3, a3)}
-    ptx = _compile_ptx(monkeypatch, getattr(_rigid_cuda, name), signatures[name])
+    ptx = compile_ptx(monkeypatch, getattr(_rigid_cuda, name), signatures[name])
     assert ptx.count(".entry") == 1
     assert "malloc" not in ptx

@@ -2,7 +2,7 @@
 
 The trajectories here are written down, not integrated (a steady spin about a principal axis is an exact
 free motion: ``q(t) = [cos(Ωt/2), sin(Ωt/2) e]``), so the module compiles nothing but the attitude
-helpers. tests/test_viewer_browser.py opens the pages in Chromium.
+helpers. tests/viz/test_viewer_browser.py opens the pages in Chromium.
 """
 
 import numpy as np

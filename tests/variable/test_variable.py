@@ -224,7 +224,7 @@ def test_totals_are_the_rotational_energy_and_the_angular_momentum():
 
 def test_documented_example_prints_what_it_claims(capsys):
     # the skater of docs/variable_inertia.md: ω_z = 6 × 5.72/0.92 = 37.304 rad/s after pulling in
-    text = (Path(__file__).resolve().parents[1] / "docs" / "variable_inertia.md").read_text(encoding="utf-8")
+    text = (Path(__file__).resolve().parents[2] / "docs" / "variable_inertia.md").read_text(encoding="utf-8")
     start = text.index("```python") + len("```python")
     exec(compile(text[start:text.index("```", start)], "variable_inertia.md", "exec"), {})  # the project's own text
     printed = capsys.readouterr().out

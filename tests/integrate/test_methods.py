@@ -33,7 +33,7 @@ from tumble import analytic, attitude, integrate
 from tumble._validate import ValidationError
 from tumble.measure import lyapunov_exponents
 
-DOCS = Path(__file__).resolve().parent.parent / "docs"
+DOCS = Path(__file__).resolve().parents[2] / "docs"
 
 # The measured order is within ± 0.2 of the declared one (diffrax's test allows ± 0.9). Measured (this file's
 # rows): rk4 4.13, dop853 8.03, cf4 4.06, splitting2 2.000, splitting4 4.003, exact_split2 1.989, exact_split4 3.992

@@ -22,7 +22,7 @@ from helpers import assert_same_run
 # worker (tests/conftest.py, KINDS), so that one process pays it.
 pytestmark = pytest.mark.slow
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = tumble.examples.directory() / "spacecraft"
 
 
@@ -82,7 +82,7 @@ def test_bad_scenarios_name_the_key(edit, where, rule):
     assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems
 
 
-# The craft of tests/test_spacecraft_wheels.py::test_hub_plus_wheels_equals_total_inertia, as scenario files:
+# The craft of tests/spacecraft/test_spacecraft_wheels.py::test_hub_plus_wheels_equals_total_inertia, as scenario files:
 # described by its hub (without the wheels) plus each wheel's mass properties, or by its total inertia.
 HUB = """
 [spacecraft.hub]
@@ -207,10 +207,10 @@ def test_mrp_example_is_simulate_of_the_same_spacecraft_built_in_python(mrp_run)
     assert mrp_run.info == reference.info
 
 
-# After 3600 s the slowest closed-loop transient (time constant 114 s, tests/test_spacecraft_control.py) has
+# After 3600 s the slowest closed-loop transient (time constant 114 s, tests/spacecraft/test_spacecraft_control.py) has
 # decayed by e^-31 of |σ₀| = 0.37: what remains is dop853's error at rtol = atol = 1e-12. Measured at the end:
 # |σ| = 4.6e-14, max |ω_k| = 1.4e-15 rad/s, P K_I K ∫σ dt = L to 1.1e-10 relative; the limits are those of
-# tests/test_spacecraft_control.py (σ, ω 1e-11; the integral 1e-9 relative).
+# tests/spacecraft/test_spacecraft_control.py (σ, ω 1e-11; the integral 1e-9 relative).
 def test_mrp_example_settles_with_the_integral_term_holding_the_disturbance(mrp_run):
     sigma = _mrp(mrp_run.q[-1])
     assert np.linalg.norm(sigma) < 1e-11

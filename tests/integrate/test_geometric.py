@@ -106,7 +106,7 @@ def test_methods_are_registered_with_their_torque_support(name, torque):
     ("cf4", "Gravity", [0.1, 0.05, 0.025, 0.0125]),
 ])
 def test_measured_order_under_each_torque(method, torque, dts):
-    # the declared order (tests/test_methods.py measures every method's on an exact motion)
+    # the declared order (tests/integrate/test_methods.py measures every method's on an exact motion)
     order = integrate.METHODS[method].order
     t = np.array([0.0, 4.0])
     body = tumble.RigidBody(FULL)

@@ -1,7 +1,7 @@
 """tumble.sweeps.shipping: the compiled code a sweep's client gives its Dask workers, and what a worker takes.
 
 The workers' side on real ``dask worker`` processes (another installation
-path, empty caches, nothing compiled) is in tests/test_sweep_dask.py; here the
+path, empty caches, nothing compiled) is in tests/sweeps/test_sweep_dask.py; here the
 plugin's entries are installed in this process into an empty
 ``NUMBA_CACHE_DIR``.
 """
