@@ -380,6 +380,8 @@ SLOW_SPINNER = TABLE.replace("stop = 1.0", "stop = 100.0").replace("dt = 0.01", 
 @pytest.mark.slow
 def test_ctrl_c_during_tumble_sweep_is_one_line_and_exit_130_and_the_store_resumes(tmp_path):
     # a terminal's Ctrl-C reaches the whole process group: the command and its local cluster's workers
+    import zarr  # noqa: F401 - imported before the sweep starts: its first import while polling took longer than the sweep
+
     scenario, store = tmp_path / "spinner.toml", tmp_path / "out.zarr"
     scenario.write_text(SLOW_SPINNER)
     process = subprocess.Popen([sys.executable, "-m", "tumble", "sweep", str(scenario), "-o", str(store), "-q",

@@ -67,9 +67,11 @@ def _run(device, name):
 
 # In the child, with the simulator on: each case's GPU run into one .npz.
 _CHILD = """
+import os
 import sys
 import numpy as np
 import runpy
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[1]))))  # tests/: its helpers
 module = runpy.run_path(sys.argv[1])
 out = {}
 for i, name in enumerate(module["cases"]()):

@@ -45,7 +45,7 @@ import sys
 import numpy as np
 import runpy
 from tumble.sweeps import device, sweep
-sys.path.insert(0, os.path.dirname(sys.argv[1]))  # the tests' folder: this file imports a sibling
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(sys.argv[1]))))  # tests/: its helpers
 module = runpy.run_path(sys.argv[1])
 tables = np.load(sys.argv[2])
 device.BLOCK = 16  # several blocks of samples, merged

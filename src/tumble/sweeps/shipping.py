@@ -127,9 +127,12 @@ def compiled_for(plan: Plan) -> CompiledCode:
         t[1] = min(t[1], t[0] + float(plan.options["dt"]))
     dataclasses.replace(plan, t=t).simulate(plan.inputs(lo, hi))
     cpu = target()
-    entries = [entry for dispatcher, source in _tumble_dispatchers() for entry in _entries(dispatcher, source)
-               if entry.cpu == cpu]
-    return CompiledCode(content_key(), _python_tag(), tuple(entries))
+    entries: dict[tuple, Entry] = {}  # one of each: a module imported again (a reload) leaves a second dispatcher of its functions
+    for dispatcher, source in _tumble_dispatchers():
+        for entry in _entries(dispatcher, source):
+            if entry.cpu == cpu:
+                entries.setdefault((entry.source, entry.name, entry.key), entry)
+    return CompiledCode(content_key(), _python_tag(), tuple(entries.values()))
 
 
 def _cache_directory(source: str) -> str | None:
