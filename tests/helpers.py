@@ -1,6 +1,7 @@
 """Helpers shared by the tests."""
 
 import contextlib
+import signal
 import subprocess
 import sys
 import time
@@ -29,6 +30,19 @@ def assert_same_run(traj, reference):
     for name in traj.totals:
         np.testing.assert_array_equal(traj.totals[name], reference.totals[name], err_msg=name)
     assert traj.method == reference.method and traj.model == reference.model
+
+
+@contextlib.contextmanager
+def sigint_as_in_a_terminal():
+    """Processes started inside take Ctrl-C as a terminal's foreground command does (Python's KeyboardInterrupt),
+    even where this process was started with SIGINT ignored (a shell's ``&`` without job control, ``nohup``): an
+    ignored signal stays ignored across ``exec`` and Python then leaves it so, while a handled one is reset to
+    the default. This process's handler comes back after."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def stop(*processes):

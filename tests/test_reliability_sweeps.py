@@ -22,7 +22,7 @@ from pathlib import Path
 import cloudpickle
 import numpy as np
 import pytest
-from helpers import dask_processes, stop
+from helpers import dask_processes, sigint_as_in_a_terminal, stop
 
 import tumble
 from tumble import _callback
@@ -388,8 +388,9 @@ def test_ctrl_c_during_tumble_sweep_is_one_line_and_exit_130_and_the_same_comman
     scenario, store = tmp_path / "spinner.toml", tmp_path / "out.zarr"
     scenario.write_text(SLOW_SPINNER)
     command = [sys.executable, "-m", "tumble", "sweep", str(scenario), "-o", str(store), "-q", "--workers", "2"]
-    process = subprocess.Popen(command, env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                               start_new_session=True)
+    with sigint_as_in_a_terminal():
+        process = subprocess.Popen(command, env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                   start_new_session=True)
     try:
         deadline = time.monotonic() + 4 * TIMEOUT
         while _done(store) < 1:
