@@ -115,6 +115,13 @@ def require_positive(x: float, name: str) -> float:
     return x
 
 
+def require_count(n, name: str, minimum: int = 1) -> int:
+    """Return ``int(n)`` if ``n`` is an integer (not a bool) >= ``minimum``, else raise naming ``name``."""
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < minimum:
+        raise ValidationError(f"{name}: must be an integer >= {minimum}, got {n!r}")
+    return int(n)
+
+
 def require_non_negative(x: float, name: str) -> float:
     """Return ``float(x)`` if it is finite and >= 0, else raise naming ``name``."""
     x = _scalar(x, name, "a finite number >= 0")

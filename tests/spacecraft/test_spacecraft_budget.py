@@ -3,6 +3,7 @@ build-up against its exact closed form, every source against SMAD's estimates wi
 seasons' closed form against the sampled shadow, and the demo through the CLI."""
 
 import math
+import re
 from datetime import timedelta
 
 import numpy as np
@@ -80,12 +81,24 @@ def test_eclipse_fraction_matches_the_sampled_cylindrical_shadow():
     assert sampled == pytest.approx(fraction[day], abs=2e-3)
 
 
-@pytest.mark.slow  # a day of the environment and 32 Monte-Carlo orbits: about a minute on 2 shared cores
-def test_demo_budget_runs_from_the_command_line(tmp_path):
-    result = CliRunner().invoke(app, ["demo", "budget", "-o", str(tmp_path)])
+@pytest.mark.slow  # simulates a spacecraft: compiles it (~38 CPU s on a cold cache)
+def test_demo_budget_runs_from_the_command_line_with_its_gravity_gradient_momentum_at_smads(tmp_path):
+    # an hour and two Monte-Carlo orbits (the default day and 32 orbits take about a minute)
+    result = CliRunner().invoke(app, ["demo", "budget", "-o", str(tmp_path), "--hours", "1", "--samples", "2"])
     assert result.exit_code == 0, result.output
     assert (tmp_path / "budget.png").stat().st_size > 10_000
-    assert "SMAD" in result.stdout and "Monte Carlo" in result.stdout
+    row = next(line for line in result.stdout.splitlines() if line.startswith("gravity gradient"))
+    momentum, smad = map(float, re.search(r"momentum (\S+) N m s \(SMAD (\S+)\)", row).groups())
+    assert momentum == pytest.approx(smad, rel=2e-3)  # within 1e-3 (test_demo_budget_reduced), printed to 3 digits
+    assert "over 1 h" in result.stdout and "(2 draws)" in result.stdout
+
+
+@pytest.mark.parametrize("args, message", [(["--samples", "0"], "--samples: must be an integer >= 1, got 0"),
+                                           (["--hours", "-1"], "--hours: must be a finite number > 0, got -1.0")])
+def test_demo_budget_refuses_a_bad_option_naming_it(tmp_path, args, message):
+    result = CliRunner().invoke(app, ["demo", "budget", "-o", str(tmp_path), *args])
+    assert result.exit_code == 2 and result.stderr.strip() == f"error: {message}"
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.slow  # simulates a spacecraft: compiles it (~38 CPU s on a cold cache)

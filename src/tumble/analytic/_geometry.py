@@ -40,7 +40,7 @@ from typing import cast
 
 import numpy as np
 
-from tumble._validate import ValidationError, as_array, require_positive
+from tumble._validate import ValidationError, as_array, require_count, require_positive
 from tumble.analytic._free import free_parameters
 from tumble.attitude import rotate
 from tumble.rigid_body import RigidBody
@@ -189,12 +189,6 @@ def _side(sign) -> int:
     return int(sign)
 
 
-def _count(n, name: str, minimum: int) -> int:
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < minimum:
-        raise ValidationError(f"{name}: must be an integer >= {minimum}, got {n!r}")
-    return int(n)
-
-
 def _angles(n: int) -> np.ndarray:
     theta = np.linspace(0.0, 2.0 * np.pi, n)
     theta[-1] = 0.0  # closed: the last point is exactly the first
@@ -216,7 +210,7 @@ def polhode(body: RigidBody, energy: float, momentum: float, *, n: int = _DEFAUL
     """
     moments = _moments(body)
     levels = _levels(moments, energy, momentum)
-    return _curve(moments, levels, _circled_axis(moments, levels), _side(sign), _angles(_count(n, "n", 3)))
+    return _curve(moments, levels, _circled_axis(moments, levels), _side(sign), _angles(require_count(n, "n", 3)))
 
 
 def polhode_through(body: RigidBody, omega, *, n: int = _DEFAULT_POINTS) -> Polhode:
@@ -235,7 +229,7 @@ def polhode_through(body: RigidBody, omega, *, n: int = _DEFAULT_POINTS) -> Polh
     params = free_parameters(moments, omega_p)
     c = _circled(params)
     sign = -1 if omega_p[c] < 0.0 else 1
-    theta = _amplitude(moments, c, sign, omega_p) + _angles(_count(n, "n", 3))
+    theta = _amplitude(moments, c, sign, omega_p) + _angles(require_count(n, "n", 3))
     if not np.cross(omega_p, moments * omega_p).any():
         return Polhode(np.tile(omega_p, (theta.size, 1)), float(params.momentum), c, sign)
     points = _curve(moments, _levels_of_rates(moments, omega_p), c, sign, theta)
@@ -254,7 +248,7 @@ def polhode_family(body: RigidBody, energy: float, n_curves: int = 5, *, n: int 
     """
     moments = _moments(body)
     energy = require_positive(energy, "energy")
-    n_curves, theta = _count(n_curves, "n_curves", 1), _angles(_count(n, "n", 3))
+    n_curves, theta = require_count(n_curves, "n_curves", 1), _angles(require_count(n, "n", 3))
     fractions = np.arange(1, n_curves + 1) / (n_curves + 1)
     separatrix_l2 = 2.0 * energy * moments[1]
     curves = []
@@ -285,7 +279,7 @@ def separatrix(body: RigidBody, energy: float, *, n: int = _DEFAULT_POINTS) -> n
     """
     moments = _moments(body)
     energy = require_positive(energy, "energy")
-    theta = _angles(_count(n, "n", 3))
+    theta = _angles(require_count(n, "n", 3))
     i1, i2, i3 = moments
     if i1 == i2 or i2 == i3:
         c = 2 if i1 == i2 else 0

@@ -301,7 +301,8 @@ DEMOS: dict[str, Demo] = {
         a residual dipole in IGRF-14) along a 500 km dawn-dusk sun-synchronous orbit, the momentum the
         wheels must store against the closed-form estimates of SMAD (Larson & Wertz 1999, section 11.1),
         eclipse seasons over a year, and a Monte-Carlo sweep over facet coefficients and centre-of-mass
-        offset (docs/spacecraft_environment.md). About a minute. Writes budget.png in the directory.
+        offset (docs/spacecraft_environment.md). About a minute (--hours 1 --samples 2: seconds). Writes
+        budget.png in the directory.
         """,
         lambda s: [
             *[(source.replace("_", " "), f"peak {s['peak_torque'][source]:.3g} N m (SMAD "
@@ -317,6 +318,9 @@ DEMOS: dict[str, Demo] = {
                             f"{s['monte_carlo_p95']:.3g} N m s ({s['monte_carlo_samples']} draws)"),
         ],
         ("budget.png",),
+        (Option("--hours", "hours", float, 24.0, "Time of the budget run, h."),
+         Option("--samples", "samples", int, 32, "Monte-Carlo draws over one orbit.",
+                "tumble._validate:require_count")),
     ),
     "lorentz": Demo(
         "tumble.viz.lorentz:demo_lorentz",
