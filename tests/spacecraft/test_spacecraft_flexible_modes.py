@@ -9,7 +9,10 @@ from scipy.integrate import cumulative_simpson
 import tumble
 from tumble import flexible
 from tumble._validate import ValidationError
+from tumble.scenario import ScenarioError, parse
 from tumble.spacecraft import FlexibleModes, MRPFeedback, Spacecraft, pyramid_wheels
+
+from helpers import assert_same_run
 
 # A simulation compiles the spacecraft's rk4 path on a cold Numba cache (~100 CPU s on the development
 # machine); warm, each test runs in well under a second.
@@ -141,3 +144,68 @@ def test_the_modes_leave_the_rate_inertia_and_keep_the_laws_rigid_design():
     np.testing.assert_allclose(craft.rate_inertia, INERTIA - spin - PARTICIPATION.T @ PARTICIPATION, rtol=1e-15)
     rigid = Spacecraft(inertia=INERTIA, wheels=wheels)
     np.testing.assert_allclose(craft._law_inertia, rigid.rate_inertia, rtol=1e-15)
+
+
+SCENARIO = """
+[spacecraft]
+moments = [2000.0, 1500.0, 3000.0]
+
+[spacecraft.wheel_pyramid]
+inertia = 0.5
+
+[spacecraft.flexible_modes]
+participation = [[0.0, 0.0, 25.0], [0.0, 0.0, 8.0]]
+frequency = [1.25, 6.9]
+damping = [0.003, 0.005]
+
+[[spacecraft.controller]]
+kind = "mrp_feedback"
+K = 40.0
+P = 400.0
+target = [0.9961946980917455, 0.0, 0.0, 0.08715574274765817]
+
+[initial]
+omega = [0.0, 0.0, 0.001]
+eta = [0.01, 0.0]
+eta_rate = [0.0, 0.002]
+
+[time]
+stop = 2.0
+step = 0.5
+
+[solver]
+dt = 0.01
+"""
+
+
+@SLOW
+def test_the_scenario_table_builds_the_spacecraft_of_the_python_api():
+    craft = Spacecraft(inertia=np.diag([2000.0, 1500.0, 3000.0]), wheels=pyramid_wheels(0.5),
+                       flexible_modes=FlexibleModes([[0.0, 0.0, 25.0], [0.0, 0.0, 8.0]], [1.25, 6.9], [0.003, 0.005]),
+                       controller=MRPFeedback(K=40.0, P=400.0, target=[0.9961946980917455, 0.0, 0.0,
+                                                                       0.08715574274765817]))
+    expected = tumble.simulate(craft, omega0=[0.0, 0.0, 0.001], eta0=[0.01, 0.0], eta_rate0=[0.0, 0.002],
+                               t=np.linspace(0.0, 2.0, 5), method="rk4", dt=0.01)
+    assert_same_run(parse(SCENARIO).run(), expected)
+
+
+@pytest.mark.parametrize(("old", "new", "where", "rule"), [
+    ("frequency = [1.25, 6.9]", "frequency = [1.25]", "spacecraft.flexible_modes.frequency",
+     "must have shape (2,), one per mode of participation, got (1,)"),
+    ("frequency = [1.25, 6.9]", "frequency = [1.25, 0.0]", "spacecraft.flexible_modes.frequency[1]",
+     "must be > 0 (rad/s), got 0.0"),
+    ("damping = [0.003, 0.005]", "damping = [0.003, -0.005]", "spacecraft.flexible_modes.damping[1]",
+     "must be a damping ratio >= 0, got -0.005"),
+    ("[0.0, 0.0, 25.0], [0.0, 0.0, 8.0]", "[0.0, 0.0, 25.0], [0.0, 8.0]", "spacecraft.flexible_modes.participation[1]",
+     "must have at least 3 entries, got 2"),
+    ("[0.0, 0.0, 25.0], [0.0, 0.0, 8.0]", "[0.0, 0.0, 55.0], [0.0, 0.0, 8.0]", "spacecraft.flexible_modes",
+     "must be positive definite"),
+    ("frequency = [1.25, 6.9]", "frequency = [1.25, 6.9]\nstiffness = 1.0", "spacecraft.flexible_modes.stiffness",
+     "unknown key"),
+    ("eta = [0.01, 0.0]", "eta = [0.01]", "initial.eta", "must have shape (…, 2), got (1,)"),
+])
+def test_bad_tables_name_the_key(old, new, where, rule):
+    assert SCENARIO.count(old) == 1, old
+    with pytest.raises(ScenarioError) as info:
+        parse(SCENARIO.replace(old, new), source="craft.toml").run()
+    assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems
