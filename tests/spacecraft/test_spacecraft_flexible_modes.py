@@ -209,3 +209,23 @@ def test_bad_tables_name_the_key(old, new, where, rule):
     with pytest.raises(ScenarioError) as info:
         parse(SCENARIO.replace(old, new), source="craft.toml").run()
     assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems
+
+
+@SLOW
+def test_the_viewer_draws_each_mode_swinging_along_its_participation_axis(controlled):
+    from tumble.viz import viewer
+
+    craft, traj = controlled
+    scene = viewer.scene(traj, model=craft, frames=50)
+    hub = scene.solids[0].rotation                                    # R(q) of the frames
+    frames = np.searchsorted(traj.t, scene.t)
+    for k, delta in enumerate(PARTICIPATION):
+        line = {line.name: line.points for line in scene.lines}[f"flexible mode {k + 1}"]
+        np.testing.assert_array_equal(line[:, 0], 0.0)
+        length = np.linalg.norm(line[:, 1], axis=-1)
+        np.testing.assert_allclose(line[:, 1] / length[:, None], hub @ (delta / np.linalg.norm(delta)), atol=1e-15)
+        eta = traj.modal_coordinate[frames, k]
+        np.testing.assert_array_equal(traj.t[frames], scene.t)
+        base = length / (1.0 + 0.5 * eta / np.abs(eta).max())         # the same at every frame
+        np.testing.assert_allclose(base, base[0], rtol=1e-14)
+        assert np.ptp(length) > 0.1 * base[0]                          # it swings
