@@ -27,7 +27,7 @@ from tumble.flexible import FlexibleBody, Mode
 from tumble.ins import GimbaledGyro
 from tumble.simulate import as_model
 from tumble.slosh import Pendulum, SloshBody
-from tumble.spacecraft import FlightSoftware, MRPFeedback, QuaternionPD, Spacecraft, pyramid_wheels
+from tumble.spacecraft import FlexibleModes, FlightSoftware, MRPFeedback, QuaternionPD, Spacecraft, pyramid_wheels
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])  # kg·m², body axes
 TARGET = [np.cos(0.2), 0.0, np.sin(0.2), 0.0]
@@ -46,6 +46,9 @@ def cases():
                             controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
     held_pd = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02, max_torque=0.1),
                          controller=QuaternionPD(0.2, 0.8, target=TARGET), control_period=0.02)
+    modes = FlexibleModes([[0.3, 0.5, 0.2], [0.1, -0.4, 0.6]], [3.0, 7.0], [0.02, 0.01])
+    flexible_craft = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), flexible_modes=modes,
+                                controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
     rigid = [tumble.RigidBody(INERTIA), tumble.RigidBody(np.diag([1.0, 2.0, 2.5]))]
     wheel_speeds = {"wheel_speeds0": [[10.0, -5.0, 3.0, 0.0], [0.0, 20.0, -8.0, 4.0]]}
     return {
@@ -55,6 +58,8 @@ def cases():
                                               "rate0": [0.2, -0.1, 0.0]}),
         "spacecraft: wheels, MRP feedback, rk4": (wheels_mrp, "rk4", None, wheel_speeds),
         "spacecraft: wheels, sampled PD, cf4": (held_pd, "cf4", TORQUE, wheel_speeds),
+        "spacecraft: wheels, MRP feedback, flexible modes, rk4": (flexible_craft, "rk4", TORQUE,
+                                                                  {**wheel_speeds, "eta0": [[0.1, -0.05], [0.0, 0.2]]}),
         "rigid, one body each, cf4": (rigid, "cf4", TORQUE, {}),
     }
 

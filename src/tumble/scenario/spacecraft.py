@@ -36,7 +36,9 @@ damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment
 (``[spacecraft.magnetic_field]``, ``[spacecraft.residual_dipole]``,
 ``gravity_gradient``, and the environment sampled along an orbit with its
 facet parts: ``[spacecraft.environment]``, ``[spacecraft.solar_pressure]``,
-``[spacecraft.drag]``, :mod:`tumble.scenario.environment`), the ``[[spacecraft.controller]]`` laws
+``[spacecraft.drag]``, :mod:`tumble.scenario.environment`), flexible appendages
+(``[spacecraft.flexible_modes]``: ``participation`` (m × 3, kg^½ m), ``frequency`` (m, rad/s),
+``damping`` (m, ζ; default 0); initial ``eta`` and ``eta_rate``), the ``[[spacecraft.controller]]`` laws
 (:mod:`tumble.scenario.control`) and the flight software that feeds them an estimate
 (``[spacecraft.flight_software]``).
 ``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
@@ -69,6 +71,7 @@ from tumble.scenario.tables import Initial, Solver, Time
 from tumble.scenario.torques import GravityGradientTorque, Torque, build_torque
 from tumble.spacecraft import actuators
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
+from tumble.spacecraft.flexible_modes import FlexibleModes
 from tumble.spacecraft.flight_software import FlightSoftware, Sampling
 from tumble.spacecraft.model import Spacecraft
 from tumble.trajectory import Trajectory
@@ -201,6 +204,20 @@ class ResidualDipoleTable(_Table):
         return ResidualDipole(np.array(self.dipole))
 
 
+class FlexibleModesTable(_Table):
+    """``[spacecraft.flexible_modes]``: cantilever modes of the appendages
+    (:class:`tumble.spacecraft.FlexibleModes`), one entry per mode: ``participation`` δ_k (kg^½ m, body axes), ``frequency`` Ω_k (rad/s), ``damping`` ζ_k
+    (default 0)."""
+
+    participation: Annotated[list[_Vector], Field(min_length=1)]
+    frequency: list[_Number]
+    damping: list[_Number] | None = None
+
+    def build(self) -> FlexibleModes:
+        return FlexibleModes(np.array(self.participation), np.array(self.frequency),
+                             None if self.damping is None else np.array(self.damping))
+
+
 class SamplingTable(_Table):
     """A sensor's sampling (:class:`tumble.spacecraft.Sampling`): ``period`` (s; default the control period),
     ``latency`` (s) and ``stream`` (its noise stream's number)."""
@@ -302,6 +319,7 @@ class SpacecraftTable(_InertiaOrMoments):
     controller: list[Controller] = []
     control_period: _Positive | None = None
     flight_software: FlightSoftwareTable | None = None
+    flexible_modes: FlexibleModesTable | None = None
 
     @model_validator(mode="after")
     def _one_description(self):
@@ -320,7 +338,7 @@ class SpacecraftTable(_InertiaOrMoments):
             key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
             for key in ("wheels", "thrusters", "controller")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field",
-                    "residual_dipole", "environment", "solar_pressure", "drag", "flight_software"):
+                    "residual_dipole", "environment", "solar_pressure", "drag", "flight_software", "flexible_modes"):
             entry = getattr(self, key)
             parts[key] = None if entry is None else _built(entry, f"spacecraft.{key}")
         pyramid = parts.pop("wheel_pyramid")
@@ -350,8 +368,9 @@ class SpacecraftInitial(Initial):
     to the hub), ``gimbal_angles`` (rad), ``damper_omega`` (the damper sphere's rate relative to inertial,
     rad/s, body axes; default ``omega``) and ``attitude_error_integral`` (∫σ dt of the MRP feedback's
     integral term, s; default 0); with flight software ``q_estimate`` (default ``q``), ``bias_estimate`` and
-    ``gyro_bias`` (rad/s, body axes; default 0) and ``sensor_seed`` (its noise seed; default its ``seed``). A
-    key the spacecraft has no state for is refused by :func:`tumble.simulate`."""
+    ``gyro_bias`` (rad/s, body axes; default 0) and ``sensor_seed`` (its noise seed; default its ``seed``); with
+    flexible modes ``eta`` (kg^½ m) and ``eta_rate`` (kg^½ m/s), one per mode (default 0). A key the spacecraft
+    has no state for is refused by :func:`tumble.simulate`."""
 
     wheel_speeds: list[_Number] | None = None
     gimbal_angles: list[_Number] | None = None
@@ -361,6 +380,8 @@ class SpacecraftInitial(Initial):
     bias_estimate: _Vector | None = None
     gyro_bias: _Vector | None = None
     sensor_seed: Annotated[int, Field(strict=True, ge=0)] | None = None
+    eta: list[_Number] | None = None
+    eta_rate: list[_Number] | None = None
 
 
 class SpacecraftSolver(Solver):

@@ -1,5 +1,5 @@
 """Spacecraft attitude dynamics and control: a rigid hub with reaction wheels, control moment gyros,
-thrusters, magnetorquers and a nutation damper, in a Keplerian orbit with gravity gradient and a dipole
+thrusters, magnetorquers, a nutation damper and flexible appendages, in a Keplerian orbit with gravity gradient and a dipole
 magnetic field (or the environment sampled along a Kepler or TLE orbit: :class:`Environment`), under feedback control laws (compiled or Python; continuous or sampled with a zero-order
 hold). A :class:`Spacecraft` is a model of :func:`tumble.simulate`.
 
@@ -24,6 +24,7 @@ from tumble.spacecraft.control import (BDot, ConstantTorque, MomentumDumping, MR
 from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.environment_table import Environment, SpaceWeather
+from tumble.spacecraft.flexible_modes import FlexibleModes
 from tumble.spacecraft.flight_software import FlightSoftware, Sampling
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
@@ -31,7 +32,8 @@ from tumble.spacecraft.passive import gravity_gradient_stability, spin_stability
 from tumble.spacecraft.tle import TLE
 
 __all__ = [
-    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "Environment", "FlightSoftware", "MRPFeedback",
+    "BDot", "CMGCluster", "ConstantTorque", "DipoleField", "Environment", "FlexibleModes", "FlightSoftware",
+    "MRPFeedback",
     "Magnetorquers",
     "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
     "Sampling",

@@ -14,12 +14,13 @@ properties are described in one of two ways:
   of hub and rotors (:meth:`tumble.rigid_body.RigidBody.composite`) plus the
   sphere's ``J_d E`` (it sits at the centre of mass).
 
-Both give the same motion for the same total (tested). The body rate answers
-to ``J_ω = J − Σ I_s a aᵀ − J_d E`` (the rotors' spin inertias and the sphere
-are carried by their own states). The equations are those of
+Both give the same motion for the same total (tested). Flexible appendages
+(``flexible_modes``) are part of either, undeformed. The body rate answers
+to ``J_ω = J − Σ I_s a aᵀ − J_d E − Σ δ_k δ_kᵀ`` (the rotors' spin inertias, the
+sphere and the appendages' modal participation are carried by their own states). The equations are those of
 :mod:`tumble.kernels.spacecraft`, one file per actuator.
 
-One class, one unit (about 630 lines): its checks, its compiled parts, its
+One class, one unit (about 700 lines): its checks, its compiled parts, its
 initial state and its named outputs each read the same list of parts, and
 what each part adds to them is a few lines beside the others.
 """
@@ -45,6 +46,7 @@ from tumble.kernels.spacecraft import drag as _drag
 from tumble.kernels.spacecraft import damper as _damper_kernel
 from tumble.kernels.spacecraft import flight_software as _fsw_kernel
 from tumble.kernels.spacecraft import environment as _environment
+from tumble.kernels.spacecraft import flexible_modes as _flexible_modes
 from tumble.kernels.spacecraft import laws as _law_kernels
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
 from tumble.kernels.spacecraft import residual_dipole as _residual_dipole
@@ -58,6 +60,7 @@ from tumble.spacecraft.control import DIPOLE_LAWS, TORQUE_LAWS, MomentumDumping,
 from tumble.spacecraft.damper import SphericalDamper
 from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.environment_table import Environment
+from tumble.spacecraft.flexible_modes import FlexibleModes
 from tumble.spacecraft.flight_software import FlightSoftware, check_seed
 from tumble.spacecraft.flight_software import initial_state as _fsw_initial_state
 from tumble.spacecraft.orbit import EARTH_MU, Orbit
@@ -116,6 +119,9 @@ class Spacecraft(Model):
     flight_software : :class:`~tumble.spacecraft.flight_software.FlightSoftware` or None: gyro, star tracker
         and direction sensors at their own rates, the MEKF at the control period (needed), the control law fed
         the estimate instead of the truth
+    flexible_modes : :class:`~tumble.spacecraft.flexible_modes.FlexibleModes` or None: cantilever modes of
+        flexible appendages (hybrid coordinates; the appendages undeformed are in ``inertia`` or ``hub``),
+        initial modal coordinates and rates ``eta0``, ``eta_rate0`` (default zero)
 
     The torque command goes to the wheels if there are any, else to the CMGs,
     else to the thrusters (through the PWPF modulators), else to the
@@ -145,6 +151,7 @@ class Spacecraft(Model):
     controller: Any = None  # a law, a sequence of laws or None: the tuple of laws once validated
     control_period: float | None = None
     flight_software: FlightSoftware | None = None
+    flexible_modes: FlexibleModes | None = None
     #: The whole spacecraft as one rigid body (total inertia J, mass, centre of mass), derived.
     body: RigidBody = field(init=False, repr=False)
 
@@ -194,6 +201,7 @@ class Spacecraft(Model):
                 raise ValidationError(f"control_period: must be None (continuous) or a number > 0 (s), got {value}")
             set_(self, "control_period", value)
         self._check_flight_software()
+        self._check_flexible_modes()
 
     # -- description -------------------------------------------------------------------
 
@@ -230,6 +238,17 @@ class Spacecraft(Model):
             raise ValidationError("flight_software: needs a torque law (QuaternionPD, MRPFeedback, RateDamping, "
                                   "ConstantTorque or a Python law) and no WheelTorques (whose commands it does "
                                   "not delay)")
+
+    def _check_flexible_modes(self) -> None:
+        """The modes are :class:`FlexibleModes` and leave ``J_ω`` positive definite."""
+        _check_type(self.flexible_modes, FlexibleModes, "flexible_modes")
+        if self.flexible_modes is None:
+            return
+        smallest, largest = np.linalg.eigvalsh(self.rate_inertia)[[0, -1]]
+        if smallest <= 1e-12 * abs(largest):
+            raise ValidationError(f"flexible_modes: J_ω = J − Σ I_s a aᵀ − J_d E − Σ δ_k δ_kᵀ must be positive "
+                                  f"definite (the appendages cannot carry more inertia than the whole body); its "
+                                  f"smallest eigenvalue is {smallest:.6g} kg m^2")
 
     @property
     def _has_field(self) -> bool:
@@ -283,15 +302,26 @@ class Spacecraft(Model):
 
     @functools.cached_property  # a frozen description: computed once, read-only
     def rate_inertia(self) -> np.ndarray:
-        """J_ω = J − Σ I_s a aᵀ − J_d E: the inertia the body rate answers to, kg·m² (rotor spins and the
-        damper sphere excluded)."""
+        """J_ω = J − Σ I_s a aᵀ − J_d E − Σ δ_k δ_kᵀ: the inertia the body rate answers to, kg·m² (rotor
+        spins, the damper sphere and the appendages' modal participation excluded)."""
         j = self.body.inertia.copy()
         for w in self.wheels:
             j -= w.inertia * np.outer(w.axis, w.axis)
         if self.damper is not None:
             j -= self.damper.inertia * np.eye(3)
+        if self.flexible_modes is not None:
+            j -= self.flexible_modes.inertia
         j.setflags(write=False)
         return j
+
+    @property
+    def _law_inertia(self) -> np.ndarray:
+        """The inertia the control laws' gains are designed for, kg·m²: ``J_ω`` with the appendages rigid
+        (``+ Σ δ_k δ_kᵀ``), the inertia of the rigid-body motion that the modes follow below their
+        frequencies."""
+        if self.flexible_modes is None:
+            return self.rate_inertia
+        return self.rate_inertia + self.flexible_modes.inertia
 
     def _torque_law(self):
         return next((law for law in self.controller if isinstance(law, TORQUE_LAWS)), None)
@@ -316,7 +346,8 @@ class Spacecraft(Model):
                 axes, spin, max_torque, max_speed, viscous, coulomb, coulomb_speed,
                 allocation=np.linalg.pinv(axes.T) if routed else np.zeros_like(axes)))
         programs += [part._program() for part in (self.cmgs, self.magnetorquers, self.damper, self.residual_dipole,
-                                                  self.environment, self.solar_pressure, self.drag)
+                                                  self.environment, self.solar_pressure, self.drag,
+                                                  self.flexible_modes)
                      if part is not None]
         if self.flight_software is not None:
             assert self.control_period is not None  # checked in __post_init__
@@ -325,7 +356,7 @@ class Spacecraft(Model):
         if thrusters is not None:  # None: no thrusters
             programs.append(thrusters)
         for law in self.controller:
-            programs += law._programs(self.rate_inertia)
+            programs += law._programs(self._law_inertia)
         if isinstance(self.magnetic_field, DipoleField):
             assert self.orbit is not None  # a DipoleField needs an orbit: checked in __post_init__
             programs.append(_environment.dipole_program(self.orbit.elements(), self.magnetic_field.params()))
@@ -402,6 +433,10 @@ class Spacecraft(Model):
                 StateField("sensor_seed0", 1, "the seed of the sensors' noise, a whole number in [0, 2**53)",
                            default=np.array([float(self.flight_software.seed)])),
             ]
+        if self.flexible_modes is not None:
+            m = self.flexible_modes.count
+            fields += [StateField("eta0", m, f"initial modal coordinates η ({m}), kg^½·m", default=np.zeros(m)),
+                       StateField("eta_rate0", m, f"initial modal rates dη/dt ({m}), kg^½·m/s", default=np.zeros(m))]
         return tuple(fields)
 
     def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:
@@ -475,6 +510,11 @@ class Spacecraft(Model):
         if "attitude_error_integral0" in values:
             s = where("mrp_integral").s + _law_kernels.INTEGRAL
             y0[:, s:s + 3] = values["attitude_error_integral0"]
+        if self.flexible_modes is not None:
+            f = where("flexible_modes")
+            state = _flexible_modes.state_slices(f.n, f.s)
+            y0[:, state["modal_coordinate"]] = values["eta0"]
+            y0[:, state["modal_rate"]] = values["eta_rate0"]
         if self.flight_software is not None:
             check_seed(values["sensor_seed0"], "sensor_seed0")
             _fsw_initial_state(self.flight_software, values, y0, where("flight_software").s, float(t0))
@@ -582,18 +622,25 @@ class Spacecraft(Model):
             add("attitude_error_integral",
                 states[..., _law_kernels.integral_slices(integral.n, integral.s)["attitude_error_integral"]], ("xyz",),
                 "s", "integral of the MRP attitude error of the MRP feedback's integral term")
+        if self.flexible_modes is not None:
+            f = where("flexible_modes")
+            state = _flexible_modes.state_slices(f.n, f.s)
+            add("modal_coordinate", states[..., state["modal_coordinate"]], ("mode",), "kg^(1/2) m",
+                "modal coordinate eta_k of the appendages (mass-normalised)")
+            add("modal_rate", states[..., state["modal_rate"]], ("mode",), "kg^(1/2) m/s", "modal rate deta_k/dt")
         if self.flight_software is not None:
             s = where("flight_software").s
             self._estimation_outputs(add, states[..., s:s + _fsw_kernel.STATE], q)
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
             "torque of all parts on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper, "
-            "residual dipole, solar pressure, drag)")
+            "residual dipole, solar pressure, drag, flexible modes)")
         momentum_body = core(_kernel.AUX_MOMENTUM)
         energy = core(_kernel.AUX_ENERGY, 1)[..., 0]
         add("total_momentum_inertial", attitude.rotate(q, momentum_body), ("xyz",), "N m s",
-            "total angular momentum (hub, wheels, gyro rotors, damper), inertial axes")
+            "total angular momentum (hub, wheels, gyro rotors, damper, appendages), inertial axes")
         add("total_energy", energy, (), "J",
-            "kinetic energy of hub, wheels and damper (gyro rotors' constant spin energy excluded)")
+            "kinetic energy of hub, wheels and damper, and the appendages' kinetic and strain energy (gyro "
+            "rotors' constant spin energy excluded)")
         info = {} if self.control_period is None else {"control_period": self.control_period}
         return Outputs(q=q, omega=omega, inertia=self.total_inertia, extras=extras,
                        totals={"energy": energy, "momentum_body": momentum_body}, info=info)
@@ -632,14 +679,15 @@ class Spacecraft(Model):
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers, residual
         dipole, solar pressure or drag): the inertial angular momentum of the whole spacecraft; and, without
-        CMGs (whose ideal gimbal servos do work) or a damper (which dissipates), its energy less the work done
-        on the wheels by motors and bearings."""
+        CMGs (whose ideal gimbal servos do work), a damper or damped flexible modes (which dissipate), its
+        energy less the work done on the wheels by motors and bearings."""
         if (traj.info.get("torque") != "none" or self.gravity_gradient or self.thrusters
                 or self.magnetorquers is not None or self.residual_dipole is not None
                 or self.solar_pressure is not None or self.drag is not None):
             return {}
         out = {"momentum_inertial": traj.momentum_inertial}
-        if self.cmgs is None and self.damper is None:
+        damped = self.flexible_modes is not None and bool(np.any(self.flexible_modes.damping))
+        if self.cmgs is None and self.damper is None and not damped:
             if self.wheels:
                 out["energy_minus_wheel_work"] = traj.energy - traj.wheel_work
             else:

@@ -17,9 +17,9 @@ from numba import njit
 from tumble import _quat, torques
 from tumble._vec import cross, matvec_flat
 from tumble.kernels.spacecraft import (_commands, cmgs, damper, drag, environment, environment_table,
-                                      flight_software, laws, magnetorquers, residual_dipole, solar_pressure,
-                                      thrusters, wheels)
-from tumble.kernels.spacecraft._base import inline, lane, no_sample
+                                      flexible_modes, flight_software, laws, magnetorquers, residual_dipole,
+                                      solar_pressure, thrusters, wheels)
+from tumble.kernels.spacecraft._base import inline, lane, no_finish, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_TORQUE,
                                                HELD_WHEELS, J,
@@ -37,6 +37,7 @@ ACTUATORS = {
     "residual_dipole": lambda lane, direct: residual_dipole.kernel(lane),
     "solar_pressure": lambda lane, direct: solar_pressure.kernel(lane),
     "drag": lambda lane, direct: drag.kernel(lane),
+    "flexible_modes": lambda lane, direct: flexible_modes.kernel(lane),
 }
 
 # The empty sums (Numba's inliner takes no *args, so one per signature).
@@ -44,6 +45,7 @@ _no_momenta = inline(lambda model, y, j: (0.0, 0.0, 0.0))
 _no_energy = inline(lambda model, y, j: 0.0)
 _no_torques = inline(lambda model, t, y, j, out, aux, store, w1, w2, w3, cmd: (0.0, 0.0, 0.0))
 _no_samples = inline(lambda model, t, y, j: None)
+_no_finishes = inline(lambda model, y, j, out, a1, a2, a3: None)
 _none_discrete = inline(lambda model: False)
 
 
@@ -125,6 +127,27 @@ def _add_sample(previous, has, where, sample):
         if has(model):
             p, n, s, _ = where(model)
             sample(model, p, n, s, t, y, j)
+
+    return total
+
+
+def _finish_all(parts):
+    """The second phase of the actuators present that have one: each completes its state derivatives in
+    ``out`` from the hub's ``ω̇ = (a₁, a₂, a₃)``."""
+    total = _no_finishes
+    for _, (has, where), part in parts:
+        if part.finish is not no_finish:
+            total = _add_finish(total, has, where, part.finish)
+    return total
+
+
+def _add_finish(previous, has, where, finish):
+    @inline
+    def total(model, y, j, out, a1, a2, a3):
+        previous(model, y, j, out, a1, a2, a3)
+        if has(model):
+            p, n, s, _ = where(model)
+            finish(model, p, n, s, y, j, out, a1, a2, a3)
 
     return total
 
@@ -227,6 +250,7 @@ def _assembled(ndim, python, device):
     momenta, energies = _sum_momenta(actuators), _sum_energies(actuators)
     torques_on_hub = _sum_torques(actuators)
     sample_parts, discrete = _sample_all(actuators)
+    finish_parts = _finish_all(actuators)
     field, gravity, external = _environment(python)
     has_fsw, where_fsw = locator("flight_software")
     has_table, where_table = locator("environment_table")
@@ -282,6 +306,7 @@ def _assembled(ndim, python, device):
         put(out, 0, j, 0.5 * r[0])
         put3(out, 1, j, 0.5 * r[1], 0.5 * r[2], 0.5 * r[3])
         put3(out, 4, j, a1, a2, a3)
+        finish_parts(model, y, j, out, a1, a2, a3)
         law_rates(model, t, y, j, out, qw, qx, qy, qz)
         hold_rates(model, out, j)
         if store:

@@ -9,8 +9,8 @@ writes only: a row view would cost reference counting in every evaluation of
 the right-hand side.
 
 An actuator (or any part that carries angular momentum: wheels, gyros, a
-damper) is an :class:`Actuator` of four compiled functions with one signature
-each; :mod:`tumble.kernels.spacecraft` sums them over the parts present.
+damper, flexible modes) is an :class:`Actuator` of five compiled functions with one
+signature each; :mod:`tumble.kernels.spacecraft` sums them over the parts present.
 Every function receives the compiled model and the part's place in it: ``p``
 the offset of its parameter block in ``model.data``, ``n`` its count (wheels,
 gyros, thrusters), ``s`` the offset of its state slice, ``a`` that of its
@@ -29,8 +29,18 @@ diagnostics (see :data:`tumble.kernels.spacecraft.PARTS`)::
         ``cmd = (u₁, u₂, u₃, m₁, m₂, m₃, b₁, b₂, b₃, source)``: torque command
         (N·m), dipole command (A·m²) and magnetic field (T), body axes, and
         what the wheel-torque law left for the wheels' direct commands
+    finish(model, p, n, s, y, j, out, a₁, a₂, a₃)
+        completes the derivatives of its states in ``out`` once the hub's
+        ``ω̇ = (a₁, a₂, a₃)`` (rad/s², body axes) is known, for a part whose
+        states respond to the hub's acceleration (the flexible modes'
+        ``η̈_k = f_k − δ_k·ω̇``): ``act`` contributes first, ``finish`` follows
+        the hub's solve, as Basilisk's ``updateContributions`` and
+        ``computeDerivatives``
     sample(model, p, n, s, t, y, j)
         its discrete updates at the end of a step that ends at ``t`` (in place)
+
+The right-hand side calls, in order: every ``momentum`` (to form ``H``), every
+``act`` (the torques on the hub), the hub's solve for ``ω̇``, every ``finish``.
 """
 
 from __future__ import annotations
@@ -107,6 +117,11 @@ def no_sample(model, p, n, s, t, y, j):
     pass
 
 
+@inline
+def no_finish(model, p, n, s, y, j, out, a1, a2, a3):
+    pass
+
+
 class Actuator(NamedTuple):
     """The compiled functions of one part (see the module docstring); absent ones do nothing."""
 
@@ -114,6 +129,7 @@ class Actuator(NamedTuple):
     momentum: Callable = no_momentum
     energy: Callable = no_energy
     sample: Callable = no_sample
+    finish: Callable = no_finish
 
 
 class Program(NamedTuple):

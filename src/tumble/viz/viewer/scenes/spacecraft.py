@@ -13,6 +13,9 @@ Drawn from the :class:`tumble.spacecraft.Spacecraft` (its parts) and its traject
   ``Rot(g_i, δ) Z(s0_i)``, and its gimbal axis ``g_i`` as a line, just outside the hub along ``g_i``;
 * thruster ``i``: a plume from its position against its direction while ``thruster_firing`` is 1;
 * a residual dipole ``m``: a line from the centre of mass along ``m/|m|`` (body axes);
+* flexible mode ``k``: a line from the centre of mass along its participation axis ``δ_k/|δ_k|`` (body axes;
+  the appendages' geometry is not in the model) of length ``(1 + ½ η_k/max|η_k|)`` × its base length, so
+  that it swings with the mode;
 * with an orbit (or an environment): the nadir ``−r/|r|`` and the orbit normal ``r × v/|r × v|`` (inertial
   axes);
 * with an environment: the direction of the Sun ``ŝ`` (inertial axes), hidden while the craft is in the
@@ -45,6 +48,7 @@ _DISK = (0.22, 0.07)     # wheel and rotor disk radius and thickness, × the hub
 _OUTSIDE = 1.05          # a part without a position sits at this × the half-diagonal along its axis
 _PLUME = 0.5             # plume length, × the half-diagonal
 _DIPOLE = 1.3            # residual-dipole line length, × the half-diagonal
+_MODE = 1.2              # flexible-mode line base length, × the half-diagonal
 _SUN = 1.9               # Sun-direction line length in full sunlight, × the half-diagonal
 _NORMAL = 0.35           # facet-normal line length, × the half-diagonal
 
@@ -65,6 +69,22 @@ def _rotor(radius: float, thickness: float) -> tuple[Mesh, Mesh]:
     """A disk along z and its spoke (a bar along x standing proud of the disk's faces)."""
     spoke = box_mesh([radius, 0.25 * radius, 1.6 * thickness]).moved(np.eye(3), [0.5 * radius, 0.0, 0.0])
     return cylinder_mesh(radius, thickness), spoke
+
+
+def _modes(scene: Scene, participation: np.ndarray, eta: np.ndarray, R: np.ndarray, length: float) -> None:
+    """One line per flexible mode along ``δ_k/|δ_k|`` (body axes, turned by ``R``: (F, 3, 3)), of length
+    ``length (1 + ½ η_k/max|η_k|)`` at the frames (``eta``: (F, m))."""
+    peak = np.abs(eta).max(axis=0)
+    swing = 1.0 + 0.5 * np.divide(eta, peak, out=np.zeros_like(eta), where=peak > 0.0)
+    for k, delta in enumerate(participation):
+        norm = float(np.linalg.norm(delta))
+        if norm == 0.0:
+            continue
+        tips = length * swing[:, k, None] * np.einsum("fij,j->fi", R, delta / norm)
+        scene.lines.append(Lines(f"flexible mode {k + 1}", np.stack([np.zeros_like(tips), tips], axis=1),
+                                 "#bcbd22", width=4.0, markers=True))
+    scene.notes.append("flexible modes: a line along each participation axis δ_k/|δ_k| (the appendages' geometry "
+                       "is not in the model), its length swinging with the modal coordinate η_k/max|η_k|")
 
 
 def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: Options) -> Scene:
@@ -117,6 +137,8 @@ def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: 
         scene.lines.append(Lines("residual dipole", np.einsum("fij,pj->fpi", R, ends), "#9467bd", width=5.0,
                                  markers=True))
         scene.notes.append("residual dipole: its direction m/|m| from the centre of mass, fixed in the body")
+    if craft.flexible_modes is not None:
+        _modes(scene, craft.flexible_modes.participation, traj.modal_coordinate[idx], R, _MODE * half)
     facets = {id(f): f for part in (craft.solar_pressure, craft.drag) if part is not None for f in part.facets}
     for i, facet in enumerate(facets.values()):
         centre, normal = np.asarray(facet.centre), np.asarray(facet.normal)
