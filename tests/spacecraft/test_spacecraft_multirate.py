@@ -1,7 +1,7 @@
 """Control laws sampled at their own periods: B-dot at 1 s and MRP feedback at 0.1 s held apart (against an
 independent NumPy RK4 of the gyrostat that holds each command at its own sample times), every period equal to
 control_period (bit for bit the single-period spacecraft), the checks of a law's period, and a new period or law
-compiling nothing."""
+compiling nothing; the scenario files' ``period``."""
 
 import numpy as np
 import pytest
@@ -9,8 +9,11 @@ from numba.core import event
 
 import tumble
 from tumble.kernels import spacecraft as kernel
+from tumble.scenario import ScenarioError, parse
 from tumble.spacecraft import (BDot, FlightSoftware, Magnetorquers, MomentumDumping, MRPFeedback, QuaternionPD,
                                ReactionWheel, Spacecraft, WheelTorques, pyramid_wheels)
+
+from helpers import assert_same_run
 
 # Every test that simulates compiles the spacecraft's kernels on first use with a cold Numba cache (its assembled
 # right-hand side alone ~35 CPU s); the spacecraft's modules run on one xdist worker (tests/conftest.py, KINDS).
@@ -206,3 +209,64 @@ def test_a_new_period_or_law_compiles_nothing():
     assert [e.data["dispatcher"].py_func.__qualname__ for e in compiles.buffer if e.is_start] == []
     assert len(kernel.evaluate.signatures) == signatures
     assert _steps_of(traj.torque_command, 20)  # the new composition ran: the torque law held at 0.2 s
+
+
+# -- scenario files ------------------------------------------------------------------------------------------
+
+MULTIRATE_SCENARIO = f"""
+[spacecraft]
+inertia = {J_TOTAL.tolist()}
+[[spacecraft.wheels]]
+axis = [1, 0, 0]
+inertia = {SPIN}
+[[spacecraft.wheels]]
+axis = [0, 1, 0]
+inertia = {SPIN}
+[[spacecraft.wheels]]
+axis = [0, 0, 1]
+inertia = {SPIN}
+[spacecraft.magnetorquers]
+max_dipole = 1e6
+[spacecraft.magnetic_field]
+uniform = {B_INERTIAL.tolist()}
+[[spacecraft.controller]]
+kind = "mrp_feedback"
+K = {K_GAIN}
+P = {P_GAIN}
+target = {TARGET.tolist()}
+period = {TORQUE_PERIOD}
+[[spacecraft.controller]]
+kind = "bdot"
+gain = {BDOT_GAIN}
+period = {DIPOLE_PERIOD}
+[initial]
+omega = {OMEGA0.tolist()}
+q = {Q0.tolist()}
+[time]
+stop = {T_END}
+samples = {len(T)}
+[solver]
+method = "rk4"
+dt = {DT}
+"""
+
+
+def test_a_scenario_gives_each_law_its_period():
+    traj = parse(MULTIRATE_SCENARIO, source="multirate.toml").run()
+    assert_same_run(traj, tumble.simulate(_multirate(), omega0=OMEGA0, q0=Q0, t=T, method="rk4", dt=DT))
+
+
+@pytest.mark.parametrize("old, new, where, rule", [
+    (f"period = {DIPOLE_PERIOD}", "period = 0.0", "spacecraft.controller[1].period", "must be > 0"),
+    (f"period = {DIPOLE_PERIOD}", "period = 1.005", "spacecraft.controller[1].period",
+     "must be a whole number of steps dt = 0.01 s"),
+    ("[[spacecraft.controller]]\nkind = \"bdot\"", "[[spacecraft.controller]]\nkind = \"momentum_dumping\"\n"
+     "gain = 0.1\n[[spacecraft.controller]]\nkind = \"bdot\"", "spacecraft.controller[2].period",
+     "make one dipole command held at one period"),
+])
+def test_a_bad_period_in_a_scenario_names_its_key(old, new, where, rule):
+    text = MULTIRATE_SCENARIO.replace(old, new)
+    assert text != MULTIRATE_SCENARIO
+    with pytest.raises(ScenarioError) as info:
+        parse(text, source="multirate.toml").run()
+    assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems
