@@ -19,7 +19,7 @@ to ``J_ω = J − Σ I_s a aᵀ − J_d E`` (the rotors' spin inertias and the s
 are carried by their own states). The equations are those of
 :mod:`tumble.kernels.spacecraft`, one file per actuator.
 
-One class, one unit (about 630 lines): its checks, its compiled parts, its
+One class, one unit (about 700 lines): its checks, its compiled parts, its
 initial state and its named outputs each read the same list of parts, and
 what each part adds to them is a few lines beside the others.
 """

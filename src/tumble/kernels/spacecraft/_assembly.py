@@ -211,8 +211,9 @@ def assemble(ndim, python, device=False):
     read the truth; ``due(model, t)`` the discrete updates due at the step end ``t`` (bits: the law groups
     sampled there, :data:`CONTROL_SAMPLE` at a sample of ``control_period``, :data:`PART_UPDATES` for the parts'
     updates, at the control samples with a ``control_period``, else after every step; 0: none);
-    ``sample(model, t, y, j, updates)`` applies those ``updates`` (the held commands, the PWPF triggers); ``device``: the variant
-    compiled for a GPU, without the flight software. Cached, so that the right-hand side, the projection and the diagnostics share it."""
+    ``sample(model, t, y, j, updates)`` applies those ``updates`` (the held commands, the PWPF triggers);
+    ``device``: the variant compiled for a GPU, without the flight software. Cached, so that the right-hand side,
+    the projection and the diagnostics share it."""
     return _assembled(int(ndim), bool(python), bool(device))
 
 
