@@ -133,6 +133,19 @@ def test_a_law_with_a_period_is_held_while_the_others_stay_continuous():
     assert _steps_of(traj.dipole_command, round(DIPOLE_PERIOD / DT)) and _steps_of(traj.torque_command, 1)
 
 
+def test_a_wheel_torque_law_is_held_at_its_own_period():
+    """A ramp of motor torques sampled every 0.05 s: each wheel's motor torque is the ramp's value at the last
+    sample, to the rounding of the interpolation (no torque law and no limits: the motor torque is the command)."""
+    ramp = WheelTorques([[0.0, 1e-3, -2e-3, 0.0], [4e-3, -1e-3, 0.0, 2e-3]], t=[0.0, 1.0], period=0.05)
+    craft = Spacecraft(inertia=J_TOTAL, wheels=pyramid_wheels(SPIN), controller=ramp)
+    t = np.linspace(0.0, 1.0, 101)
+    traj = tumble.simulate(craft, omega0=OMEGA0, t=t, method="rk4", dt=DT)
+    sampled = t[(np.arange(t.size) // 5) * 5]  # the last sample time 0.05 k at or before each output time
+    expected = np.array([np.interp(sampled, ramp.t, ramp.torques[:, i]) for i in range(4)]).T
+    assert _steps_of(traj.wheel_torque, 5)
+    np.testing.assert_allclose(traj.wheel_torque, expected, rtol=0, atol=1e-17)  # 10 ulp of 4e-3 N m
+
+
 @pytest.mark.parametrize("control_period", [None, 0.5])
 def test_every_period_equal_to_control_period_is_the_single_period_spacecraft_bit_for_bit(control_period):
     single = tumble.simulate(_multirate(None, None, control_period=0.5), omega0=OMEGA0, q0=Q0, t=T, method="rk4",
