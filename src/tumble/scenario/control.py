@@ -22,6 +22,10 @@ builds (SI units, body axes; the equations are there and in
                        row per time, ``interpolation`` ``"linear"`` or ``"previous"``
 =====================  =====================================================================
 
+Every law takes ``period`` (s, > 0): its own sample period, its command held
+in between; omitted, the spacecraft's ``control_period`` (continuous without
+one). See ``docs/spacecraft.md``, "Laws at their own rates".
+
 The target of the regulators is an attitude (body → inertial): ``target``, a
 quaternion ``[w, x, y, z]``, or ``target_euler``, Euler angles as in
 ``[initial]``'s ``euler`` (default: the identity). Python laws are code and
@@ -44,7 +48,13 @@ from tumble.spacecraft import control
 __all__ = ["Controller", "Regulator"]
 
 
-class Regulator(_Table):
+class _Law(_Table):
+    """A control law: ``period``, its own sample period (s, > 0), or the spacecraft's ``control_period``."""
+
+    period: _Positive | None = None
+
+
+class Regulator(_Law):
     """A law that regulates the attitude to a target: ``target`` (quaternion ``[w, x, y, z]``, body → inertial)
     or ``target_euler`` (Euler angles, degrees by default), not both; default the identity."""
 
@@ -81,7 +91,7 @@ class PDTable(Regulator):
 
     def build(self) -> control.QuaternionPD:
         return control.QuaternionPD(self.natural_frequency, self.damping_ratio, target=self.target_quaternion(),
-                                    max_rate=self.max_rate, max_torque=self.max_torque)
+                                    max_rate=self.max_rate, max_torque=self.max_torque, period=self.period)
 
 
 class MRPTable(Regulator):
@@ -95,43 +105,43 @@ class MRPTable(Regulator):
     Ki: _Positive | None = None
 
     def build(self) -> control.MRPFeedback:
-        return control.MRPFeedback(self.K, self.P, Ki=self.Ki, target=self.target_quaternion())
+        return control.MRPFeedback(self.K, self.P, Ki=self.Ki, target=self.target_quaternion(), period=self.period)
 
 
-class RateDampingTable(_Table):
+class RateDampingTable(_Law):
     kind: Literal["rate_damping"]
     time_constant: _Positive
     max_torque: _Limit = math.inf
 
     def build(self) -> control.RateDamping:
-        return control.RateDamping(self.time_constant, self.max_torque)
+        return control.RateDamping(self.time_constant, self.max_torque, period=self.period)
 
 
-class ConstantTorqueTable(_Table):
+class ConstantTorqueTable(_Law):
     kind: Literal["constant_torque"]
     torque: _Vector
 
     def build(self) -> control.ConstantTorque:
-        return control.ConstantTorque(cast(Any, self.torque))  # array_like: the law converts it
+        return control.ConstantTorque(cast(Any, self.torque), period=self.period)  # array_like: converted there
 
 
-class BDotTable(_Table):
+class BDotTable(_Law):
     kind: Literal["bdot"]
     gain: _Positive
 
     def build(self) -> control.BDot:
-        return control.BDot(self.gain)
+        return control.BDot(self.gain, period=self.period)
 
 
-class DumpingTable(_Table):
+class DumpingTable(_Law):
     kind: Literal["momentum_dumping"]
     gain: _Positive
 
     def build(self) -> control.MomentumDumping:
-        return control.MomentumDumping(self.gain)
+        return control.MomentumDumping(self.gain, period=self.period)
 
 
-class WheelTorquesTable(_Table):
+class WheelTorquesTable(_Law):
     """Motor torques commanded to the wheels directly (N m, in the order of the wheels): ``torques`` one per
     wheel, constant; or ``times`` (s, strictly increasing) and ``torques`` one row per time, interpolated
     ``"linear"`` (default) or ``"previous"`` (zero-order hold), the end rows held outside."""
@@ -151,8 +161,8 @@ class WheelTorquesTable(_Table):
         return interpolation
 
     def build(self) -> control.WheelTorques:
-        return control.WheelTorques(self.torques, self.times, **({} if self.interpolation is None else
-                                                                  {"interpolation": self.interpolation}))
+        return control.WheelTorques(self.torques, self.times, period=self.period,
+                                    **({} if self.interpolation is None else {"interpolation": self.interpolation}))
 
 
 #: One ``[[spacecraft.controller]]`` entry, chosen by ``kind``.

@@ -408,7 +408,8 @@ class SpacecraftScenario(Scenario):
             craft = self.spacecraft.build()
             self._check_gravity_gradient_once()
             torque = build_torque(self.torque, craft.body)
-            keys = {**self.initial.argument_keys("initial"), **RUN_KEYS}
+            # a law's period the run refuses (a step that does not divide it) is reported against its table
+            keys = {**self.initial.argument_keys("initial"), **RUN_KEYS, "controller": "spacecraft.controller"}
             with keyed(keys, "initial"):
                 initial = self.initial.state()
             return Run(craft, initial, self.time.times(), self.solver.method, self.solver.options(), torque, keys,

@@ -39,6 +39,12 @@ The laws (body axes, SI units):
 * :class:`WheelTorques`: motor torques commanded to the wheels directly, one
   per wheel (N·m): a constant, samples in time, or a Python function.
 
+Every law takes ``period``, its own sample period (s): its command is
+computed at ``t₀ + k·period`` and held in between (zero-order hold). The
+default None samples it at the spacecraft's ``control_period`` (continuous
+without one). The dipole laws add into one dipole command and share one
+period (``docs/spacecraft.md``, "Laws at their own rates").
+
 ``H`` is the spacecraft's angular momentum in body axes (hub, wheels, gyros,
 damper). ``J`` is the inertia the body rate answers to: the total inertia less
 the wheels' spin inertias and the damper sphere (see ``docs/spacecraft.md``).
@@ -62,6 +68,17 @@ __all__ = ["QuaternionPD", "MRPFeedback", "RateDamping", "ConstantTorque", "BDot
            "WheelTorques", "TORQUE_LAWS", "DIPOLE_LAWS"]
 
 
+def _period(value) -> float | None:
+    """A law's own sample period: None (the spacecraft's ``control_period``) or a finite number > 0, s."""
+    if value is None:
+        return None
+    try:
+        return require_positive(value, "period")
+    except ValidationError:
+        raise ValidationError(f"period: must be None (the spacecraft's control_period) or a finite number > 0 "
+                              f"(s), got {value!r}") from None
+
+
 def _quaternion(value, name: str) -> np.ndarray:
     q = as_array(value, name, tail=(4,))
     if q.shape != (4,) or np.linalg.norm(q) == 0.0:
@@ -75,7 +92,8 @@ class QuaternionPD:
 
     natural_frequency : ω_n, rad/s; damping_ratio : ζ (> 0);
     max_rate : eigen-axis slew rate limit, rad/s (``math.inf``: none);
-    max_torque : limit on each component of the commanded torque, N·m (``math.inf``: none).
+    max_torque : limit on each component of the commanded torque, N·m (``math.inf``: none);
+    period : its sample period, s (None: the spacecraft's ``control_period``).
     """
 
     natural_frequency: float
@@ -83,9 +101,11 @@ class QuaternionPD:
     target: np.ndarray = (1.0, 0.0, 0.0, 0.0)  # type: ignore[assignment]  # array_like: __post_init__ converts
     max_rate: float = math.inf
     max_torque: float = math.inf
+    period: float | None = None
 
     def __post_init__(self):
         set_ = object.__setattr__
+        set_(self, "period", _period(self.period))
         set_(self, "natural_frequency", require_positive(self.natural_frequency, "natural_frequency"))
         set_(self, "damping_ratio", require_positive(self.damping_ratio, "damping_ratio"))
         set_(self, "target", _quaternion(self.target, "target"))
@@ -114,6 +134,7 @@ class MRPFeedback:
         ``∫σ dt`` is a state (``attitude_error_integral``, initial value ``attitude_error_integral0``,
         default 0), integrated continuously also when the controller is sampled
     target : commanded attitude, unit quaternion ``[w, x, y, z]``, body → inertial
+    period : its sample period, s (None: the spacecraft's ``control_period``)
 
     ``J`` (in ``z``) and ``H`` are the spacecraft's: the inertia its rate answers to and its
     angular momentum (hub, wheels, gyros), body axes.
@@ -123,9 +144,11 @@ class MRPFeedback:
     P: object
     Ki: float | None = None
     target: np.ndarray = (1.0, 0.0, 0.0, 0.0)  # type: ignore[assignment]  # array_like: __post_init__ converts
+    period: float | None = None
 
     def __post_init__(self):
         set_ = object.__setattr__
+        set_(self, "period", _period(self.period))
         set_(self, "K", require_positive(self.K, "K"))
         p = as_array(self.P, "P")
         if p.shape == ():
@@ -147,12 +170,15 @@ class MRPFeedback:
 
 @dataclass(frozen=True)
 class RateDamping:
-    """Rate damping ``u = −J ω/τ + ω × H``: every rate decays as ``e^{−t/τ}``; ``time_constant`` τ, s."""
+    """Rate damping ``u = −J ω/τ + ω × H``: every rate decays as ``e^{−t/τ}``; ``time_constant`` τ, s;
+    ``period`` its sample period, s (None: the spacecraft's ``control_period``)."""
 
     time_constant: float
     max_torque: float = math.inf
+    period: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "period", _period(self.period))
         object.__setattr__(self, "time_constant", require_positive(self.time_constant, "time_constant"))
         object.__setattr__(self, "max_torque", _limit(self.max_torque, "max_torque"))
 
@@ -165,11 +191,14 @@ class RateDamping:
 @dataclass(frozen=True)
 class ConstantTorque:
     """An open-loop torque command ``u = torque`` (N·m, body axes), for actuator studies (e.g. the
-    pulse train a PWPF modulator makes of a constant command)."""
+    pulse train a PWPF modulator makes of a constant command); ``period`` its sample period, s (None: the
+    spacecraft's ``control_period``)."""
 
     torque: np.ndarray
+    period: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "period", _period(self.period))
         u = as_array(self.torque, "torque", tail=(3,))
         if u.shape != (3,):
             raise ValidationError(f"torque: must have shape (3,), got {u.shape}")
@@ -182,11 +211,14 @@ class ConstantTorque:
 
 @dataclass(frozen=True)
 class BDot:
-    """B-dot detumbling with magnetorquers: ``m = −k Ḃ = k ω × B``; ``gain`` k in A·m²·s/T."""
+    """B-dot detumbling with magnetorquers: ``m = −k Ḃ = k ω × B``; ``gain`` k in A·m²·s/T; ``period`` its
+    sample period, s (None: the spacecraft's ``control_period``)."""
 
     gain: float
+    period: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "period", _period(self.period))
         object.__setattr__(self, "gain", require_positive(self.gain, "gain"))
 
     def _programs(self, rate_inertia) -> tuple[Program, ...]:
@@ -195,11 +227,14 @@ class BDot:
 
 @dataclass(frozen=True)
 class MomentumDumping:
-    """Wheel momentum dumping with magnetorquers: ``m = k (h × B)/|B|²``; ``gain`` k in 1/s."""
+    """Wheel momentum dumping with magnetorquers: ``m = k (h × B)/|B|²``; ``gain`` k in 1/s; ``period`` its
+    sample period, s (None: the spacecraft's ``control_period``)."""
 
     gain: float
+    period: float | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "period", _period(self.period))
         object.__setattr__(self, "gain", require_positive(self.gain, "gain"))
 
     def _programs(self, rate_inertia) -> tuple[Program, ...]:
@@ -216,15 +251,17 @@ class PythonLaw:
     the hub, 3 numbers (N·m, body axes), delivered by the spacecraft's
     actuators as a compiled law's is. It is called back from the compiled
     integrator through :mod:`tumble._callback`: a few microseconds per call,
-    four calls per RK4 step (once per sample with a ``control_period``), and a
-    batch runs on one core. A plain callable given as a controller is wrapped
-    in this class.
+    four calls per RK4 step (once per sample when sampled: ``period``, s, or
+    the spacecraft's ``control_period`` when None), and a batch runs on one
+    core. A plain callable given as a controller is wrapped in this class.
     """
 
     function: object
+    period: float | None = None
     callback: _callback.Callback = field(init=False, repr=False)  # registered per process
 
     def __post_init__(self):
+        object.__setattr__(self, "period", _period(self.period))
         object.__setattr__(self, "callback", _callback.Callback(
             self.function, field="controller", signature="(t, q, omega, wheel_speeds)",
             returns="3 finite numbers (torque command, body axes, N·m)"))
@@ -242,14 +279,17 @@ class WheelTorques:
         interpolated ``"linear"`` or ``"previous"`` (zero-order hold), the end values held outside; or a
         Python function ``torques(t, q, omega, wheel_speeds) -> (n_w,)`` (Python speed, one core; see
         :class:`PythonLaw`)
+    period : its sample period, s (None: the spacecraft's ``control_period``)
     """
 
     torques: Any  # a function of time, or samples (len(t), n_w) or (n_w,): an array (len(t), n_w) once validated
     t: object = None
     interpolation: str = "linear"
+    period: float | None = None
     callback: _callback.Callback | None = field(init=False, repr=False, default=None)  # a function's, per process
 
     def __post_init__(self):
+        object.__setattr__(self, "period", _period(self.period))
         if self.interpolation not in ("linear", "previous"):
             raise ValidationError(f"interpolation: must be 'linear' or 'previous', got {self.interpolation!r}")
         if callable(self.torques):

@@ -20,7 +20,7 @@ to ``J_ω = J − Σ I_s a aᵀ − J_d E − Σ δ_k δ_kᵀ`` (the rotors' spi
 sphere and the appendages' modal participation are carried by their own states). The equations are those of
 :mod:`tumble.kernels.spacecraft`, one file per actuator.
 
-One class, one unit (about 700 lines): its checks, its compiled parts, its
+One class, one unit (about 770 lines): its checks, its compiled parts, its
 initial state and its named outputs each read the same list of parts, and
 what each part adds to them is a few lines beside the others.
 """
@@ -41,6 +41,7 @@ from tumble import attitude, integrate, torques
 from tumble._validate import ValidationError, as_array
 from tumble.rigid_body import RigidBody
 from tumble.kernels import spacecraft as _kernel
+from tumble.kernels.spacecraft import _commands
 from tumble.kernels.spacecraft import cmgs as _cmgs
 from tumble.kernels.spacecraft import drag as _drag
 from tumble.kernels.spacecraft import damper as _damper_kernel
@@ -114,8 +115,11 @@ class Spacecraft(Model):
     controller : a law or a sequence of laws: at most one torque law (:class:`QuaternionPD`,
         :class:`MRPFeedback`, :class:`RateDamping`, :class:`ConstantTorque`, or a Python callable
         ``u = law(t, q, omega, wheel_speeds)``, i.e. a :class:`PythonLaw`), one of each dipole law
-        (:class:`BDot`, :class:`MomentumDumping`) and one :class:`WheelTorques`
-    control_period : None (continuous) or the sample period of a zero-order-hold controller, s
+        (:class:`BDot`, :class:`MomentumDumping`) and one :class:`WheelTorques`; a law's ``period`` (s) samples
+        it at its own rate (the dipole laws share one; with the torque delivered by the magnetorquers, the
+        torque law's too; with flight software, a whole multiple of ``control_period``)
+    control_period : None (continuous) or the sample period of a zero-order-hold controller, s: that of every
+        law without a ``period`` of its own
     flight_software : :class:`~tumble.spacecraft.flight_software.FlightSoftware` or None: gyro, star tracker
         and direction sensors at their own rates, the MEKF at the control period (needed), the control law fed
         the estimate instead of the truth
@@ -202,6 +206,7 @@ class Spacecraft(Model):
             set_(self, "control_period", value)
         self._check_flight_software()
         self._check_flexible_modes()
+        self._check_law_periods()
 
     # -- description -------------------------------------------------------------------
 
@@ -249,6 +254,56 @@ class Spacecraft(Model):
             raise ValidationError(f"flexible_modes: J_ω = J − Σ I_s a aᵀ − J_d E − Σ δ_k δ_kᵀ must be positive "
                                   f"definite (the appendages cannot carry more inertia than the whole body); its "
                                   f"smallest eigenvalue is {smallest:.6g} kg m^2")
+
+    def _check_law_periods(self) -> None:
+        """The laws' own periods: with flight software, a whole multiple of ``control_period`` (a law due then
+        reads the estimate of its sample time); the dipole laws, and the torque law when the magnetorquers
+        deliver its torque, make one dipole command, held at one period."""
+        for i, law in enumerate(self.controller):
+            if law.period is not None and self.flight_software is not None:
+                assert self.control_period is not None  # the flight software needs one: checked before
+                ratio = law.period / self.control_period
+                if ratio < 1.0 - _WHOLE or abs(ratio - round(ratio)) > _WHOLE * ratio:
+                    raise ValidationError(f"controller[{i}].period: with flight software a law's period must be a "
+                                          f"whole multiple of control_period = {self.control_period} s (the law "
+                                          f"reads the estimate of its sample time), got {law.period} s")
+        one_dipole = [(i, law) for i, law in enumerate(self.controller) if isinstance(law, DIPOLE_LAWS) or (
+            isinstance(law, TORQUE_LAWS) and self._torque_by_magnetorquers)]
+        for i, law in one_dipole[1:]:
+            first, period = self._law_period(one_dipole[0][1]), self._law_period(law)
+            if period != first:
+                k = i if law.period is not None else one_dipole[0][0]
+                raise ValidationError(
+                    f"controller[{k}].period: the dipole laws, and the torque law when the magnetorquers deliver "
+                    f"its torque, make one dipole command held at one period; got {_seconds(first)} and "
+                    f"{_seconds(period)}")
+
+    def _law_period(self, law) -> float | None:
+        """The sample period of ``law`` (s): its own, else ``control_period``; None: continuous."""
+        return self.control_period if law.period is None else law.period
+
+    @property
+    def _torque_by_magnetorquers(self) -> bool:
+        return self.route == "magnetorquers" and self._torque_law() is not None
+
+    @property
+    def _sampled(self) -> bool:
+        """Some law is held between samples: a ``control_period`` or a law's own ``period``."""
+        return self.control_period is not None or any(law.period is not None for law in self.controller)
+
+    def _group_periods(self) -> tuple[float, float, float]:
+        """The sample periods (s; 0: continuous) of the torque law, the dipole laws and the wheel-torque law,
+        a group without a law at ``control_period`` (the dipole laws' at the torque law's when the
+        magnetorquers deliver its torque)."""
+
+        def period(kinds, default: float) -> float:
+            law = next((law for law in self.controller if isinstance(law, kinds)), None)
+            return default if law is None else self._law_period(law) or 0.0
+
+        control = self.control_period or 0.0
+        torque = period(TORQUE_LAWS, control)
+        return torque, period(DIPOLE_LAWS, torque if self._torque_by_magnetorquers else control), period(
+            (WheelTorques,), control)
 
     @property
     def _has_field(self) -> bool:
@@ -333,9 +388,8 @@ class Spacecraft(Model):
         """The programs of the parts (:mod:`tumble.kernels.spacecraft`), in no particular order."""
         programs = []
         wheel_law = any(isinstance(law, WheelTorques) for law in self.controller)
-        if self.control_period is not None:
-            n = len(self.wheels) if wheel_law else 0
-            programs.append(Program("hold", np.zeros(0), count=n, state=_kernel.HELD_WHEELS + n))
+        if self._sampled:
+            programs.append(_commands.hold_program(*self._group_periods(), len(self.wheels) if wheel_law else 0))
         if self.wheels:
             axes = np.array([w.axis for w in self.wheels])
             routed = self.route == "wheels" and self._torque_law() is not None
@@ -440,21 +494,30 @@ class Spacecraft(Model):
         return tuple(fields)
 
     def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:
-        """A sampled controller needs a fixed-step method (rk4, cf4) whose step divides the control period and
-        every output interval, so that steps end on the sample times (where the projection updates the held
-        commands). Which methods apply at all is the kernel's to declare (``provides``)."""
+        """A sampled controller needs a fixed-step method (rk4, cf4) whose step divides the control period, each
+        law's own period and every output interval, so that steps end on the sample times (where the projection
+        updates the held commands). Which methods apply at all is the kernel's to declare (``provides``)."""
         if self.environment is not None:
             self.environment.check_times(t)
         period = self.control_period
-        if period is None:
+        own = [(f"controller[{i}].period", law.period) for i, law in enumerate(self.controller)
+               if law.period is not None]
+        clocks = ([] if period is None else [("control_period", period)]) + own
+        if not clocks:
             return
         if method.adaptive or dt is None:  # dt is None: a method with no step ("exact")
-            raise ValidationError(f"method: a sampled controller (control_period = {period} s) needs a fixed-step "
-                                  f"method ('rk4', 'cf4'), whose steps land on the sample times; got {method.name!r}")
-        ratio = period / dt
-        if abs(ratio - round(ratio)) > _WHOLE * ratio:
-            raise ValidationError(f"dt: must divide control_period = {period} s into whole steps, got dt = {dt} "
-                                  f"({ratio:.6g} steps)")
+            raise ValidationError(f"method: a sampled controller ({clocks[0][0]} = {clocks[0][1]} s) needs a "
+                                  f"fixed-step method ('rk4', 'cf4'), whose steps land on the sample times; got "
+                                  f"{method.name!r}")
+        for name, clock in clocks:
+            ratio = clock / dt
+            if abs(ratio - round(ratio)) <= _WHOLE * ratio:
+                continue
+            if name == "control_period":
+                raise ValidationError(f"dt: must divide control_period = {clock} s into whole steps, got dt = {dt} "
+                                      f"({ratio:.6g} steps)")
+            raise ValidationError(f"{name}: must be a whole number of steps dt = {dt} s (the law's samples fall "
+                                  f"on the steps), got {clock} s ({ratio:.6g} steps)")
         if self.flight_software is not None:
             for sensor, (sensor_period, _, _) in zip(_fsw_kernel.SENSORS, self.flight_software.clocks(period)):
                 ratio = sensor_period / dt
@@ -588,7 +651,7 @@ class Spacecraft(Model):
             add("pwpf_filter", states[..., state["pwpf_filter"]], ("xyz",), "1", "PWPF filter outputs of the axes")
         if self._torque_law() is not None:
             add("torque_command", core(_kernel.AUX_TORQUE_COMMAND), ("xyz",), "N m",
-                "controller torque command, body axes (the held value with a control period)")
+                "controller torque command, body axes (the held value when the torque law is sampled)")
         if self.magnetorquers is not None:
             m = where("magnetorquers")
             add("dipole_command", core(_kernel.AUX_DIPOLE_COMMAND), ("xyz",), "A m2",
@@ -693,6 +756,10 @@ class Spacecraft(Model):
             else:
                 out["energy"] = traj.energy
         return out
+
+
+def _seconds(period: float | None) -> str:
+    return "continuous" if period is None else f"{period} s"
 
 
 def _check_type(value, cls, name):

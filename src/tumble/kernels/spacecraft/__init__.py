@@ -35,7 +35,8 @@ gravity gradient plus the external torque program of ``torque=``
 dipole ``m_c`` (A·m²), motor torques of the wheels — are evaluated in the
 right-hand side (continuous control) or, with a ``"hold"`` part, at the
 sample times ``t₀ + k·period`` in :func:`tumble._protocol.project` and held
-in the state (zero-order hold). The torque command goes to the actuator
+in the state (zero-order hold), each group of laws at its own period
+(:mod:`._commands`). The torque command goes to the actuator
 ``route`` (a kind index of :data:`PARTS`; −1: none).
 
 The diagnostics of one sample (:func:`evaluate`) start with the core block
@@ -58,11 +59,11 @@ from numba.extending import overload
 
 from tumble import _protocol, torques
 from tumble.kernels.spacecraft._assembly import assemble as _assemble
-from tumble.kernels.spacecraft._base import SAMPLE_TOLERANCE, Program, inline
+from tumble.kernels.spacecraft._base import Program, inline
 from tumble.kernels.spacecraft._layout import (ABSENT, AUX_ACTUATOR, AUX_CORE, AUX_DIPOLE_COMMAND, AUX_ENERGY,
                                                AUX_EXTERNAL, AUX_FIELD, AUX_GRAVITY, AUX_MOMENTUM,
                                                AUX_TORQUE_COMMAND, CORE_FIELDS, HELD_WHEELS, HUB_SIZE, PARTS,
-                                               PERIOD, START, Slices, locator, pack, unpack)
+                                               Slices, pack, unpack)
 
 __all__ = ["AUX_ACTUATOR", "AUX_DIPOLE_COMMAND", "AUX_ENERGY", "AUX_EXTERNAL", "AUX_FIELD", "AUX_GRAVITY",
            "AUX_MOMENTUM", "AUX_TORQUE_COMMAND", "HELD_WHEELS", "PARTS", "Program", "Slices", "SpacecraftModel",
@@ -193,8 +194,7 @@ def _project(device):
     without the flight software (refused there: ``gpu_refusal``)."""
 
     def typer(model, b0, t, Y):
-        _, sense, sample, discrete = _assemble(Y.ndim, _python(model), device)
-        has_hold, _ = locator("hold")
+        _, sense, sample, due = _assemble(Y.ndim, _python(model), device)
         if Y.ndim == 1:
             normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
         else:
@@ -204,15 +204,10 @@ def _project(device):
             normalize(Y)
             for j in range(lanes(Y)):  # the flight software's sensors read at their own sample times
                 sense(model, t, Y, j)
-            if has_hold(model):  # a zero-order hold samples at t₀ + k·period
-                period, start = model.data[PERIOD], model.data[START]
-                k = round((t - start) / period)
-                if abs(t - start - k * period) <= SAMPLE_TOLERANCE * period:
-                    for j in range(lanes(Y)):
-                        sample(model, t, Y, j)
-            elif discrete(model):  # parts with discrete states update after every step
+            updates = due(model, t)  # the laws held at their sample times t₀ + k·period, the parts' updates
+            if updates:
                 for j in range(lanes(Y)):
-                    sample(model, t, Y, j)
+                    sample(model, t, Y, j, updates)
         return impl
 
     return typer
@@ -254,12 +249,12 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sense, sample, _ = _assemble(1, _python(model))
+    _, sense, sample, due = _assemble(1, _python(model))
 
     def impl(model, t, y):
         for j in range(1):  # j an int64, as in the projection: a literal 0 would compile these once more
             sense(model, t, y, j)
-            sample(model, t, y, j)
+            sample(model, t, y, j, due(model, t))
 
     return impl
 

@@ -23,7 +23,11 @@ from tumble.kernels.spacecraft._base import inline, lane, no_finish, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_TORQUE,
                                                HELD_WHEELS, J,
-                                               J_RATE, J_RATE_INV, PARTS, PERIOD, locator)
+                                               J_RATE, J_RATE_INV, PARTS, PERIOD, START, locator)
+
+#: The discrete updates due at a step end, besides the law groups due (bits of ``_commands.ALL_LAWS``): a sample
+#: time of ``control_period`` (the flight software's estimate), and the parts' own updates (the PWPF triggers).
+CONTROL_SAMPLE, PART_UPDATES = 8, 16
 
 #: The actuators (parts that carry momentum or exert torque on the hub), each ``kernel(lane, direct)`` of its
 #: state access (:func:`~tumble.kernels.spacecraft._base.lane`) and the motor torques commanded directly to the
@@ -219,7 +223,7 @@ def _no_sensing(model, t, y, j):
 
 
 def assemble(ndim, python, device=False):
-    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, discrete)``; ``python``: the
+    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, due)``; ``python``: the
     variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
     which then allocates nothing, is compiled without reference counting: the
     runtime tests of the parts split the refcount pairs of the model's arrays over branches that Numba's
@@ -227,10 +231,12 @@ def assemble(ndim, python, device=False):
     ``derivative(model, t, y, j, out, aux, store)`` writes ``dy/dt`` of the member in lane ``j`` of the block
     ``y`` (or of the state vector ``y``, ``ndim`` 1) into ``out`` and, when ``store``, its diagnostics into
     ``aux``; ``sense(model, t, y, j)`` lets the flight software's sensors whose sample time is the step end ``t``
-    read the truth; ``sample(model, t, y, j)`` applies the discrete updates of a sample time (the held commands, the
-    PWPF triggers); ``discrete(model)`` is True when a part present updates after every step (without a
-    zero-order hold, which samples at its own times); ``device``: the variant compiled for a GPU, without the
-    flight software. Cached, so that the right-hand side, the projection and the diagnostics share it."""
+    read the truth; ``due(model, t)`` the discrete updates due at the step end ``t`` (bits: the law groups
+    sampled there, :data:`CONTROL_SAMPLE` at a sample of ``control_period``, :data:`PART_UPDATES` for the parts'
+    updates, at the control samples with a ``control_period``, else after every step; 0: none);
+    ``sample(model, t, y, j, updates)`` applies those ``updates`` (the held commands, the PWPF triggers);
+    ``device``: the variant compiled for a GPU, without the flight software. Cached, so that the right-hand side,
+    the projection and the diagnostics share it."""
     return _assembled(int(ndim), bool(python), bool(device))
 
 
@@ -243,6 +249,7 @@ def _assembled(ndim, python, device):
     direct = _commands.make_direct(access)
     commands = _commands.controller(access, python)
     held, hold = _commands.zero_order_hold(access, direct)
+    live, laws_due = _commands.law_clocks()
     has_hold, where_hold = locator("hold")
     has_integral, where_integral = locator("mrp_integral")
     _, where_mrp = locator("mrp")
@@ -258,10 +265,14 @@ def _assembled(ndim, python, device):
 
     @inline
     def controller_commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
-        """The commands in force: held from the last sample time, or the laws' now."""
+        """The commands in force: those of the sampled law groups held from their last sample time, the
+        others' now."""
         if has_hold(model):
-            return held(model, y, j)
-        return commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3)
+            u1, u2, u3, m1, m2, m3, source = held(model, y, j)
+            return commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3, live(model),
+                            u1, u2, u3, m1, m2, m3, source)
+        return commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3, _commands.ALL_LAWS,
+                        0.0, 0.0, 0.0, 0.0, 0.0, 0.0, (_commands.NO_WHEEL_LAW, 0, 0, model.data))
 
     @inline
     def law_rates(model, t, y, j, out, qw, qx, qy, qz):
@@ -368,20 +379,37 @@ def _assembled(ndim, python, device):
                 return fsw_pend(model, p, s, y, j, u1, u2, u3, m1, m2, m3)
             return False
 
-    @njit
-    def sample(model, t, y, j):
+    @inline
+    def due(model, t):
+        d = model.data
+        bits = 0
+        if d[PERIOD] > 0.0:
+            if _commands.on_clock(t, d[START], d[PERIOD]):
+                bits = CONTROL_SAMPLE | PART_UPDATES
+        elif discrete(model):  # parts with discrete states update after every step
+            bits = PART_UPDATES
         if has_hold(model):
+            bits |= laws_due(model, t)
+        return bits
+
+    @njit
+    def sample(model, t, y, j, updates):
+        if updates & (CONTROL_SAMPLE | _commands.ALL_LAWS):
             qw, qx, qy, qz = at(y, 0, j), at(y, 1, j), at(y, 2, j), at(y, 3, j)
             w1, w2, w3 = at(y, 4, j), at(y, 5, j), at(y, 6, j)
             b1, b2, b3 = field(model, t, qw, qx, qy, qz)
-            qw, qx, qy, qz, w1, w2, w3 = estimate(model, t, y, j, qw, qx, qy, qz, w1, w2, w3)
+            if updates & CONTROL_SAMPLE:  # the laws due read the estimate (their periods: multiples of control's)
+                qw, qx, qy, qz, w1, w2, w3 = estimate(model, t, y, j, qw, qx, qy, qz, w1, w2, w3)
             H1, H2, H3 = matvec_flat(model.data, J_RATE, w1, w2, w3)
             h1, h2, h3 = momenta(model, y, j)
-            u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3,
-                                                      H1 + h1, H2 + h2, H3 + h3, b1, b2, b3)
-            if pending(model, y, j, u1, u2, u3, m1, m2, m3):  # acts after the delay: the held stays
+            u1, u2, u3, m1, m2, m3, source = held(model, y, j)
+            u1, u2, u3, m1, m2, m3, source = commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1 + h1, H2 + h2,
+                                                      H3 + h3, b1, b2, b3, updates & _commands.ALL_LAWS,
+                                                      u1, u2, u3, m1, m2, m3, source)
+            if updates & CONTROL_SAMPLE and pending(model, y, j, u1, u2, u3, m1, m2, m3):  # acts after the delay
                 u1, u2, u3, m1, m2, m3, source = held(model, y, j)
             hold(model, t, y, j, u1, u2, u3, m1, m2, m3, source)
-        sample_parts(model, t, y, j)
+        if updates & PART_UPDATES:
+            sample_parts(model, t, y, j)
 
-    return derivative, sense, sample, discrete
+    return derivative, sense, sample, due

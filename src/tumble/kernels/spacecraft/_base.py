@@ -54,8 +54,8 @@ from numba import njit
 #: IR-level inlining: the parts are small and called in the innermost loop (a call costs more than they do).
 inline = njit(inline="always")
 
-#: A step end counts as a sample time of the zero-order hold when within this fraction of the
-#: control period of a whole number of periods after the start.
+#: A step end counts as a sample time of a clock (the control period, a law's own period) when within this
+#: fraction of the clock's period of a whole number of periods after the start.
 SAMPLE_TOLERANCE = 1e-9
 
 

@@ -1,6 +1,13 @@
 """Compile-time assembly of the controller: the commands of the control laws (:mod:`.laws`), evaluated in the
 right-hand side or held by a zero-order hold.
 
+The laws come in three groups, each held at its own sample period (the ``"hold"`` part's parameter block,
+:func:`hold_program`) or evaluated continuously (period 0): the torque law (``u_c``), the dipole laws (``m_c``,
+summed) and the wheel-torque law (the wheels' direct motor torques). A group of period ``T`` is sampled at the
+step ends ``t₀ + k·T`` (within :data:`~tumble.kernels.spacecraft._base.SAMPLE_TOLERANCE` of ``T``) and its
+commands are held in the hold's state until its next sample; a set of groups travels as bits
+(:data:`~tumble.kernels.spacecraft._layout.TORQUE_LAW`, ``DIPOLE_LAW``, ``WHEEL_LAW``).
+
 Every function here runs once, when Numba compiles the spacecraft model type, and returns compiled (inlined)
 functions of the model and one member's state. Which laws a spacecraft has is data: each law is a part whose
 field in the model says whether it is present (:func:`tumble.kernels.spacecraft._layout.locator`), read at run
@@ -19,10 +26,28 @@ import numpy as np
 
 from tumble._vec import cross, matvec_flat
 from tumble.kernels.spacecraft import laws, wheels
-from tumble.kernels.spacecraft._base import inline
-from tumble.kernels.spacecraft._layout import HELD_DIPOLE, HELD_TORQUE, HELD_WHEELS, J_RATE, PARTS, locator
+from tumble.kernels.spacecraft._base import SAMPLE_TOLERANCE, Program, inline
+from tumble.kernels.spacecraft._layout import (DIPOLE_LAW, HELD_DIPOLE, HELD_TORQUE, HELD_WHEELS, HOLD_PERIODS, J_RATE,
+                                               LAW_GROUPS, PARTS, START, TORQUE_LAW, WHEEL_LAW, locator)
 
 NO_WHEEL_LAW, WHEEL_TABLE, WHEEL_PYTHON, WHEEL_HELD = 0, 1, 2, 3
+
+#: Every law group.
+ALL_LAWS = TORQUE_LAW | DIPOLE_LAW | WHEEL_LAW
+
+
+def hold_program(torque_period: float, dipole_period: float, wheel_period: float, n_wheels: int) -> Program:
+    """The ``"hold"`` part: the sample periods (s; 0: continuous) of the torque law, the dipole laws and the
+    wheel-torque law, and the held commands (``n_wheels`` motor torques when a wheel-torque law is present)."""
+    periods = np.array([torque_period, dipole_period, wheel_period], dtype=np.float64)  # in the order of the bits
+    return Program("hold", periods, count=n_wheels, state=HELD_WHEELS + n_wheels)
+
+
+@inline
+def on_clock(t, start, period):
+    """True when ``t`` (s) is a sample time ``start + k·period`` of the clock, within ``SAMPLE_TOLERANCE·period``."""
+    k = round((t - start) / period)
+    return abs(t - start - k * period) <= SAMPLE_TOLERANCE * period
 
 
 def make_speeds(lane):
@@ -162,24 +187,61 @@ def make_direct(lane):
 
 
 def controller(lane, python):
-    """``commands(model, t, y, j, q, ω, H, B) -> (u_c, m_c, source)``: the control laws as evaluated now (the
-    Python laws only in the variant that calls Python, ``python``)."""
+    """``commands(model, t, y, j, q, ω, H, B, now, u_c, m_c, source) -> (u_c, m_c, source)``: the commands of the
+    law groups ``now`` (bits) as the laws give them at ``t`` from ``q``, ``ω``, ``H`` and ``B``, the other groups'
+    those given (the held ones); the Python laws only in the variant that calls Python (``python``). With the
+    torque command routed to the magnetorquers (``m = B × u/|B|²``, the part of ``u`` normal to ``B``, added to
+    the dipole command) the torque and dipole groups share one period (``Spacecraft`` checks it)."""
     speeds = make_speeds(lane)
     torque_law, dipole_law = make_torque_law(lane, speeds, python), make_dipole_law(lane)
-    source = make_wheel_law(speeds, python)
+    source_now = make_wheel_law(speeds, python)
     magnetorquers_index = PARTS.index("magnetorquers")
 
     @inline
-    def commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3):
-        u1, u2, u3 = torque_law(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3)
-        m1, m2, m3 = dipole_law(model, y, j, w1, w2, w3, b1, b2, b3)
-        if model.route == magnetorquers_index:  # m = B × u/|B|²: the part of u normal to B
-            k = 1.0 / (b1 * b1 + b2 * b2 + b3 * b3)
-            e1, e2, e3 = cross(b1, b2, b3, u1, u2, u3)
-            m1, m2, m3 = m1 + k * e1, m2 + k * e2, m3 + k * e3
-        return u1, u2, u3, m1, m2, m3, source(model, t, y, j, qw, qx, qy, qz, w1, w2, w3)
+    def commands(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3, b1, b2, b3, now, u1, u2, u3, m1, m2, m3,
+                 source):
+        if now & TORQUE_LAW:
+            u1, u2, u3 = torque_law(model, t, y, j, qw, qx, qy, qz, w1, w2, w3, H1, H2, H3)
+        if now & DIPOLE_LAW:
+            m1, m2, m3 = dipole_law(model, y, j, w1, w2, w3, b1, b2, b3)
+            if model.route == magnetorquers_index:
+                k = 1.0 / (b1 * b1 + b2 * b2 + b3 * b3)
+                e1, e2, e3 = cross(b1, b2, b3, u1, u2, u3)
+                m1, m2, m3 = m1 + k * e1, m2 + k * e2, m3 + k * e3
+        if now & WHEEL_LAW:
+            source = source_now(model, t, y, j, qw, qx, qy, qz, w1, w2, w3)
+        return u1, u2, u3, m1, m2, m3, source
 
     return commands
+
+
+def law_clocks():
+    """``(live, due)`` of the law groups under a zero-order hold: ``live(model)`` the groups evaluated in the
+    right-hand side (period 0), ``due(model, t)`` those with a sample time at the step end ``t`` (bits)."""
+    _, where = locator("hold")
+
+    @inline
+    def live(model):
+        p, _, _, _ = where(model)
+        d = model.data
+        bits = 0
+        for k in range(LAW_GROUPS):
+            if d[p + HOLD_PERIODS + k] == 0.0:
+                bits |= 1 << k
+        return bits
+
+    @inline
+    def due(model, t):
+        p, _, _, _ = where(model)
+        d = model.data
+        bits = 0
+        for k in range(LAW_GROUPS):
+            period = d[p + HOLD_PERIODS + k]
+            if period > 0.0 and on_clock(t, d[START], period):
+                bits |= 1 << k
+        return bits
+
+    return live, due
 
 
 def zero_order_hold(lane, direct):

@@ -30,7 +30,12 @@ PERIOD = 27        # control period, s (0: continuous)
 START = 28         # the control clock's start t₀, s
 HUB_SIZE = 29
 
-# The "hold" part's state: u_c (3), m_c (3), then one motor torque per wheel when a wheel-torque law is present.
+# The "hold" part's parameters: the sample period of each law group (s; 0: evaluated in the right-hand side), that
+# of the group of bit 1 << k (TORQUE_LAW, DIPOLE_LAW, WHEEL_LAW) at HOLD_PERIODS + k; its state: u_c (3), m_c (3),
+# then one motor torque per wheel when a wheel-torque law is present.
+HOLD_PERIODS = 0
+TORQUE_LAW, DIPOLE_LAW, WHEEL_LAW = 1, 2, 4
+LAW_GROUPS = 3
 HELD_TORQUE, HELD_DIPOLE, HELD_WHEELS = 0, 3, 6
 
 # The core block of the diagnostics:
