@@ -519,6 +519,7 @@ class Spacecraft(Model):
             raise ValidationError(f"{name}: must be a whole number of steps dt = {dt} s (the law's samples fall "
                                   f"on the steps), got {clock} s ({ratio:.6g} steps)")
         if self.flight_software is not None:
+            assert period is not None  # the flight software needs a control_period: checked in __post_init__
             for sensor, (sensor_period, _, _) in zip(_fsw_kernel.SENSORS, self.flight_software.clocks(period)):
                 ratio = sensor_period / dt
                 if sensor_period > 0.0 and (ratio < 1.0 - _WHOLE or abs(ratio - round(ratio)) > _WHOLE * ratio):
