@@ -178,7 +178,7 @@ def slices(model: SpacecraftModel, kind: str) -> Slices | None:
 # (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
 @_protocol.implements(_protocol.rhs, SpacecraftModel)
 def _spacecraft_rhs(model, b0, t, Y, OUT):
-    derivative, _, _, _ = _assemble(Y.ndim, _python(model))
+    derivative, _, _, _, _ = _assemble(Y.ndim, _python(model))
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
             derivative(model, t, Y, 0, OUT, Y, _STORE[0])
@@ -194,7 +194,7 @@ def _project(device):
     without the flight software (refused there: ``gpu_refusal``)."""
 
     def typer(model, b0, t, Y):
-        _, sense, sample, due = _assemble(Y.ndim, _python(model), device)
+        _, sense, sample, due, constrain = _assemble(Y.ndim, _python(model), device)
         if Y.ndim == 1:
             normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
         else:
@@ -202,7 +202,8 @@ def _project(device):
 
         def impl(model, b0, t, Y):
             normalize(Y)
-            for j in range(lanes(Y)):  # the flight software's sensors read at their own sample times
+            for j in range(lanes(Y)):  # the parts' constraints; the flight software's sensors at their sample times
+                constrain(model, Y, j)
                 sense(model, t, Y, j)
             updates = due(model, t)  # the laws held at their sample times t₀ + k·period, the parts' updates
             if updates:
@@ -233,7 +234,7 @@ def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload 
 
 @overload(_evaluate, jit_options={"cache": True})
 def _evaluate_overload(model, t, y, aux):
-    derivative, _, _, _ = _assemble(1, _python(model))
+    derivative, _, _, _, _ = _assemble(1, _python(model))
 
     def impl(model, t, y, aux):
         out = np.empty(y.shape[1])
@@ -249,7 +250,7 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sense, sample, due = _assemble(1, _python(model))
+    _, sense, sample, due, _ = _assemble(1, _python(model))
 
     def impl(model, t, y):
         for j in range(1):  # j an int64, as in the projection: a literal 0 would compile these once more
