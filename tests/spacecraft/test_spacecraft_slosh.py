@@ -1,6 +1,6 @@
 """Fuel slosh as a part of the spacecraft hub (``SloshPendulum``): the same motion as the independent
-``SloshBody`` kernel, conservation and a monotone energy with wheels, two tanks' energy balance, and the
-refusals."""
+``SloshBody`` kernel, conservation and a monotone energy with wheels, two tanks' energy balance, the scenario
+tables, the viewer's rods, and the refusals."""
 
 import numpy as np
 import pytest
@@ -9,7 +9,10 @@ from scipy.integrate import cumulative_simpson
 import tumble
 from tumble import slosh
 from tumble._validate import ValidationError
+from tumble.scenario import ScenarioError, parse
 from tumble.spacecraft import MRPFeedback, SloshPendulum, Spacecraft, pyramid_wheels
+
+from helpers import assert_same_run
 
 # A simulation compiles the spacecraft's rk4 path on a cold Numba cache (~100 CPU s); warm, each test runs in
 # well under a second.
@@ -128,3 +131,83 @@ def test_bad_slosh_and_initial_rods_are_refused_naming_the_field():
                         method="rk4", dt=0.1)
     with pytest.raises(ValidationError, match=r"^direction0: "):
         tumble.simulate(craft, omega0=[0.0, 0.0, 0.1], t=[0.0, 1.0], method="rk4", dt=0.1)
+
+
+SCENARIO = """
+[spacecraft]
+inertia = [[600.0, 5.0, -3.0], [5.0, 640.0, 2.0], [-3.0, 2.0, 300.0]]
+
+[spacecraft.wheel_pyramid]
+inertia = 0.5
+
+[[spacecraft.slosh]]
+reduced_mass = 25.0
+length = 0.4
+hinge = [-0.3, 0.2, 0.5]
+damping = 0.8
+
+[[spacecraft.slosh]]
+reduced_mass = 10.0
+length = 0.3
+hinge = [0.4, 0.0, 0.0]
+
+[[spacecraft.controller]]
+kind = "mrp_feedback"
+K = 20.0
+P = 200.0
+target = [0.9950041652780258, 0.0, 0.0, 0.09983341664682815]
+
+[initial]
+omega = [0.0, 0.0, 0.01]
+direction = [0.0, -0.3, 1.0, 1.0, 0.0, 0.0]
+rate = [0.2, 0.0, 0.0, 0.0, 0.1, 0.0]
+
+[time]
+stop = 2.0
+step = 0.5
+
+[solver]
+dt = 0.01
+"""
+
+
+@SLOW
+def test_the_scenario_tables_build_the_spacecraft_of_the_python_api():
+    craft = Spacecraft(inertia=HUB.inertia, wheels=pyramid_wheels(0.5),
+                       slosh=[SloshPendulum(25.0, 0.4, [-0.3, 0.2, 0.5], 0.8), SloshPendulum(10.0, 0.3, [0.4, 0.0, 0.0])],
+                       controller=MRPFeedback(K=20.0, P=200.0, target=[0.9950041652780258, 0.0, 0.0,
+                                                                       0.09983341664682815]))
+    expected = tumble.simulate(craft, omega0=[0.0, 0.0, 0.01], direction0=[0.0, -0.3, 1.0, 1.0, 0.0, 0.0],
+                               rate0=[0.2, 0.0, 0.0, 0.0, 0.1, 0.0], t=np.linspace(0.0, 2.0, 5), method="rk4",
+                               dt=0.01)
+    assert_same_run(parse(SCENARIO).run(), expected)
+
+
+@pytest.mark.parametrize(("old", "new", "where", "rule"), [
+    ("length = 0.4", "length = 0.0", "spacecraft.slosh[0].length", "greater than 0"),
+    ("damping = 0.8", "damping = -0.8", "spacecraft.slosh[0].damping", "must be a finite number >= 0, got -0.8"),
+    ("hinge = [0.4, 0.0, 0.0]", "hinge = [0.4, 0.0]", "spacecraft.slosh[1].hinge", "must have at least 3 entries"),
+    ("length = 0.3", "length = 0.3\nmass = 1.0", "spacecraft.slosh[1].mass", "unknown key"),
+    ("direction = [0.0, -0.3, 1.0, 1.0, 0.0, 0.0]", "direction = [0.0, -0.3, 1.0]", "initial.direction",
+     "must have shape (…, 6), got (3,)"),
+])
+def test_bad_tables_name_the_key(old, new, where, rule):
+    assert SCENARIO.count(old) == 1, old
+    with pytest.raises(ScenarioError) as info:
+        parse(SCENARIO.replace(old, new), source="craft.toml").run()
+    assert any(w == where and rule in r for w, r in info.value.problems), info.value.problems
+
+
+@SLOW
+def test_the_viewer_draws_each_rod_from_its_hinge_to_the_slosh_mass(controlled):
+    from tumble.viz import viewer
+
+    craft, traj = controlled
+    scene = viewer.scene(traj, model=craft, frames=50)
+    hub = scene.solids[0].rotation                                    # R(q) of the frames
+    frames = np.searchsorted(traj.t, scene.t)
+    np.testing.assert_array_equal(traj.t[frames], scene.t)
+    rod = {line.name: line.points for line in scene.lines}["slosh pendulum 1"]
+    np.testing.assert_allclose(rod[:, 0], hub @ TANK.hinge, rtol=0.0, atol=1e-15)
+    mass = TANK.hinge + TANK.length * traj.pendulum_direction[frames, 0]
+    np.testing.assert_allclose(rod[:, 1], np.einsum("fij,fj->fi", hub, mass), rtol=0.0, atol=1e-15)
