@@ -26,7 +26,7 @@ from tumble._validate import ValidationError, as_array, require_non_negative, re
 from tumble.kernels.spacecraft import slosh as _kernel
 from tumble.kernels.spacecraft._base import Program
 
-__all__ = ["SloshPendulum", "slosh_program", "initial_rods"]
+__all__ = ["SloshPendulum"]
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 
 A spacecraft is assembled from *parts*, each a program of one kind of
 :data:`PARTS` — an actuator (one file each: :mod:`.wheels`, :mod:`.cmgs`,
-:mod:`.thrusters`, :mod:`.magnetorquers`, :mod:`.damper`, :mod:`.flexible_modes`), a control law
+:mod:`.thrusters`, :mod:`.magnetorquers`, :mod:`.damper`, :mod:`.flexible_modes`, :mod:`.slosh`), a control law
 (:mod:`.laws`), a piece of the environment (:mod:`.environment`) or the
 zero-order hold of a sampled controller — made of a parameter block in the one
 flat array ``data``, a slice of the state vector and a slice of the
@@ -22,14 +22,15 @@ State vector::
 axes. Equations (body axes; Hughes, *Spacecraft Attitude Dynamics*, §7.2;
 Markley & Crassidis 2014, §3.3.5)::
 
-    J_ω ω̇ = τ_ext + Σ τ_k − ω × H,      H = J_ω ω + Σ h_k,      q̇ = ½ q ⊗ [0, ω]
+    (J_ω + Σ ΔM_k) ω̇ = τ_ext + Σ τ_k − ω × H,      H = J_ω ω + Σ h_k,      q̇ = ½ q ⊗ [0, ω]
 
 where ``J_ω`` is the inertia the hub's rate answers to (the total ``J``, every
 rotor counted as a rigid part, less the inertias the parts carry in their own
 states: the wheels' spin inertias, the damper sphere, the appendages' ``Σ δ_kδ_kᵀ``), ``h_k`` the angular
 momentum part ``k`` carries and ``τ_k`` the torque it exerts on the hub
 (``−dh_k/dt`` seen from the hub for internal parts; thrusters and
-magnetorquers exert external torques), and ``τ_ext`` the environment's
+magnetorquers exert external torques), ``ΔM_k`` the state-dependent inertia a part adds to
+the hub's matrix (the slosh pendulums' ``μ g gᵀ``; none: the precomputed ``J_ω⁻¹`` solves), and ``τ_ext`` the environment's
 gravity gradient plus the external torque program of ``torque=``
 (:mod:`tumble.torques`). The controller's commands — torque ``u_c`` (N·m),
 dipole ``m_c`` (A·m²), motor torques of the wheels — are evaluated in the
