@@ -88,8 +88,9 @@ def test_a_new_composition_compiles_nothing():
         env_traj = tumble.simulate(in_orbit, [0.01, -0.02, 0.03], t=T, method="rk4", dt=0.1)
         flexible = tumble.simulate(wheels_mrp_and_modes(), [0.01, -0.02, 0.03], eta0=[0.1], t=T, method="rk4",
                                    dt=0.1)
-        sloshing = tumble.simulate(wheels_mrp_and_tanks(), [0.01, -0.02, 0.03], direction0=[1.0, 0.0, 0.0, 0.0, 0.0, 1.0],
-                                   rate0=[0.0, 0.1, 0.0, 0.1, 0.0, 0.0], t=T, method="rk4", dt=0.1)
+        sloshing = tumble.simulate(wheels_mrp_and_tanks(), [0.01, -0.02, 0.03],
+                                   direction0=[1.0, 0.0, 0.0, 0.0, 0.0, 1.0], rate0=[0.0, 0.1, 0.0, 0.1, 0.0, 0.0],
+                                   t=T, method="rk4", dt=0.1)
     assert [e.data["dispatcher"].py_func.__qualname__ for e in compiles.buffer if e.is_start] == []
     assert len(kernel.evaluate.signatures) == signatures
     np.testing.assert_array_equal(traj.external_torque[-1], [1e-3, 0.0, -2e-3])  # the new parts ran

@@ -25,8 +25,8 @@ TANK = SloshPendulum(SLOSH_BODY.reduced_mass, PENDULUM.length, PENDULUM.hinge, P
 TARGET = [np.cos(0.1), 0.0, 0.0, np.sin(0.1)]  # 0.2 rad about z
 
 # The same rk4 steps in two kernels whose arithmetic differs in order (the spacecraft solves
-# (I_B + μ g gᵀ) ω̇ = rhs by Cramer's rule and forms H as I_B ω + μ r × ṙ, with ω × H on the right and ω × h
-# in the tank's torque; SloshBody by Sherman–Morrison from I_B⁻¹ with ω × I_B ω): over 20 s (2000 steps)
+# (I_B + μ g gᵀ) ω̇ = rhs by Cramer's rule and forms H as I_B ω + μ r × ṙ, with ω × H on the right and
+# ω × h in the tank's torque; SloshBody by Sherman–Morrison from I_B⁻¹ with ω × I_B ω): over 20 s (2000 steps)
 # the largest differences measured are 5.6e-17 in q, 4.2e-17 rad/s in ω (of 0.3), 2.2e-16 in s, 4.2e-17 rad/s
 # in ν (of 0.097), 3.6e-15 J in T (of 15.8) and 2.8e-14 N m s in H (of 100): at most 4.3e-16 of each's size.
 # Allowed: 1e-14 of each's size.
@@ -118,9 +118,11 @@ def test_two_tanks_conserve_momentum_and_dissipate_by_their_hinge_damping():
     (dict(reduced_mass=0.0, length=0.5, hinge=[0.0, 0.0, 1.0]), r"^reduced_mass: must be a finite number > 0, got 0.0"),
     (dict(reduced_mass=1.0, length=-0.5, hinge=[0.0, 0.0, 1.0]), r"^length: must be a finite number > 0, got -0.5"),
     (dict(reduced_mass=1.0, length=0.5, hinge=[0.0, 1.0]), r"^hinge: must have shape \(…, 3\)"),
-    (dict(reduced_mass=1.0, length=0.5, hinge=[[0.0, 0.0, 1.0]]), r"^hinge: must have shape \(3,\), got \(1, 3\)"),
+    (dict(reduced_mass=1.0, length=0.5, hinge=[[0.0, 0.0, 1.0]]),
+     r"^hinge: must have shape \(3,\), got \(1, 3\)"),
     (dict(reduced_mass=1.0, length=0.5, hinge=[0.0, np.nan, 1.0]), r"^hinge: must be finite"),
-    (dict(reduced_mass=1.0, length=0.5, hinge=[0.0, 0.0, 1.0], damping=-1.0), r"^damping: must be a finite number >= 0, got -1.0"),
+    (dict(reduced_mass=1.0, length=0.5, hinge=[0.0, 0.0, 1.0], damping=-1.0),
+     r"^damping: must be a finite number >= 0, got -1.0"),
 ])
 def test_bad_tanks_are_refused_naming_the_field(arguments, message):
     with pytest.raises(ValidationError, match=message):
@@ -179,7 +181,8 @@ dt = 0.01
 @SLOW
 def test_the_scenario_tables_build_the_spacecraft_of_the_python_api():
     craft = Spacecraft(inertia=HUB.inertia, wheels=pyramid_wheels(0.5),
-                       slosh=[SloshPendulum(25.0, 0.4, [-0.3, 0.2, 0.5], 0.8), SloshPendulum(10.0, 0.3, [0.4, 0.0, 0.0])],
+                       slosh=[SloshPendulum(25.0, 0.4, [-0.3, 0.2, 0.5], 0.8),
+                              SloshPendulum(10.0, 0.3, [0.4, 0.0, 0.0])],
                        controller=MRPFeedback(K=20.0, P=200.0, target=[0.9950041652780258, 0.0, 0.0,
                                                                        0.09983341664682815]))
     expected = tumble.simulate(craft, omega0=[0.0, 0.0, 0.01], direction0=[0.0, -0.3, 1.0, 1.0, 0.0, 0.0],
@@ -190,7 +193,8 @@ def test_the_scenario_tables_build_the_spacecraft_of_the_python_api():
 
 @pytest.mark.parametrize(("old", "new", "where", "rule"), [
     ("length = 0.4", "length = 0.0", "spacecraft.slosh[0].length", "must be > 0.0, got 0.0"),
-    ("damping = 0.8", "damping = -0.8", "spacecraft.slosh[0].damping", "must be a finite number >= 0, got -0.8"),
+    ("damping = 0.8", "damping = -0.8", "spacecraft.slosh[0].damping",
+     "must be a finite number >= 0, got -0.8"),
     ("hinge = [0.4, 0.0, 0.0]", "hinge = [0.4, 0.0]", "spacecraft.slosh[1].hinge", "must have at least 3 entries"),
     ("length = 0.3", "length = 0.3\nmass = 1.0", "spacecraft.slosh[1].mass", "unknown key"),
     ("direction = [0.0, -0.3, 1.0, 1.0, 0.0, 0.0]", "direction = [0.0, -0.3, 1.0]", "initial.direction",

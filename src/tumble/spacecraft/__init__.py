@@ -1,5 +1,6 @@
 """Spacecraft attitude dynamics and control: a rigid hub with reaction wheels, control moment gyros,
-thrusters, magnetorquers, a nutation damper, flexible appendages and fuel slosh, in a Keplerian orbit with gravity gradient and a dipole
+thrusters, magnetorquers, a nutation damper, flexible appendages and fuel slosh, in a Keplerian orbit with gravity
+gradient and a dipole
 magnetic field (or the environment sampled along a Kepler or TLE orbit: :class:`Environment`), under feedback control laws (compiled or Python; continuous or sampled with a zero-order
 hold). A :class:`Spacecraft` is a model of :func:`tumble.simulate`.
 

@@ -29,8 +29,9 @@ rotor counted as a rigid part, less the inertias the parts carry in their own
 states: the wheels' spin inertias, the damper sphere, the appendages' ``Σ δ_kδ_kᵀ``), ``h_k`` the angular
 momentum part ``k`` carries and ``τ_k`` the torque it exerts on the hub
 (``−dh_k/dt`` seen from the hub for internal parts; thrusters and
-magnetorquers exert external torques), ``ΔM_k`` the state-dependent inertia a part adds to
-the hub's matrix (the slosh pendulums' ``μ g gᵀ``; none: the precomputed ``J_ω⁻¹`` solves), and ``τ_ext`` the environment's
+magnetorquers exert external torques), ``ΔM_k`` the state-dependent inertia a
+part adds to the hub's matrix (the slosh pendulums' ``μ g gᵀ``; none: the
+precomputed ``J_ω⁻¹`` solves), and ``τ_ext`` the environment's
 gravity gradient plus the external torque program of ``torque=``
 (:mod:`tumble.torques`). The controller's commands — torque ``u_c`` (N·m),
 dipole ``m_c`` (A·m²), motor torques of the wheels — are evaluated in the

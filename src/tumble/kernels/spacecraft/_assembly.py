@@ -270,8 +270,8 @@ def _no_sensing(model, t, y, j):
 
 
 def assemble(ndim, python, device=False):
-    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, due, constrain)``; ``python``: the
-    variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
+    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, due, constrain)``; ``python``:
+    the variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
     which then allocates nothing, is compiled without reference counting: the
     runtime tests of the parts split the refcount pairs of the model's arrays over branches that Numba's
     pruner cannot join, and counting them made the RK4 step 5.5 times slower).
