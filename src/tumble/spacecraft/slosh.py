@@ -18,6 +18,7 @@ A spacecraft with only one tank moves as the ``SloshBody`` of the same hub and p
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -56,7 +57,7 @@ class SloshPendulum:
         object.__setattr__(self, "hinge", hinge)
 
 
-def slosh_program(tanks: tuple[SloshPendulum, ...]) -> Program:
+def slosh_program(tanks: Sequence[SloshPendulum]) -> Program:
     """The compiled part of the ``tanks``."""
     return _kernel.program([t.reduced_mass for t in tanks], [t.length for t in tanks],
                            [t.damping for t in tanks], np.array([t.hinge for t in tanks]))
