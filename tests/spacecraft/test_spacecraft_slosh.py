@@ -220,3 +220,20 @@ def test_the_viewer_draws_each_rod_from_its_hinge_to_the_slosh_mass(controlled):
     np.testing.assert_allclose(rod[:, 0], hub @ TANK.hinge, rtol=0.0, atol=1e-15)
     mass = TANK.hinge + TANK.length * traj.pendulum_direction[frames, 0]
     np.testing.assert_allclose(rod[:, 1], np.einsum("fij,fj->fi", hub, mass), rtol=0.0, atol=1e-15)
+
+
+@SLOW
+def test_a_batch_of_two_equals_each_run_alone():
+    """The block path (lanes of 64: the tanks' state access, hub matrix and projection per lane) gives each
+    member's single run bit for bit."""
+    craft = Spacecraft(inertia=HUB.inertia, wheels=pyramid_wheels(0.5), slosh=[TANK, TANK],
+                       controller=MRPFeedback(K=20.0, P=200.0, target=TARGET))
+    members = dict(omega0=[[0.05, -0.02, 0.3], [0.0, 0.01, -0.1]],
+                   direction0=[[1.0, 0.2, 0.1, 0.0, -0.3, 1.0], [0.0, 1.0, 0.0, 1.0, 0.0, 0.0]],
+                   rate0=[[0.0, 0.3, 0.0, 0.2, 0.0, 0.0], [0.1, 0.0, 0.0, 0.0, 0.0, 0.2]])
+    run = dict(t=np.linspace(0.0, 5.0, 11), method="rk4", dt=0.01)
+    batch = tumble.simulate(craft, **members, **run)
+    for b in range(2):
+        alone = tumble.simulate(craft, **{name: value[b] for name, value in members.items()}, **run)
+        for name in ("q", "omega", "pendulum_direction", "pendulum_rate", "energy"):
+            np.testing.assert_array_equal(getattr(batch, name)[:, b], getattr(alone, name), err_msg=name)
