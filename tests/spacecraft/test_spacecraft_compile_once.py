@@ -18,7 +18,7 @@ from tumble import torques
 from tumble.kernels import spacecraft as kernel
 from tumble.kernels.spacecraft import _assembly
 from tumble.spacecraft import (CMGCluster, Environment, FlexibleModes, MRPFeedback, Orbit, QuaternionPD,
-                               ResidualDipole, Spacecraft, pyramid_wheels)
+                               ResidualDipole, SloshPendulum, Spacecraft, pyramid_wheels)
 from tumble.spacecraft.surfaces import Drag, SolarPressure, box_facets
 
 # The tests marked slow compile the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
@@ -44,6 +44,12 @@ def wheels_cmgs_pd_dipole():
 def wheels_mrp_and_modes():
     return Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02),
                       flexible_modes=FlexibleModes([[0.0, 0.3, 0.5]], [2.0]),
+                      controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
+
+
+def wheels_mrp_and_tanks():
+    return Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02),
+                      slosh=[SloshPendulum(2.0, 0.3, [0.4, 0.0, 0.0], 0.5), SloshPendulum(1.0, 0.2, [0.0, -0.3, 0.1])],
                       controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
 
 
@@ -82,9 +88,13 @@ def test_a_new_composition_compiles_nothing():
         env_traj = tumble.simulate(in_orbit, [0.01, -0.02, 0.03], t=T, method="rk4", dt=0.1)
         flexible = tumble.simulate(wheels_mrp_and_modes(), [0.01, -0.02, 0.03], eta0=[0.1], t=T, method="rk4",
                                    dt=0.1)
+        sloshing = tumble.simulate(wheels_mrp_and_tanks(), [0.01, -0.02, 0.03],
+                                   direction0=[1.0, 0.0, 0.0, 0.0, 0.0, 1.0], rate0=[0.0, 0.1, 0.0, 0.1, 0.0, 0.0],
+                                   t=T, method="rk4", dt=0.1)
     assert [e.data["dispatcher"].py_func.__qualname__ for e in compiles.buffer if e.is_start] == []
     assert len(kernel.evaluate.signatures) == signatures
     np.testing.assert_array_equal(traj.external_torque[-1], [1e-3, 0.0, -2e-3])  # the new parts ran
     assert np.abs(traj.residual_dipole_torque).max() > 0.0
     assert np.abs(env_traj.solar_pressure_torque).max() > 0.0 and np.abs(env_traj.drag_torque).max() > 0.0
     assert np.abs(flexible.modal_rate).max() > 0.0
+    assert np.abs(sloshing.pendulum_rate).max() > 0.0

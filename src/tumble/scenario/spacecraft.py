@@ -38,7 +38,9 @@ damper (``[spacecraft.damper]``, :mod:`tumble.scenario.damper`), environment
 facet parts: ``[spacecraft.environment]``, ``[spacecraft.solar_pressure]``,
 ``[spacecraft.drag]``, :mod:`tumble.scenario.environment`), flexible appendages
 (``[spacecraft.flexible_modes]``: ``participation`` (m × 3, kg^½ m), ``frequency`` (m, rad/s),
-``damping`` (m, ζ; default 0); initial ``eta`` and ``eta_rate``), the ``[[spacecraft.controller]]`` laws
+``damping`` (m, ζ; default 0); initial ``eta`` and ``eta_rate``), fuel slosh (``[[spacecraft.slosh]]``, one
+table per tank: ``reduced_mass`` (kg), ``length`` (m), ``hinge`` (m, body axes), ``damping`` (1/s; default 0);
+initial ``direction`` and ``rate``, 3 per tank), the ``[[spacecraft.controller]]`` laws
 (:mod:`tumble.scenario.control`) and the flight software that feeds them an estimate
 (``[spacecraft.flight_software]``).
 ``[initial]``, ``[time]``, ``[solver]``, ``[spacecraft.orbit]`` and the
@@ -74,6 +76,7 @@ from tumble.spacecraft.environment import DipoleField, ResidualDipole
 from tumble.spacecraft.flexible_modes import FlexibleModes
 from tumble.spacecraft.flight_software import FlightSoftware, Sampling
 from tumble.spacecraft.model import Spacecraft
+from tumble.spacecraft.slosh import SloshPendulum
 from tumble.trajectory import Trajectory
 
 if TYPE_CHECKING:
@@ -218,6 +221,19 @@ class FlexibleModesTable(_Table):
                              None if self.damping is None else np.array(self.damping))
 
 
+class SloshTable(_Table):
+    """``[[spacecraft.slosh]]``: the slosh pendulum of one tank (:class:`tumble.spacecraft.SloshPendulum`):
+    ``reduced_mass`` μ (kg), ``length`` l (m), ``hinge`` b (m, body axes), ``damping`` d (1/s; default 0)."""
+
+    reduced_mass: _Positive
+    length: _Positive
+    hinge: _Vector
+    damping: _Number = 0.0
+
+    def build(self) -> SloshPendulum:
+        return SloshPendulum(**self.model_dump())
+
+
 class SamplingTable(_Table):
     """A sensor's sampling (:class:`tumble.spacecraft.Sampling`): ``period`` (s; default the control period),
     ``latency`` (s) and ``stream`` (its noise stream's number)."""
@@ -320,6 +336,7 @@ class SpacecraftTable(_InertiaOrMoments):
     control_period: _Positive | None = None
     flight_software: FlightSoftwareTable | None = None
     flexible_modes: FlexibleModesTable | None = None
+    slosh: list[SloshTable] = []
 
     @model_validator(mode="after")
     def _one_description(self):
@@ -336,7 +353,7 @@ class SpacecraftTable(_InertiaOrMoments):
         """The :class:`~tumble.spacecraft.Spacecraft`; a refusal is reported against its key."""
         parts: dict[str, Any] = {  # the keyword arguments of Spacecraft
             key: [_built(entry, f"spacecraft.{key}[{i}]") for i, entry in enumerate(getattr(self, key))]
-            for key in ("wheels", "thrusters", "controller")}
+            for key in ("wheels", "thrusters", "controller", "slosh")}
         for key in ("hub", "wheel_pyramid", "cmgs", "pwpf", "magnetorquers", "damper", "orbit", "magnetic_field",
                     "residual_dipole", "environment", "solar_pressure", "drag", "flight_software", "flexible_modes"):
             entry = getattr(self, key)
@@ -369,7 +386,9 @@ class SpacecraftInitial(Initial):
     rad/s, body axes; default ``omega``) and ``attitude_error_integral`` (∫σ dt of the MRP feedback's
     integral term, s; default 0); with flight software ``q_estimate`` (default ``q``), ``bias_estimate`` and
     ``gyro_bias`` (rad/s, body axes; default 0) and ``sensor_seed`` (its noise seed; default its ``seed``); with
-    flexible modes ``eta`` (kg^½ m) and ``eta_rate`` (kg^½ m/s), one per mode (default 0). A key the spacecraft
+    flexible modes ``eta`` (kg^½ m) and ``eta_rate`` (kg^½ m/s), one per mode (default 0); with slosh
+    ``direction`` (the rods' directions, body axes) and ``rate`` (their rates relative to the hub, rad/s;
+    default 0), 3 per tank, tank by tank. A key the spacecraft
     has no state for is refused by :func:`tumble.simulate`."""
 
     wheel_speeds: list[_Number] | None = None
@@ -382,6 +401,8 @@ class SpacecraftInitial(Initial):
     sensor_seed: Annotated[int, Field(strict=True, ge=0)] | None = None
     eta: list[_Number] | None = None
     eta_rate: list[_Number] | None = None
+    direction: list[_Number] | None = None
+    rate: list[_Number] | None = None
 
 
 class SpacecraftSolver(Solver):

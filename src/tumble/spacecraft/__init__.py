@@ -1,5 +1,6 @@
 """Spacecraft attitude dynamics and control: a rigid hub with reaction wheels, control moment gyros,
-thrusters, magnetorquers, a nutation damper and flexible appendages, in a Keplerian orbit with gravity gradient and a dipole
+thrusters, magnetorquers, a nutation damper, flexible appendages and fuel slosh, in a Keplerian orbit with gravity
+gradient and a dipole
 magnetic field (or the environment sampled along a Kepler or TLE orbit: :class:`Environment`), under feedback control laws (compiled or Python; continuous or sampled with a zero-order
 hold). A :class:`Spacecraft` is a model of :func:`tumble.simulate`.
 
@@ -28,6 +29,7 @@ from tumble.spacecraft.flexible_modes import FlexibleModes
 from tumble.spacecraft.flight_software import FlightSoftware, Sampling
 from tumble.spacecraft.model import SaturationWarning, SingularityWarning, Spacecraft
 from tumble.spacecraft.orbit import Orbit, attitude_in_lvlh, lvlh_quaternion
+from tumble.spacecraft.slosh import SloshPendulum
 from tumble.spacecraft.passive import gravity_gradient_stability, spin_stability
 from tumble.spacecraft.tle import TLE
 
@@ -37,7 +39,8 @@ __all__ = [
     "Magnetorquers",
     "MomentumDumping", "Orbit", "PWPF", "PythonLaw", "QuaternionPD", "RateDamping", "ReactionWheel", "ResidualDipole",
     "Sampling",
-    "SaturationWarning", "SingularityWarning", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE", "Thruster",
+    "SaturationWarning", "SingularityWarning", "SloshPendulum", "SpaceWeather", "Spacecraft", "SphericalDamper", "TLE",
+    "Thruster",
     "WheelTorques",
     "attitude_in_lvlh", "gravity_gradient_stability", "lvlh_quaternion",
     "pyramid_wheels", "spin_stability",

@@ -17,10 +17,12 @@ properties are described in one of two ways:
 Both give the same motion for the same total (tested). Flexible appendages
 (``flexible_modes``) are part of either, undeformed. The body rate answers
 to ``J_ω = J − Σ I_s a aᵀ − J_d E − Σ δ_k δ_kᵀ`` (the rotors' spin inertias, the
-sphere and the appendages' modal participation are carried by their own states). The equations are those of
+sphere and the appendages' modal participation are carried by their own states). Slosh pendulums (``slosh``)
+ride on the hub: ``J`` is then the hub's inertia about its own centre of mass, without the sloshing liquid. The
+equations are those of
 :mod:`tumble.kernels.spacecraft`, one file per actuator.
 
-One class, one unit (about 770 lines): its checks, its compiled parts, its
+One class, one unit (about 800 lines): its checks, its compiled parts, its
 initial state and its named outputs each read the same list of parts, and
 what each part adds to them is a few lines beside the others.
 """
@@ -51,6 +53,7 @@ from tumble.kernels.spacecraft import flexible_modes as _flexible_modes
 from tumble.kernels.spacecraft import laws as _law_kernels
 from tumble.kernels.spacecraft import magnetorquers as _magnetorquers
 from tumble.kernels.spacecraft import residual_dipole as _residual_dipole
+from tumble.kernels.spacecraft import slosh as _slosh
 from tumble.kernels.spacecraft import solar_pressure as _solar_pressure
 from tumble.kernels.spacecraft import thrusters as _thrusters
 from tumble.kernels.spacecraft import wheels as _wheels
@@ -65,6 +68,7 @@ from tumble.spacecraft.flexible_modes import FlexibleModes
 from tumble.spacecraft.flight_software import FlightSoftware, check_seed
 from tumble.spacecraft.flight_software import initial_state as _fsw_initial_state
 from tumble.spacecraft.orbit import EARTH_MU, Orbit
+from tumble.spacecraft.slosh import SloshPendulum, initial_rods, slosh_program
 from tumble.spacecraft.surfaces import Drag, SolarPressure
 from tumble.trajectory import Extra, Trajectory
 
@@ -126,6 +130,9 @@ class Spacecraft(Model):
     flexible_modes : :class:`~tumble.spacecraft.flexible_modes.FlexibleModes` or None: cantilever modes of
         flexible appendages (hybrid coordinates; the appendages undeformed are in ``inertia`` or ``hub``),
         initial modal coordinates and rates ``eta0``, ``eta_rate0`` (default zero)
+    slosh : sequence of :class:`~tumble.spacecraft.slosh.SloshPendulum`: the fuel slosh of each tank as a
+        spherical pendulum (``inertia`` the hub's, without the sloshing liquid), initial rod directions
+        ``direction0`` and relative rates ``rate0`` (3 per tank, tank by tank; rates default zero)
 
     The torque command goes to the wheels if there are any, else to the CMGs,
     else to the thrusters (through the PWPF modulators), else to the
@@ -156,6 +163,7 @@ class Spacecraft(Model):
     control_period: float | None = None
     flight_software: FlightSoftware | None = None
     flexible_modes: FlexibleModes | None = None
+    slosh: Sequence[SloshPendulum] = ()
     #: The whole spacecraft as one rigid body (total inertia J, mass, centre of mass), derived.
     body: RigidBody = field(init=False, repr=False)
 
@@ -163,8 +171,10 @@ class Spacecraft(Model):
         set_ = object.__setattr__
         set_(self, "wheels", tuple(self.wheels))
         set_(self, "thrusters", tuple(self.thrusters))
+        set_(self, "slosh", tuple(self.slosh))
         _check_items(self.wheels, ReactionWheel, "wheels")
         _check_items(self.thrusters, Thruster, "thrusters")
+        _check_items(self.slosh, SloshPendulum, "slosh")
         _check_type(self.cmgs, CMGCluster, "cmgs")
         _check_type(self.pwpf, PWPF, "pwpf")
         _check_type(self.magnetorquers, Magnetorquers, "magnetorquers")
@@ -403,6 +413,8 @@ class Spacecraft(Model):
                                                   self.environment, self.solar_pressure, self.drag,
                                                   self.flexible_modes)
                      if part is not None]
+        if self.slosh:
+            programs.append(slosh_program(self.slosh))
         if self.flight_software is not None:
             assert self.control_period is not None  # checked in __post_init__
             programs.append(self.flight_software._program(self.control_period))
@@ -491,6 +503,13 @@ class Spacecraft(Model):
             m = self.flexible_modes.count
             fields += [StateField("eta0", m, f"initial modal coordinates η ({m}), kg^½·m", default=np.zeros(m)),
                        StateField("eta_rate0", m, f"initial modal rates dη/dt ({m}), kg^½·m/s", default=np.zeros(m))]
+        if self.slosh:
+            k = 3 * len(self.slosh)
+            fields += [StateField("direction0", k, "initial directions of the slosh pendulums' rods from their hinges, "
+                                  "body axes, 3 per tank (normalised)"),
+                       StateField("rate0", k, "initial angular velocities of the rods relative to the hub, rad/s, "
+                                  "body axes, 3 per tank (their components along the rods removed)",
+                                  default=np.zeros(k))]
         return tuple(fields)
 
     def check_run(self, method: integrate.Method, t: np.ndarray, dt: float | None) -> None:
@@ -579,6 +598,10 @@ class Spacecraft(Model):
             state = _flexible_modes.state_slices(f.n, f.s)
             y0[:, state["modal_coordinate"]] = values["eta0"]
             y0[:, state["modal_rate"]] = values["eta_rate0"]
+        if self.slosh:
+            rods = _slosh.state_slices(len(self.slosh), where("slosh").s)
+            s0, nu0 = initial_rods(values["direction0"], values["rate0"], len(self.slosh))
+            y0[:, rods["pendulum_direction"]], y0[:, rods["pendulum_rate"]] = s0, nu0
         if self.flight_software is not None:
             check_seed(values["sensor_seed0"], "sensor_seed0")
             _fsw_initial_state(self.flight_software, values, y0, where("flight_software").s, float(t0))
@@ -692,19 +715,25 @@ class Spacecraft(Model):
             add("modal_coordinate", states[..., state["modal_coordinate"]], ("mode",), "kg^(1/2) m",
                 "modal coordinate eta_k of the appendages (mass-normalised)")
             add("modal_rate", states[..., state["modal_rate"]], ("mode",), "kg^(1/2) m/s", "modal rate deta_k/dt")
+        if self.slosh:
+            rods = _slosh.state_slices(len(self.slosh), where("slosh").s)
+            add("pendulum_direction", states[..., rods["pendulum_direction"]], ("tank", "body_axis"), "1",
+                "unit direction of each tank's slosh pendulum from its hinge, body axes")
+            add("pendulum_rate", states[..., rods["pendulum_rate"]], ("tank", "body_axis"), "rad/s",
+                "angular velocity of each slosh pendulum relative to the hub, body axes")
         if self.flight_software is not None:
             s = where("flight_software").s
             self._estimation_outputs(add, states[..., s:s + _fsw_kernel.STATE], q)
         add("actuator_torque", core(_kernel.AUX_ACTUATOR), ("xyz",), "N m",
             "torque of all parts on the hub, body axes (wheels, gyros, thrusters, magnetorquers, damper, "
-            "residual dipole, solar pressure, drag, flexible modes)")
+            "residual dipole, solar pressure, drag, flexible modes, slosh)")
         momentum_body = core(_kernel.AUX_MOMENTUM)
         energy = core(_kernel.AUX_ENERGY, 1)[..., 0]
         add("total_momentum_inertial", attitude.rotate(q, momentum_body), ("xyz",), "N m s",
-            "total angular momentum (hub, wheels, gyro rotors, damper, appendages), inertial axes")
+            "total angular momentum (hub, wheels, gyro rotors, damper, appendages, slosh), inertial axes")
         add("total_energy", energy, (), "J",
-            "kinetic energy of hub, wheels and damper, and the appendages' kinetic and strain energy (gyro "
-            "rotors' constant spin energy excluded)")
+            "kinetic energy of hub, wheels, damper and slosh masses, and the appendages' kinetic and strain energy "
+            "(gyro rotors' constant spin energy excluded)")
         info = {} if self.control_period is None else {"control_period": self.control_period}
         return Outputs(q=q, omega=omega, inertia=self.total_inertia, extras=extras,
                        totals={"energy": energy, "momentum_body": momentum_body}, info=info)
@@ -743,14 +772,16 @@ class Spacecraft(Model):
     def invariants(self, traj: Trajectory) -> dict[str, np.ndarray]:
         """Without external torque (no ``torque=``, gravity gradient, thrusters, magnetorquers, residual
         dipole, solar pressure or drag): the inertial angular momentum of the whole spacecraft; and, without
-        CMGs (whose ideal gimbal servos do work), a damper or damped flexible modes (which dissipate), its
+        CMGs (whose ideal gimbal servos do work), a damper, damped flexible modes or damped slosh (which
+        dissipate), its
         energy less the work done on the wheels by motors and bearings."""
         if (traj.info.get("torque") != "none" or self.gravity_gradient or self.thrusters
                 or self.magnetorquers is not None or self.residual_dipole is not None
                 or self.solar_pressure is not None or self.drag is not None):
             return {}
         out = {"momentum_inertial": traj.momentum_inertial}
-        damped = self.flexible_modes is not None and bool(np.any(self.flexible_modes.damping))
+        damped = (self.flexible_modes is not None and bool(np.any(self.flexible_modes.damping))) or any(
+            tank.damping > 0.0 for tank in self.slosh)
         if self.cmgs is None and self.damper is None and not damped:
             if self.wheels:
                 out["energy_minus_wheel_work"] = traj.energy - traj.wheel_work

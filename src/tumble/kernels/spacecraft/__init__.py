@@ -2,7 +2,7 @@
 
 A spacecraft is assembled from *parts*, each a program of one kind of
 :data:`PARTS` — an actuator (one file each: :mod:`.wheels`, :mod:`.cmgs`,
-:mod:`.thrusters`, :mod:`.magnetorquers`, :mod:`.damper`, :mod:`.flexible_modes`), a control law
+:mod:`.thrusters`, :mod:`.magnetorquers`, :mod:`.damper`, :mod:`.flexible_modes`, :mod:`.slosh`), a control law
 (:mod:`.laws`), a piece of the environment (:mod:`.environment`) or the
 zero-order hold of a sampled controller — made of a parameter block in the one
 flat array ``data``, a slice of the state vector and a slice of the
@@ -22,14 +22,16 @@ State vector::
 axes. Equations (body axes; Hughes, *Spacecraft Attitude Dynamics*, §7.2;
 Markley & Crassidis 2014, §3.3.5)::
 
-    J_ω ω̇ = τ_ext + Σ τ_k − ω × H,      H = J_ω ω + Σ h_k,      q̇ = ½ q ⊗ [0, ω]
+    (J_ω + Σ ΔM_k) ω̇ = τ_ext + Σ τ_k − ω × H,      H = J_ω ω + Σ h_k,      q̇ = ½ q ⊗ [0, ω]
 
 where ``J_ω`` is the inertia the hub's rate answers to (the total ``J``, every
 rotor counted as a rigid part, less the inertias the parts carry in their own
 states: the wheels' spin inertias, the damper sphere, the appendages' ``Σ δ_kδ_kᵀ``), ``h_k`` the angular
 momentum part ``k`` carries and ``τ_k`` the torque it exerts on the hub
 (``−dh_k/dt`` seen from the hub for internal parts; thrusters and
-magnetorquers exert external torques), and ``τ_ext`` the environment's
+magnetorquers exert external torques), ``ΔM_k`` the state-dependent inertia a
+part adds to the hub's matrix (the slosh pendulums' ``μ g gᵀ``; none: the
+precomputed ``J_ω⁻¹`` solves), and ``τ_ext`` the environment's
 gravity gradient plus the external torque program of ``torque=``
 (:mod:`tumble.torques`). The controller's commands — torque ``u_c`` (N·m),
 dipole ``m_c`` (A·m²), motor torques of the wheels — are evaluated in the
@@ -178,7 +180,7 @@ def slices(model: SpacecraftModel, kind: str) -> Slices | None:
 # (NumbaIRAssumptionWarning "variable ... is not in scope"); the call costs a few ns per evaluation.
 @_protocol.implements(_protocol.rhs, SpacecraftModel)
 def _spacecraft_rhs(model, b0, t, Y, OUT):
-    derivative, _, _, _ = _assemble(Y.ndim, _python(model))
+    derivative, _, _, _, _ = _assemble(Y.ndim, _python(model))
     if Y.ndim == 1:
         def impl(model, b0, t, Y, OUT):
             derivative(model, t, Y, 0, OUT, Y, _STORE[0])
@@ -194,7 +196,7 @@ def _project(device):
     without the flight software (refused there: ``gpu_refusal``)."""
 
     def typer(model, b0, t, Y):
-        _, sense, sample, due = _assemble(Y.ndim, _python(model), device)
+        _, sense, sample, due, constrain = _assemble(Y.ndim, _python(model), device)
         if Y.ndim == 1:
             normalize, lanes = _protocol.normalize_quaternion, inline(lambda Y: 1)
         else:
@@ -202,7 +204,8 @@ def _project(device):
 
         def impl(model, b0, t, Y):
             normalize(Y)
-            for j in range(lanes(Y)):  # the flight software's sensors read at their own sample times
+            for j in range(lanes(Y)):  # the parts' constraints; the flight software's sensors at their sample times
+                constrain(model, Y, j)
                 sense(model, t, Y, j)
             updates = due(model, t)  # the laws held at their sample times t₀ + k·period, the parts' updates
             if updates:
@@ -233,7 +236,7 @@ def _evaluate(model, t, y, aux):  # pragma: no cover - replaced by the overload 
 
 @overload(_evaluate, jit_options={"cache": True})
 def _evaluate_overload(model, t, y, aux):
-    derivative, _, _, _ = _assemble(1, _python(model))
+    derivative, _, _, _, _ = _assemble(1, _python(model))
 
     def impl(model, t, y, aux):
         out = np.empty(y.shape[1])
@@ -249,7 +252,7 @@ def _sample(model, t, y):  # pragma: no cover - replaced by the overload in comp
 
 @overload(_sample, jit_options={"cache": True})
 def _sample_overload(model, t, y):
-    _, sense, sample, due = _assemble(1, _python(model))
+    _, sense, sample, due, _ = _assemble(1, _python(model))
 
     def impl(model, t, y):
         for j in range(1):  # j an int64, as in the projection: a literal 0 would compile these once more

@@ -15,11 +15,11 @@ import functools
 from numba import njit
 
 from tumble import _quat, torques
-from tumble._vec import cross, matvec_flat
+from tumble._vec import cross, matvec_flat, solve_symmetric
 from tumble.kernels.spacecraft import (_commands, cmgs, damper, drag, environment, environment_table,
                                       flexible_modes, flight_software, laws, magnetorquers, residual_dipole,
-                                      solar_pressure, thrusters, wheels)
-from tumble.kernels.spacecraft._base import inline, lane, no_finish, no_sample
+                                      slosh, solar_pressure, thrusters, wheels)
+from tumble.kernels.spacecraft._base import inline, lane, no_added_inertia, no_finish, no_project, no_sample
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_TORQUE,
                                                HELD_WHEELS, J,
@@ -42,6 +42,7 @@ ACTUATORS = {
     "solar_pressure": lambda lane, direct: solar_pressure.kernel(lane),
     "drag": lambda lane, direct: drag.kernel(lane),
     "flexible_modes": lambda lane, direct: flexible_modes.kernel(lane),
+    "slosh": lambda lane, direct: slosh.kernel(lane),
 }
 
 # The empty sums (Numba's inliner takes no *args, so one per signature).
@@ -50,6 +51,8 @@ _no_energy = inline(lambda model, y, j: 0.0)
 _no_torques = inline(lambda model, t, y, j, out, aux, store, w1, w2, w3, cmd: (0.0, 0.0, 0.0))
 _no_samples = inline(lambda model, t, y, j: None)
 _no_finishes = inline(lambda model, y, j, out, a1, a2, a3: None)
+_no_added_inertia = inline(lambda model, y, j: (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+_no_projections = inline(lambda model, y, j: None)
 _none_discrete = inline(lambda model: False)
 
 
@@ -156,6 +159,50 @@ def _add_finish(previous, has, where, finish):
     return total
 
 
+def _added_inertia_all(parts):
+    """``(added, coupled)``: ``Σ ΔM`` (upper triangle, kg·m²) of the actuators present that add to the hub's
+    matrix, and ``coupled(model)``, True when the spacecraft carries one of them."""
+    total, coupled = _no_added_inertia, _none_discrete
+    for _, (has, where), part in parts:
+        if part.added_inertia is not no_added_inertia:
+            total, coupled = _add_inertia(total, has, where, part.added_inertia), _or_present(coupled, has)
+    return total, coupled
+
+
+def _add_inertia(previous, has, where, added_inertia):
+    @inline
+    def total(model, y, j):
+        m00, m01, m02, m11, m12, m22 = previous(model, y, j)
+        if has(model):
+            p, n, s, _ = where(model)
+            d00, d01, d02, d11, d12, d22 = added_inertia(model, p, n, s, y, j)
+            m00, m01, m02, m11, m12, m22 = m00 + d00, m01 + d01, m02 + d02, m11 + d11, m12 + d12, m22 + d22
+        return m00, m01, m02, m11, m12, m22
+
+    return total
+
+
+def _project_all(parts):
+    """The projections of the actuators present that have one: each puts its states back on their
+    constraints."""
+    total = _no_projections
+    for _, (has, where), part in parts:
+        if part.project is not no_project:
+            total = _add_projection(total, has, where, part.project)
+    return total
+
+
+def _add_projection(previous, has, where, project):
+    @inline
+    def total(model, y, j):
+        previous(model, y, j)
+        if has(model):
+            p, n, s, _ = where(model)
+            project(model, p, n, s, y, j)
+
+    return total
+
+
 def _or_present(previous, has):
     return inline(lambda model: previous(model) or has(model))
 
@@ -223,8 +270,8 @@ def _no_sensing(model, t, y, j):
 
 
 def assemble(ndim, python, device=False):
-    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, due)``; ``python``: the
-    variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
+    """Compile-time assembly for states of ``ndim``: ``(derivative, sense, sample, due, constrain)``; ``python``:
+    the variant for a spacecraft whose control laws call Python (else those laws are left out, and the derivative,
     which then allocates nothing, is compiled without reference counting: the
     runtime tests of the parts split the refcount pairs of the model's arrays over branches that Numba's
     pruner cannot join, and counting them made the RK4 step 5.5 times slower).
@@ -235,6 +282,7 @@ def assemble(ndim, python, device=False):
     sampled there, :data:`CONTROL_SAMPLE` at a sample of ``control_period``, :data:`PART_UPDATES` for the parts'
     updates, at the control samples with a ``control_period``, else after every step; 0: none);
     ``sample(model, t, y, j, updates)`` applies those ``updates`` (the held commands, the PWPF triggers);
+    ``constrain(model, y, j)`` puts the parts' states back on their constraints (every step end);
     ``device``: the variant compiled for a GPU, without the flight software. Cached, so that the right-hand side,
     the projection and the diagnostics share it."""
     return _assembled(int(ndim), bool(python), bool(device))
@@ -258,6 +306,8 @@ def _assembled(ndim, python, device):
     torques_on_hub = _sum_torques(actuators)
     sample_parts, discrete = _sample_all(actuators)
     finish_parts = _finish_all(actuators)
+    added_inertia, coupled = _added_inertia_all(actuators)
+    project_parts = _project_all(actuators)
     field, gravity, external = _environment(python)
     has_fsw, where_fsw = locator("flight_software")
     has_table, where_table = locator("environment_table")
@@ -294,6 +344,17 @@ def _assembled(ndim, python, device):
             for i in range(flight_software.STATE):
                 put(out, s + i, j, 0.0)
 
+    @inline
+    def hub_rate(model, y, j, r1, r2, r3):
+        """``ω̇`` (rad/s²) of the hub's ``(J_ω + Σ ΔM) ω̇ = r``: with the precomputed ``J_ω⁻¹`` unless a part
+        adds to the matrix."""
+        d = model.data
+        if coupled(model):
+            m00, m01, m02, m11, m12, m22 = added_inertia(model, y, j)
+            return solve_symmetric(d[J_RATE] + m00, d[J_RATE + 1] + m01, d[J_RATE + 2] + m02, d[J_RATE + 4] + m11,
+                                   d[J_RATE + 5] + m12, d[J_RATE + 8] + m22, r1, r2, r3)
+        return matvec_flat(d, J_RATE_INV, r1, r2, r3)
+
     # Not inlined: one compiled function that the right-hand side and the diagnostics
     # (:func:`tumble.kernels.spacecraft.evaluate`) share, so that the model type compiles it once.
     @njit(_nrt=python)
@@ -312,7 +373,7 @@ def _assembled(ndim, python, device):
         g1, g2, g3 = gravity(model, t, qw, qx, qy, qz)
         e1, e2, e3 = external(model, t, qw, qx, qy, qz, w1, w2, w3)
         k1, k2, k3 = cross(w1, w2, w3, H1, H2, H3)
-        a1, a2, a3 = matvec_flat(d, J_RATE_INV, x1 + g1 + e1 - k1, x2 + g2 + e2 - k2, x3 + g3 + e3 - k3)
+        a1, a2, a3 = hub_rate(model, y, j, x1 + g1 + e1 - k1, x2 + g2 + e2 - k2, x3 + g3 + e3 - k3)
         r = _quat.qmul(qw, qx, qy, qz, 0.0, w1, w2, w3)
         put(out, 0, j, 0.5 * r[0])
         put3(out, 1, j, 0.5 * r[1], 0.5 * r[2], 0.5 * r[3])
@@ -412,4 +473,8 @@ def _assembled(ndim, python, device):
         if updates & PART_UPDATES:
             sample_parts(model, t, y, j)
 
-    return derivative, sense, sample, due
+    @njit
+    def constrain(model, y, j):
+        project_parts(model, y, j)
+
+    return derivative, sense, sample, due, constrain

@@ -9,7 +9,7 @@ writes only: a row view would cost reference counting in every evaluation of
 the right-hand side.
 
 An actuator (or any part that carries angular momentum: wheels, gyros, a
-damper, flexible modes) is an :class:`Actuator` of five compiled functions with one
+damper, flexible modes, slosh pendulums) is an :class:`Actuator` of up to seven compiled functions with one
 signature each; :mod:`tumble.kernels.spacecraft` sums them over the parts present.
 Every function receives the compiled model and the part's place in it: ``p``
 the offset of its parameter block in ``model.data``, ``n`` its count (wheels,
@@ -38,9 +38,20 @@ diagnostics (see :data:`tumble.kernels.spacecraft.PARTS`)::
         ``computeDerivatives``
     sample(model, p, n, s, t, y, j)
         its discrete updates at the end of a step that ends at ``t`` (in place)
+    added_inertia(model, p, n, s, y, j) -> (m₀₀, m₀₁, m₀₂, m₁₁, m₁₂, m₂₂)
+        a state-dependent, symmetric contribution ``ΔM`` (kg·m², upper triangle) to
+        the hub's matrix, for a part whose states' accelerations carry the hub's
+        ``ω̇`` back into the torque it exerts (the slosh pendulums' ``μ g gᵀ``; Basilisk's
+        effectors add their ``matrixD`` terms to the hub's back-substitution so):
+        the hub then solves ``(J_ω + Σ ΔM) ω̇ = rhs`` (a closed-form 3×3 solve),
+        without such a part present with the precomputed ``J_ω⁻¹``
+    project(model, p, n, s, y, j)
+        puts its states back on their constraints at every step end (in place; the
+        slosh rods' ``|s| = 1``, ``ν·s = 0``), as the quaternion is normalised there
 
 The right-hand side calls, in order: every ``momentum`` (to form ``H``), every
-``act`` (the torques on the hub), the hub's solve for ``ω̇``, every ``finish``.
+``act`` (the torques on the hub), every ``added_inertia``, the hub's solve for
+``ω̇``, every ``finish``.
 """
 
 from __future__ import annotations
@@ -122,6 +133,16 @@ def no_finish(model, p, n, s, y, j, out, a1, a2, a3):
     pass
 
 
+@inline
+def no_added_inertia(model, p, n, s, y, j):
+    return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+
+
+@inline
+def no_project(model, p, n, s, y, j):
+    pass
+
+
 class Actuator(NamedTuple):
     """The compiled functions of one part (see the module docstring); absent ones do nothing."""
 
@@ -130,6 +151,8 @@ class Actuator(NamedTuple):
     energy: Callable = no_energy
     sample: Callable = no_sample
     finish: Callable = no_finish
+    added_inertia: Callable = no_added_inertia
+    project: Callable = no_project
 
 
 class Program(NamedTuple):

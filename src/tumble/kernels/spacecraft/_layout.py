@@ -14,7 +14,7 @@ from tumble.kernels.spacecraft._base import inline
 PARTS = ("hold", "wheels", "cmgs", "thrusters", "magnetorquers", "damper", "pd", "mrp", "mrp_integral",
          "python_law", "bdot", "dumping", "wheel_table", "wheel_python", "dipole_field", "uniform_field",
          "gravity_gradient", "residual_dipole", "environment_table", "solar_pressure", "drag",
-         "flight_software", "flexible_modes")
+         "flight_software", "flexible_modes", "slosh")
 
 #: The fields of ``SpacecraftModel`` before the parts' (one int64 per kind of :data:`PARTS` follows them).
 CORE_FIELDS = ("data", "route", "size", "aux_size", "torque_at", "torque_terms", "python_calls")

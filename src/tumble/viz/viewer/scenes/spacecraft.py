@@ -16,6 +16,8 @@ Drawn from the :class:`tumble.spacecraft.Spacecraft` (its parts) and its traject
 * flexible mode ``k``: a line from the centre of mass along its participation axis ``δ_k/|δ_k|`` (body axes;
   the appendages' geometry is not in the model) of length ``(1 + ½ η_k/max|η_k|)`` × its base length, so
   that it swings with the mode;
+* slosh tank ``k``: its pendulum's rod from the hinge ``b_k`` to the slosh mass at ``b_k + l_k s_k(t)``
+  (body axes, from the hub's centre of mass), the mass a marker;
 * with an orbit (or an environment): the nadir ``−r/|r|`` and the orbit normal ``r × v/|r × v|`` (inertial
   axes);
 * with an environment: the direction of the Sun ``ŝ`` (inertial axes), hidden while the craft is in the
@@ -139,6 +141,14 @@ def scene(traj: Trajectory, idx: np.ndarray, model: Spacecraft | None, options: 
         scene.notes.append("residual dipole: its direction m/|m| from the centre of mass, fixed in the body")
     if craft.flexible_modes is not None:
         _modes(scene, craft.flexible_modes.participation, traj.modal_coordinate[idx], R, _MODE * half)
+    if craft.slosh:
+        direction = traj.pendulum_direction[idx]
+        for k, tank in enumerate(craft.slosh):
+            ends = np.stack([np.broadcast_to(tank.hinge, direction[:, k].shape),
+                             tank.hinge + tank.length * direction[:, k]], axis=1)
+            scene.lines.append(Lines(f"slosh pendulum {k + 1}", np.einsum("fij,fpj->fpi", R, ends), "#1f77b4",
+                                     width=4.0, markers=True))
+        scene.notes.append("slosh: each tank's pendulum rod from its hinge to the slosh mass (marker)")
     facets = {id(f): f for part in (craft.solar_pressure, craft.drag) if part is not None for f in part.facets}
     for i, facet in enumerate(facets.values()):
         centre, normal = np.asarray(facet.centre), np.asarray(facet.normal)
