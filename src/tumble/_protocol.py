@@ -52,6 +52,16 @@ held in registers (a 7-tuple), which the fixed-step RK4 and CF4 then run fused
     members(model, b0, b1) -> model         the kernel of members b0 … b1−1 alone (its rows 0 … b1−b0−1),
                                             contiguous copies, so that a block reads lane j's row j
 
+(:func:`implemented` tells an overload whether a kernel type gives one.) Such a
+kernel's class also declares, as a static method, whether compiled code of a
+Numba type of it may call a Python function (known when a call is typed; the
+fused passes over the lanes then keep reference counts)::
+
+    may_call_python(numba_type) -> bool
+
+A kernel also tells Python whether it calls back into the interpreter
+(``calls_python``): the integrators then run its batch on one core.
+
 A kernel whose right-hand side needs scratch memory (a robot's articulated-body
 algorithm: its per-body spatial quantities) gives it as one float64 array that
 the method allocates once per run with its own workspace, per block of lanes
@@ -62,19 +72,9 @@ evaluations then reuse::
                                             one after another, or one state vector)
     with_scratch(model, S) -> model         the kernel that evaluates its right-hand side in S
 
-The methods reach both through :func:`model_workspace` (the model's share of a
-method's workspace: ``(S,)`` or ``()``) and :func:`evaluating` (the kernel
-that evaluates in it).
-
-(:func:`implemented` tells an overload whether a kernel type gives one.) Such a
-kernel's class also declares, as a static method, whether compiled code of a
-Numba type of it may call a Python function (known when a call is typed; the
-fused passes over the lanes then keep reference counts)::
-
-    may_call_python(numba_type) -> bool
-
-A kernel also tells Python whether it calls back into the interpreter
-(``calls_python``): the integrators then run its batch on one core.
+The methods that evaluate ``rhs`` (``rk4``, ``cf4``, ``dop853``) reach both
+through :func:`model_workspace` (the model's share of a method's workspace:
+``(S,)`` or ``()``) and :func:`evaluating` (the kernel that evaluates in it).
 
 The integrators call these generic functions; Numba picks the implementation
 from the model's type when it compiles the integrator, so each model gets its

@@ -119,6 +119,7 @@ def joint_torque(model, t, q, qd, tau):
 
 @njit(cache=True)
 def _call_python_law(model, t, q, qd, tau):
+    """``tau = f(t, q, q̇)``: the law's Python function, called through :mod:`tumble._callback`."""
     slot = model.law[1]
     with objmode():
         _callback.invoke(slot, t, (q, qd), tau)
