@@ -62,6 +62,20 @@ fused passes over the lanes then keep reference counts)::
 A kernel also tells Python whether it calls back into the interpreter
 (``calls_python``): the integrators then run its batch on one core.
 
+A kernel whose right-hand side needs scratch memory (a robot's articulated-body
+algorithm: its per-body spatial quantities) gives it as one float64 array that
+the method allocates once per run with its own workspace, per block of lanes
+on the CPU and per member on a GPU (where no code may allocate), and that the
+evaluations then reuse::
+
+    scratch(model, Y) -> S                  a new array, the scratch of evaluating Y (a block's lanes
+                                            one after another, or one state vector)
+    with_scratch(model, S) -> model         the kernel that evaluates its right-hand side in S
+
+The methods that evaluate ``rhs`` (``rk4``, ``cf4``, ``dop853``) reach both
+through :func:`model_workspace` (the model's share of a method's workspace:
+``(S,)`` or ``()``) and :func:`evaluating` (the kernel that evaluates in it).
+
 The integrators call these generic functions; Numba picks the implementation
 from the model's type when it compiles the integrator, so each model gets its
 own fully inlined integrator, and the compiled code is cached on disk. (Passing
@@ -186,6 +200,44 @@ def inverse_moments(model, b):  # pragma: no cover - replaced by overloads in co
     whose motion is torque-free provide it: the splitting methods rely on both.
     """
     raise NotImplementedError(f"{type(model).__name__} is not a torque-free rigid body")
+
+
+def scratch(model, Y):  # pragma: no cover - replaced by overloads in compiled code
+    """A new float64 array: the scratch memory the right-hand side of ``model`` evaluates ``Y`` in (a block,
+    its lanes one after another, or one state vector)."""
+    raise NotImplementedError(f"{type(model).__name__} needs no scratch")
+
+
+def with_scratch(model, S):  # pragma: no cover - replaced by overloads in compiled code
+    """The kernel ``model`` evaluating its right-hand side in the scratch ``S`` (a :func:`scratch` array, or
+    a member's row of one on a GPU)."""
+    raise NotImplementedError(f"{type(model).__name__} needs no scratch")
+
+
+def model_workspace(model, Y):  # pragma: no cover - replaced by the overload in compiled code
+    """The model's share of a method's workspace for ``Y``: ``(scratch(model, Y),)`` for a kernel that gives
+    :func:`scratch`, else ``()``; a method appends it to its own arrays."""
+    raise NotImplementedError("compiled code only")
+
+
+def evaluating(model, work):  # pragma: no cover - replaced by the overload in compiled code
+    """The kernel that evaluates in the scratch of a method's workspace ``work`` (its last array, from
+    :func:`model_workspace`): ``with_scratch(model, work[-1])``, or ``model`` itself for a kernel without."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(model_workspace, inline="always", target="generic", jit_options={"cache": True})
+def _model_workspace(model, Y):
+    if implemented(scratch, model):
+        return lambda model, Y: (scratch(model, Y),)
+    return lambda model, Y: ()
+
+
+@overload(evaluating, inline="always", target="generic", jit_options={"cache": True})
+def _evaluating(model, work):
+    if implemented(scratch, model):
+        return lambda model, work: with_scratch(model, work[-1])
+    return lambda model, work: model
 
 
 #: What a compiled model can provide to the methods, in the words of the error message that

@@ -22,7 +22,7 @@ import pytest
 from helpers import compile_ptx, nvvm_available
 
 import tumble
-from tumble import torques
+from tumble import robot, torques
 from tumble.flexible import FlexibleBody, Mode
 from tumble.ins import GimbaledGyro
 from tumble.simulate import as_model
@@ -35,6 +35,19 @@ T = np.array([0.0, 0.02, 0.06, 0.12])  # 2, 4 and 6 steps of DT (a sampled contr
 DT = 0.01
 OMEGA0 = np.array([[0.3, 1.0, -0.4], [-0.5, 0.2, 0.9]])  # two members, rad/s, body axes
 TORQUE = torques.ConstantBody([0.05, -0.02, 0.1]) + torques.ConstantInertial([0.0, 0.03, -0.01])
+
+
+def branching_tree():
+    """A free hub (floating base) with two arms on opposite sides, of two links and of one: a small tree that
+    branches."""
+    def arm_link(mass, origin, com):
+        return robot.Link(joint="revolute", axis=(0, 0, 1), origin_position=origin, mass=mass, com=com,
+                          inertia=np.diag([0.01, 0.3, 0.3]) * mass)
+
+    hub = robot.Link(joint="floating", mass=50.0, com=(0.0, 0.0, 0.0), inertia=np.diag([20.0, 25.0, 8.0]))
+    links = [hub, arm_link(4.0, (0.5, 0.0, 0.0), (0.5, 0.0, 0.0)), arm_link(2.0, (1.0, 0.0, 0.0), (0.4, 0.0, 0.0)),
+             arm_link(3.0, (-0.5, 0.0, 0.0), (-0.3, 0.0, 0.0))]
+    return robot.RobotTree(links, [-1, 0, 1, 0])
 
 
 def cases():
@@ -61,13 +74,31 @@ def cases():
         "spacecraft: wheels, MRP feedback, flexible modes, rk4": (flexible_craft, "rk4", TORQUE,
                                                                   {**wheel_speeds, "eta0": [[0.1, -0.05], [0.0, 0.2]]}),
         "rigid, one body each, cf4": (rigid, "cf4", TORQUE, {}),
+        # robots provide no body rate (cf4's need): rk4 only
+        "robot: planar two-link chain, rk4": (robot.load(tumble.examples.directory() / "robots/planar_2link.toml"),
+                                              "rk4", [1.0, -0.5], {"q0": [[0.3, -0.5], [1.0, 0.2]],
+                                                                   "qd0": [[0.1, 0.4], [-0.3, 0.0]]}),
+        "robot: a branching tree on a free hub, rk4": (branching_tree(), "rk4", [0.3, -0.2, 0.5], {
+            "q0": [[0.4, -0.6, 0.2], [0.1, 0.2, -0.3]], "qd0": [[0.1, -0.2, 0.0], [0.3, 0.0, 0.4]],
+            "base_omega0": [[0.0, 0.0, 0.05], [0.02, -0.01, 0.0]], "base_velocity0": [0.1, 0.0, -0.05]}),
     }
 
 
 def _run(device, name):
+    """The run's positions and rates: ``q`` and ``omega`` (the bodies), or a robot's joint coordinates and rates
+    (with a floating base, the base's attitude and rates first); and its statistics."""
     model, method, torque, state = cases()[name]
-    traj = tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, device=device, **state)
-    return {"q": traj.q, "omega": traj.omega, **{k: traj.info[k] for k in ("n_steps", "n_rhs")}}
+    if isinstance(model, robot.RobotTree):
+        traj = tumble.simulate(model, t=T, method=method, dt=DT, torque=torque, device=device, **state)
+        base = model.floating_base
+        motion = {"q": np.concatenate([traj.base_attitude, traj.joint_position], axis=-1) if base
+                  else traj.joint_position,
+                  "omega": np.concatenate([traj.base_omega, traj.base_velocity, traj.joint_velocity], axis=-1)
+                  if base else traj.joint_velocity}
+    else:
+        traj = tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, device=device, **state)
+        motion = {"q": traj.q, "omega": traj.omega}
+    return {**motion, **{k: traj.info[k] for k in ("n_steps", "n_rhs")}}
 
 
 # In the child, with the simulator on: each case's GPU run into one .npz.
@@ -130,6 +161,13 @@ def test_what_cannot_run_on_a_gpu_is_refused_naming_the_part(make, message):
         tumble.simulate(model, OMEGA0[0], t=T, method="rk4", dt=DT, torque=torque, device="cuda")
 
 
+def test_a_robot_under_a_python_torque_law_is_refused_naming_torque():
+    chain = robot.load(tumble.examples.directory() / "robots/planar_2link.toml")
+    with pytest.raises(tumble.ValidationError, match=r"^torque: a Python function cannot run on the GPU "
+                                                     r"\(device='cuda'\); use the compiled models or device='cpu'$"):
+        tumble.simulate(chain, q0=[0.3, -0.5], t=T, method="rk4", dt=DT, torque=lambda t, q, qd: -qd, device="cuda")
+
+
 def test_a_model_kind_without_a_device_path_is_refused_naming_device():
     gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
                         outer_gimbal=1e-3, imbalance=0.01)
@@ -150,7 +188,7 @@ def test_methods_without_a_device_kernel_are_refused():
 @pytest.mark.slow
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "spacecraft: wheels, MRP feedback, rk4",
-                                  "rigid, one body each, cf4"])
+                                  "rigid, one body each, cf4", "robot: planar two-link chain, rk4"])
 def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""
     from numba import typeof

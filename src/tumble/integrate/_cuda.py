@@ -243,11 +243,13 @@ def _rows(work, b):
     return tuple(w[b] for w in work)
 
 
-# The workspaces of the device methods, by their number of arrays: none (a step in registers), cf4's 4, rk4's 5.
+# The workspaces of the device methods, by their number of arrays: none (a step in registers), cf4's 4, rk4's 5,
+# and one more with the model's scratch (a robot's: tumble._protocol.scratch).
 _ROWS = {
     0: lambda work, b: (),
     4: lambda work, b: (work[0][b], work[1][b], work[2][b], work[3][b]),
     5: lambda work, b: (work[0][b], work[1][b], work[2][b], work[3][b], work[4][b]),
+    6: lambda work, b: (work[0][b], work[1][b], work[2][b], work[3][b], work[4][b], work[5][b]),
 }
 
 

@@ -21,7 +21,7 @@ from functools import cache
 import numpy as np
 from numba import njit, prange
 
-from tumble._protocol import project, rhs, state_size
+from tumble._protocol import evaluating, model_workspace, project, rhs, state_size
 from tumble.integrate._fixed import store
 from tumble.integrate._method import ADAPTIVE, Driver, Method
 
@@ -166,6 +166,7 @@ def dop853_path(model, b, y, t_out, rtol, atol, max_steps, tab, out, stats):
     number of steps to the end of ``t_out`` (see :data:`PROJECT_AFTER`).
     """
     A, B, C, E3, E5 = tab
+    model = evaluating(model, model_workspace(model, y))  # the model's scratch (a robot's), if any
     n = state_size(model)
     K = np.empty((_STAGES + 1, n))
     y_new, tmp = np.empty(n), np.empty(n)

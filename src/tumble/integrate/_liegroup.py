@@ -43,7 +43,7 @@ import numpy as np
 from numba import njit
 
 from tumble import _protocol, _quat
-from tumble._protocol import body_rate, point_rates, project, quaternion_scale, rhs
+from tumble._protocol import body_rate, evaluating, model_workspace, point_rates, project, quaternion_scale, rhs
 from tumble.integrate import _fixed, _fused
 from tumble.integrate._method import FIXED_STEP, Method
 from tumble.integrate._rk4 import weighted_sum
@@ -134,7 +134,9 @@ def _cf4_workspace(scheme, model, b0, Y):
         lanes = Y.size // Y.shape[0]  # 1 for one body's state vector
         n = Y.shape[0]
         # derivatives k₁…k₄ and the stage state (state × lanes), stage rates ω₁…ω₄, Q₂
-        return (np.empty((4, n, lanes)), np.empty((n, lanes)), np.empty((4, 3, lanes)), np.empty((4, lanes)))
+        # then the model's scratch (a robot's), if any
+        return (np.empty((4, n, lanes)), np.empty((n, lanes)), np.empty((4, 3, lanes)),
+                np.empty((4, lanes))) + model_workspace(model, Y)
 
     return impl
 
@@ -145,7 +147,8 @@ def _cf4_advance(scheme, model, b0, t0, h, m, Y, work):
         return _fused_advance(Y, model)  # one step of a lane in registers (_fused)
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
-        K, S, W, Q2 = work
+        K, S, W, Q2 = work[0], work[1], work[2], work[3]
+        model = evaluating(model, work)
         # one body's state vector runs as a block of one lane
         y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))
         for s in range(m):

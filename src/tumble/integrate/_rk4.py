@@ -28,7 +28,8 @@ from numba import njit
 from numba.extending import register_jitable
 
 from tumble import _protocol
-from tumble._protocol import point_rates, project, quaternion_scale, rhs, state_size
+from tumble._protocol import (evaluating, model_workspace, point_rates, project, quaternion_scale, rhs,
+                              state_size)
 from tumble.integrate import _fixed, _fused
 from tumble.integrate._method import FIXED_STEP, Method
 
@@ -88,8 +89,9 @@ SCHEME = RK4()
 def _rk4_workspace(scheme, model, b0, Y):
     if _protocol.implemented(point_rates, model):
         return _fused.workspace(model, Y)
+    # the stages k₁…k₄ and the stage state, then the model's scratch (a robot's), if any
     return lambda scheme, model, b0, Y: (np.empty_like(Y), np.empty_like(Y), np.empty_like(Y), np.empty_like(Y),
-                                     np.empty_like(Y))
+                                         np.empty_like(Y)) + model_workspace(model, Y)
 
 
 @_protocol.implements(_fixed.advance, RK4)
@@ -102,7 +104,8 @@ def _rk4_advance(scheme, model, b0, t0, h, m, Y, work):
     flat = _itself if Y.ndim == 1 else _raveled
 
     def impl(scheme, model, b0, t0, h, m, Y, work):
-        k1, k2, k3, k4, tmp = work
+        k1, k2, k3, k4, tmp = work[0], work[1], work[2], work[3], work[4]
+        model = evaluating(model, work)
         y_, k1_, k2_, k3_, k4_, tmp_ = flat(Y), flat(k1), flat(k2), flat(k3), flat(k4), flat(tmp)
         # a compile-time constant for one body, so LLVM unrolls the stage loops
         size = state_size(model) if Y.ndim == 1 else Y.size

@@ -22,7 +22,15 @@ The joint torques act on the joints only (none on a floating base).
 ``project`` renormalises the base quaternion (a fixed base has nothing to
 project). The torque law is zero, a constant, or a Python function ``f(t, q,
 q̇)`` called through the one registry of Python callbacks,
-:mod:`tumble._callback` (then ``calls_python``: the batch runs on one core).
+:mod:`tumble._callback` (then ``calls_python``: the batch runs on one core;
+refused on a GPU).
+
+``FD`` runs in the kernel's ``scratch`` (:func:`scratch_size`: the articulated
+bodies' spatial quantities, the copies of ``q``, ``q̇``, ``τ`` and ``q̈``, a zero wrench),
+which the methods allocate once per run with their workspace, per block on
+the CPU and per member on a GPU (:func:`tumble._protocol.scratch`): an
+evaluation allocates nothing, so the same right-hand side compiles for an
+NVIDIA GPU (``"cuda"``).
 """
 
 from __future__ import annotations
@@ -31,6 +39,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit, objmode
+from numba.extending import overload
 
 from tumble import _callback, _protocol
 from tumble._quat import qmul, qnorm, qrotate
@@ -49,6 +58,8 @@ class RobotModel(NamedTuple):
     law     : (2,) int64: the torque law (``ZERO``, ``CONSTANT`` or ``PYTHON``) and,
               for ``PYTHON``, the function's slot in :mod:`tumble._callback`
     torque  : (dof,) the constant joint torques of ``CONSTANT`` (N·m or N)
+    scratch : (:func:`scratch_size`,) where the right-hand side evaluates (one evaluation at a time); the
+              methods give each block or GPU thread its own (:func:`tumble._protocol.with_scratch`)
     """
 
     params: np.ndarray
@@ -56,16 +67,30 @@ class RobotModel(NamedTuple):
     gravity: np.ndarray
     law: np.ndarray
     torque: np.ndarray
+    scratch: np.ndarray
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side (and a projection)."""
-        return frozenset({"rhs"})
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side (and a projection); ``"cuda"``
+        without a Python torque law."""
+        return frozenset({"rhs", *(() if self.calls_python else ("cuda",))})
 
     @property
     def calls_python(self) -> bool:
         """True when the torque law is a Python function (the batch then runs on one core)."""
         return int(self.law[0]) == PYTHON
+
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this kernel cannot run on an NVIDIA GPU (a ValidationError message), or None: a Python torque law."""
+        return _protocol.python_on_gpu("torque") if self.calls_python else None
+
+
+def scratch_size(nb: int, nv: int) -> int:
+    """Length of the scratch of one evaluation for a tree of nb bodies and nv velocity coordinates: the
+    single-state workspace of :mod:`tumble.kernels.featherstone` (the bodies' scratch, the forward dynamics'
+    matrices, the copies of ``q``, ``q̇`` and ``τ``), then ``q̈`` (nv) and a zero wrench (6)."""
+    return _featherstone.workspace_size(nb, nv) + nv + 6
 
 
 def initial_states(q0: np.ndarray, qd0: np.ndarray) -> np.ndarray:
@@ -83,14 +108,38 @@ def joint_torque(model, t, q, qd, tau):
     """The joint torques ``τ(t, q, q̇)`` (N·m or N) of the model's law, into ``tau`` (n,)."""
     law = model.law[0]
     if law == ZERO:
-        tau[:] = 0.0
+        for i in range(tau.shape[0]):
+            tau[i] = 0.0
     elif law == CONSTANT:
         for i in range(tau.shape[0]):  # by a loop: a slice assignment compiles a shape-mismatch message formatter
             tau[i] = model.torque[i]
     else:
-        slot = model.law[1]
-        with objmode():
-            _callback.invoke(slot, t, (q, qd), tau)
+        _python_law(model, t, q, qd, tau)
+
+
+@njit(cache=True)
+def _call_python_law(model, t, q, qd, tau):
+    """``tau = f(t, q, q̇)``: the law's Python function, called through :mod:`tumble._callback`."""
+    slot = model.law[1]
+    with objmode():
+        _callback.invoke(slot, t, (q, qd), tau)
+
+
+def _python_law(model, t, q, qd, tau):  # pragma: no cover - replaced by the overloads in compiled code
+    """``tau = f(t, q, q̇)``, the law's Python function. Compiled per target: on the CPU it calls the function;
+    on an NVIDIA GPU it does nothing, since a Python law is refused before a launch (``gpu_refusal``), so that
+    the right-hand side compiles for the GPU."""
+    raise NotImplementedError("compiled code only")
+
+
+@overload(_python_law, target="cpu", jit_options={"cache": True})
+def _python_law_cpu(model, t, q, qd, tau):
+    return lambda model, t, q, qd, tau: _call_python_law(model, t, q, qd, tau)
+
+
+@overload(_python_law, target="cuda")
+def _python_law_gpu(model, t, q, qd, tau):
+    return lambda model, t, q, qd, tau: None
 
 
 @njit(cache=True)
@@ -103,7 +152,8 @@ def sample_torques(model, t, Q, QD, TAU):
 
 @njit(cache=True)
 def _derivative(model, t, y, ydot):
-    """``ẏ = [q̇ (configuration rates), FD(q, q̇, τ), τ · q̇]`` of one state vector ``y = [q, q̇, W]``.
+    """``ẏ = [q̇ (configuration rates), FD(q, q̇, τ), τ · q̇]`` of one state vector ``y = [q, q̇, W]``, in the
+    kernel's scratch.
 
     ``q`` and ``q̇`` are copied out of ``y`` (which may be a lane of a block)
     so that the forward dynamics always sees contiguous arrays: one compiled
@@ -111,12 +161,18 @@ def _derivative(model, t, y, ydot):
     """
     nq, nv = model.sizes[0], model.sizes[1]
     fl = nq - nv
-    P = model.params
-    W, X, T, M, zero = _featherstone.fd_scratch(P.shape[0], nv)
-    q, qd = y[:nq].copy(), y[nq:nq + nv].copy()
-    tau, qdd = np.zeros(nv), np.empty(nv)
+    P, S = model.params, model.scratch
+    W, X, T, M, zero = _featherstone.fd_views(P, S, nv)
+    o = _featherstone.state_offset(P, nv)  # q, q̇, τ, then q̈
+    q, qd = _featherstone.state_copy(y[:nq], S, o), _featherstone.state_copy(y[nq:nq + nv], S, o + nq)
+    tau, qdd = S[o + nq + nv:o + nq + 2 * nv], S[o + nq + 2 * nv:o + nq + 3 * nv]
+    no_wrench = S[o + nq + 3 * nv:o + nq + 3 * nv + 6]  # on the last body
+    for i in range(6):
+        no_wrench[i] = 0.0
+    for i in range(6 * fl):  # no joint torque on a floating base
+        tau[i] = 0.0
     joint_torque(model, t, q, qd, tau[6 * fl:])
-    _featherstone.forward_one(P, q, qd, tau, model.gravity, np.zeros(6), W, X, T, M, zero, qdd)
+    _featherstone.forward_one(P, q, qd, tau, model.gravity, no_wrench, W, X, T, M, zero, qdd)
     power = 0.0
     for i in range(nv):
         ydot[nq + i] = qdd[i]
@@ -160,3 +216,13 @@ def _robot_project(model, b0, t, Y):
 @_protocol.implements(_protocol.state_size, RobotModel)
 def _robot_state_size(model):
     return lambda model: model.sizes[0] + model.sizes[1] + 1
+
+
+@_protocol.implements(_protocol.scratch, RobotModel)
+def _robot_scratch(model, Y):
+    return lambda model, Y: np.empty(model.scratch.shape[0])
+
+
+@_protocol.implements(_protocol.with_scratch, RobotModel, inline=True)
+def _robot_with_scratch(model, S):
+    return lambda model, S: RobotModel(model.params, model.sizes, model.gravity, model.law, model.torque, S)

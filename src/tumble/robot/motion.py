@@ -147,7 +147,7 @@ class ChainMotion(Model):
         law, slot, constant = self._torque_law(torque)
         return _kernel.RobotModel(params=self._params, sizes=np.array([self.nq, self.nv], dtype=np.int64),
                                   gravity=self._gravity, law=np.array([law, slot], dtype=np.int64),
-                                  torque=constant)
+                                  torque=constant, scratch=np.empty(_kernel.scratch_size(len(self._params), self.nv)))
 
     def _torque_law(self, torque) -> tuple[int, int, np.ndarray]:
         """``(law, callback slot, constant torque)`` of the ``torque`` argument."""

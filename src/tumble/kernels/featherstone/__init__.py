@@ -41,17 +41,18 @@ One module per job: :mod:`.layout` (the columns, the scratch), :mod:`.spatial`
 energies, centroidal momentum).
 """
 
-from tumble.kernels.featherstone.forward import (aba, aba_batch, aba_one, cholesky_solve, fd_scratch,
+from tumble.kernels.featherstone.forward import (aba, aba_batch, aba_one, cholesky_solve, fd_scratch, fd_views,
                                                  forward_one, mimic)
 from tumble.kernels.featherstone.inverse import crba, crba_batch, crba_one, rnea, rnea_batch, rnea_one
 from tumble.kernels.featherstone.kinematics import (body_poses_batch, centroidal_momentum_batch,
                                                     centroidal_momentum_one, energy_batch, energy_one, poses_batch,
                                                     poses_one, world_poses)
 from tumble.kernels.featherstone.layout import (COORDINATE, FREE, MULTIPLIER, PARAMS, PARENT, PRISMATIC, REVOLUTE,
-                                                floating, scratch, workspace)
+                                                floating, scratch, state_copy, state_offset, workspace,
+                                                workspace_size)
 
 __all__ = ["COORDINATE", "FREE", "MULTIPLIER", "PARAMS", "PARENT", "PRISMATIC", "REVOLUTE", "aba", "aba_batch",
            "aba_one", "body_poses_batch", "centroidal_momentum_batch", "centroidal_momentum_one", "cholesky_solve",
-           "crba", "crba_batch", "crba_one", "energy_batch", "energy_one", "fd_scratch", "floating", "forward_one",
-           "mimic", "poses_batch", "poses_one", "rnea", "rnea_batch", "rnea_one", "scratch", "workspace",
-           "world_poses"]
+           "crba", "crba_batch", "crba_one", "energy_batch", "energy_one", "fd_scratch", "fd_views", "floating",
+           "forward_one", "mimic", "poses_batch", "poses_one", "rnea", "rnea_batch", "rnea_one", "scratch",
+           "state_copy", "state_offset", "workspace", "workspace_size", "world_poses"]

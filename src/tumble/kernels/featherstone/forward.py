@@ -16,7 +16,7 @@ from tumble._vec import cross
 from tumble.kernels.featherstone.inverse import crba_one, rnea_one
 from tumble.kernels.featherstone.layout import (ABA_ACCELERATION, ARTICULATED_INERTIA, AXIS_INERTIA,
                                                 BIAS_ACCELERATION, BIAS_FORCE, COORDINATE, FIRST_MOMENT, INERTIA,
-                                                JIT, JOINT_FORCE, JOINT_INERTIA, JOINT_TYPE, MASS, NO_REFCOUNT,
+                                                INLINE, JIT, JOINT_FORCE, JOINT_INERTIA, JOINT_TYPE, MASS, NO_REFCOUNT,
                                                 ORIGIN, PARENT, PARENT_POSE, REVOLUTE, SPATIAL_PAIR,
                                                 TRANSMITTED_BIAS, VELOCITY, WIDTH, all_finite, body_scratch,
                                                 floating, state_copy, state_fits, state_offset)
@@ -209,6 +209,20 @@ def fd_scratch(nb, nv):
     return np.empty((nb, WIDTH)), np.empty((6, 6)), np.empty((6, 6)), np.empty((nv, nv)), np.zeros(nv)
 
 
+@njit(**INLINE)
+def fd_views(P, S, nv):
+    """The scratch arrays of :func:`forward_one`, ``(W, X, T, M, zero)``, as views of a workspace ``S``
+    (:func:`~.layout.workspace`: ``W``, then the two 6×6 matrices, ``M`` and the zeros), the zeros set. They
+    allocate nothing: code compiled for a GPU takes its scratch so."""
+    o = P.shape[0] * WIDTH
+    X, T = S[o:o + 36].reshape((6, 6)), S[o + 36:o + SPATIAL_PAIR].reshape((6, 6))
+    o += SPATIAL_PAIR
+    M, zero = S[o:o + nv * nv].reshape((nv, nv)), S[o + nv * nv:o + nv * nv + nv]
+    for k in range(nv):
+        zero[k] = 0.0
+    return body_scratch(P, S), X, T, M, zero
+
+
 @njit(**NO_REFCOUNT)
 def forward_one(P, q, qd, tau, g, fext, W, X, T, M, zero, qdd):
     """``q̈ = FD(q, q̇, τ)``: the ABA (:func:`aba_one`), or with mimic joints ``M q̈ = τ − RNEA(q, q̇, 0)`` by CRBA
@@ -233,14 +247,10 @@ def aba(P, q, qd, tau, g, fext, S, qdd):
     nq, nv = q.shape[0], qdd.shape[0]
     if not state_fits(P, S, q, qd, tau, g, fext, nv):
         return False
-    o = P.shape[0] * WIDTH  # the two 6×6 matrices, M and the zeros follow W
-    X, T = S[o:o + 36].reshape(6, 6), S[o + 36:o + SPATIAL_PAIR].reshape(6, 6)
-    o += SPATIAL_PAIR
-    M, zero = S[o:o + nv * nv].reshape(nv, nv), S[o + nv * nv:o + nv * nv + nv]
-    zero[:] = 0.0
+    W, X, T, M, zero = fd_views(P, S, nv)
     o = state_offset(P, nv)
     return forward_one(P, state_copy(q, S, o), state_copy(qd, S, o + nq), state_copy(tau, S, o + nq + nv), g, fext,
-                       body_scratch(P, S), X, T, M, zero, qdd)
+                       W, X, T, M, zero, qdd)
 
 
 @njit(**NO_REFCOUNT)

@@ -152,17 +152,23 @@ def scratch(nb):
     return np.empty((nb, WIDTH))
 
 
+@njit(**INLINE)
+def workspace_size(nb, nv):
+    """The length of a :func:`workspace` for a tree of nb bodies and nv velocity coordinates."""
+    return nb * WIDTH + SPATIAL_PAIR + nv * nv + 4 * nv + 1
+
+
 def workspace(nb: int, nv: int) -> np.ndarray:
     """The flat scratch of the single-state entries for a tree of nb bodies and nv velocity coordinates, in
     order: the per-body scratch (nb, WIDTH); ABA's two 6×6 blocks; for mimic joints M (nv, nv) and nv zeros;
     a contiguous copy of the state (q, nq ≤ nv + 1, and two nv-vectors)."""
-    return np.empty(nb * WIDTH + SPATIAL_PAIR + nv * nv + 4 * nv + 1)
+    return np.empty(workspace_size(nb, nv))
 
 
 @njit(**INLINE)
 def fits(P, S, q, nv):
     """True when ``q`` has the tree's nq = nv + (1 with a floating base) entries and ``S`` is its workspace."""
-    return q.shape[0] == nv + floating(P) and S.shape[0] == P.shape[0] * WIDTH + SPATIAL_PAIR + nv * nv + 4 * nv + 1
+    return q.shape[0] == nv + floating(P) and S.shape[0] == workspace_size(P.shape[0], nv)
 
 
 @njit(**INLINE)
