@@ -78,12 +78,15 @@ import math
 import numpy as np
 from numba import njit
 
-# Compiler options: fused multiply-adds allowed (contraction only: no reassociation,
-# NaN and inf keep their meaning, so the finiteness checks stay valid); a division
-# by zero gives inf or NaN (found by those checks) rather than an exception; the
-# small vector helpers are inlined in Numba's IR (measured 0.9 → 0.5 µs per
-# 7-DOF RNEA).
-JIT = {"cache": True, "fastmath": {"contract"}, "error_model": "numpy"}
+# Compiler options: a division by zero gives inf or NaN (found by the finiteness checks)
+# rather than an exception; the small vector helpers are inlined in Numba's IR (measured
+# 0.9 → 0.5 µs per 7-DOF RNEA). No fast-math flags, not even contraction into fused
+# multiply-adds (docs/integrators.md): whether LLVM fuses ``a·b + c`` depends on what it
+# has inlined around it, so each copy of a function (its own compiled module, and every
+# caller's module it is linked into and optimised again) would round differently, and
+# which copy runs depends on which module the JIT linked first, i.e. on what came from
+# Numba's cache (docs/reliability.md, "Cached and fresh code agree").
+JIT = {"cache": True, "error_model": "numpy"}
 INLINE = {**JIT, "inline": "always"}
 # The sweeps and the single-state entries allocate nothing, so they are compiled without
 # Numba's reference counting (``_nrt=False``): else every array argument, every array handed
