@@ -147,3 +147,42 @@ def test_cache_info_counts_the_compiled_functions_and_cache_clear_removes_them(t
     assert tumble_cache("clear")["removed"].startswith(f"{len(indexes) + len(data)} files, ")
     assert not list(cache.rglob("*.nb[ic]"))
     assert tumble_cache("info")["functions"] == "0"
+
+
+# The robots' inverse and forward dynamics (tumble.kernels.featherstone) over 200 random states, as the bytes'
+# SHA-256, then whether the two batch kernels were compiled or loaded from the cache.
+DYNAMICS = """
+import hashlib
+import numpy as np
+import tumble
+from tumble import robot
+from tumble.kernels import featherstone
+
+rng = np.random.default_rng(3)
+for name in ("puma560.toml", "panda.toml"):
+    chain = robot.load(tumble.examples.directory() / "robots" / name)
+    q, qd, x = (rng.normal(size=(200, chain.dof)) for _ in range(3))
+    for tau in (robot.rnea(chain, q, qd, x), robot.forward_dynamics(chain, q, qd, x)):
+        print(name, hashlib.sha256(np.ascontiguousarray(tau).tobytes()).hexdigest())
+for kernel in (featherstone.rnea_batch, featherstone.aba_batch):
+    print(kernel.__name__, sum(kernel.stats.cache_misses.values()), "compiled", sum(kernel.stats.cache_hits.values()),
+          "loaded")
+"""
+
+
+@pytest.mark.slow
+def test_code_loaded_from_the_cache_gives_the_freshly_compiled_results_bit_for_bit(tmp_path):
+    # Before the featherstone kernels stopped contracting a·b + c into fused multiply-adds, each copy of a
+    # function (in its own module, and inlined again in each caller's) rounded differently, and which copy ran
+    # depended on what the JIT had linked first: the PUMA's RNEA and ABA differed in the last bits here.
+    env = {**os.environ, "PYTHONPATH": str(SRC.parent), "NUMBA_CACHE_DIR": str(tmp_path)}
+
+    def run():
+        done = subprocess.run([sys.executable, "-c", DYNAMICS], env=env, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        return done.stdout.splitlines()
+
+    fresh, loaded = run(), run()
+    assert fresh[-2:] == ["rnea_batch 1 compiled 0 loaded", "aba_batch 1 compiled 0 loaded"]
+    assert loaded[-2:] == ["rnea_batch 0 compiled 1 loaded", "aba_batch 0 compiled 1 loaded"]
+    assert len(fresh) == 6 and loaded[:4] == fresh[:4]
