@@ -92,9 +92,9 @@ try:
     sweep(module["BODY"], device="cuda", workers=2, **module["sweep_arguments"]())
 except ValidationError as error:
     found["refusal"] = str(error)
-with local_cluster(gpus=["3"]) as cluster, Client(cluster) as client:
-    found["environments"] = client.run(lambda: os.environ["CUDA_VISIBLE_DEVICES"])
-    found["names"] = sorted(w["name"] for w in client.scheduler_info()["workers"].values())
+with local_cluster(gpus=["3", "1"]) as cluster, Client(cluster) as client:
+    seen = client.run(lambda dask_worker: [dask_worker.name, os.environ["CUDA_VISIBLE_DEVICES"]])
+    found["environments"] = dict(sorted(seen.values()))
 here = sweep(module["BODY"], device="cuda", workers=0, **module["sweep_arguments"]())
 cluster = sweep(module["BODY"], device="cuda", workers=1, **module["sweep_arguments"]())
 found["computed"] = [here.attrs["chunks_computed"], cluster.attrs["chunks_computed"]]
@@ -116,8 +116,7 @@ def test_a_sweep_on_a_cluster_of_one_worker_per_gpu_equals_the_run_in_this_proce
     assert found["listed"] == ["3"]
     assert found["refusal"] == ("workers: device='cuda' runs one worker per GPU, and numba.cuda finds 1 GPU here; "
                                 "got workers=2")
-    assert list(found["environments"].values()) == ["3"]  # the worker sees its GPU alone
-    assert found["names"] == ["cuda-3"]
+    assert found["environments"] == {"cuda-1": "1", "cuda-3": "3"}  # each worker sees its own GPU alone
     assert found["computed"] == [2, 2]
     with np.load(tmp_path / "out.npz") as out:
         names = {key.split("/", 1)[1] for key in out.files}
