@@ -134,8 +134,6 @@ def test_a_device_sweep_refuses_what_it_cannot_run():
     with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' runs the methods 'rk4', 'cf4'; "
                                                      r"got method='dop853'$"):
         sweep(body, device="cuda", **arguments)
-    with pytest.raises(tumble.ValidationError, match=r"^workers: device='cuda' runs the chunks in this process"):
-        sweep(body, device="cuda", method="rk4", dt=DT, workers=2, **arguments)
     with pytest.raises(tumble.ValidationError, match=r"^device: must be 'cpu' or 'cuda', got 'tpu'$"):
         sweep(body, device="tpu", method="rk4", dt=DT, **arguments)
 

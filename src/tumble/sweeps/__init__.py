@@ -54,7 +54,7 @@ from tumble.sweeps.outcomes import (
     SettlingTime,
 )
 from tumble.sweeps.plan import _is_builder, make_plan
-from tumble.sweeps.runner import local_cluster, run_chunks
+from tumble.sweeps.runner import gpu_workers, local_cluster, run_chunks
 from tumble.sweeps.store import StoreMismatchError, SweepStore, stored_chunk, writing
 from tumble.sweeps.stream import simulate_to_store
 
@@ -153,9 +153,12 @@ def sweep(
     retries : int
         Retries of a task that raised (a killed worker's tasks are rescheduled by Dask regardless).
     device : {"cpu", "cuda"}
-        ``"cuda"``: each chunk is simulated on the GPU (``method="rk4"`` or ``"cf4"``; ``docs/gpu.md``), in
-        this process (or on ``client``'s workers, one per GPU), and the statistics and percentiles are reduced
-        there (:mod:`tumble.sweeps.device`: the percentiles bit for bit those of the reduction on the CPU).
+        ``"cuda"``: each chunk is simulated on a GPU (``method="rk4"`` or ``"cf4"``; ``docs/gpu.md``): with
+        several GPUs on a local cluster of one worker per GPU, each seeing its own (those of
+        ``CUDA_VISIBLE_DEVICES`` where set; ``workers=N``: the first N, at most as many as there are), with
+        one GPU (or ``workers=0``) in this process, or on ``client``'s workers; the statistics and
+        percentiles are reduced on this process's GPU (:mod:`tumble.sweeps.device`: the percentiles bit for
+        bit those of the reduction on the CPU).
     **initial_state
         Initial states shared by every sample (e.g. ``q0=[1, 0, 0, 0]``).
 
@@ -178,15 +181,15 @@ def sweep(
                                  dict(dt=dt, rtol=rtol, atol=atol, max_steps=max_steps))
     if workers is not None and int(workers) < 0:
         raise ValidationError(f"workers: must be >= 0 (0: in this process), got {workers}")
+    gpus: list[str] = []
     if device not in ("cpu", "cuda"):
         raise ValidationError(f"device: must be 'cpu' or 'cuda', got {device!r}")
     if device == "cuda":
         if m.name not in ("rk4", "cf4"):
             raise ValidationError(f"device: 'cuda' runs the methods 'rk4', 'cf4'; got method={m.name!r}")
-        if client is None and workers not in (None, 0):
-            raise ValidationError(f"workers: device='cuda' runs the chunks in this process, on its GPU (workers=0), "
-                                  f"or on a client's cluster of one worker per GPU; got workers={workers}")
-        workers = 0 if client is None else workers
+        if client is None:  # one worker per GPU, or this process with one GPU
+            gpus = gpu_workers(workers)
+            workers = len(gpus)
     percentiles = tuple(float(p) for p in percentiles)
     if any(not 0.0 <= p <= 100.0 for p in percentiles):
         raise ValidationError(f"percentiles: must lie in [0, 100], got {list(percentiles)}")
@@ -201,7 +204,8 @@ def sweep(
                    f"{'; in memory, every value kept' if store is None else ''})")
     with writing(store):  # one writer at a time; the temporaries of killed runs removed
         result = SweepStore(store, plan)
-        computed = run_chunks(plan, result, client=client, workers=workers, progress=progress, retries=retries)
+        computed = run_chunks(plan, result, client=client, workers=workers, gpus=gpus, progress=progress,
+                              retries=retries)
         if computed or not result.complete or not result.has_percentiles(percentiles):
             result.finalize(percentiles, device)
     ds = result.dataset()

@@ -4,7 +4,9 @@ By default the chunks run on a :class:`distributed.LocalCluster` started for
 the sweep and closed after it: one worker process per core, one thread each,
 listening on 127.0.0.1 only (``workers=0``: in this process, without Dask), with Numba held to one thread per process
 (``NUMBA_NUM_THREADS=1``) so that the processes do not oversubscribe the
-cores. ``client=`` runs them on any existing cluster instead (a
+cores. With ``device="cuda"`` the cluster has one worker process per GPU
+instead, each seeing that GPU alone (:func:`gpu_workers`, :func:`local_cluster`'s
+``gpus``). ``client=`` runs them on any existing cluster instead (a
 ``LocalCluster``, ``dask scheduler`` + ``dask worker`` processes on other
 machines, dask-jobqueue, Kubernetes): only the chunks' small results travel
 back to the client, which writes them to the store, so the workers need no
@@ -27,7 +29,7 @@ import os
 import signal
 import threading
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from contextlib import contextmanager, nullcontext
 from typing import TYPE_CHECKING
 
@@ -38,7 +40,7 @@ from tumble.sweeps.store import SweepStore
 if TYPE_CHECKING:
     from distributed import Client, LocalCluster
 
-__all__ = ["local_cluster", "run_chunks"]
+__all__ = ["gpu_workers", "local_cluster", "run_chunks", "visible_gpus"]
 
 _TRIM = "MALLOC_TRIM_THRESHOLD_"  # glibc's malloc setting that Dask gives its workers
 #: The fewest chunks submitted at once (else four per worker thread): more are submitted as these complete,
@@ -46,9 +48,14 @@ _TRIM = "MALLOC_TRIM_THRESHOLD_"  # glibc's malloc setting that Dask gives its w
 IN_FLIGHT = 32
 
 
-def local_cluster(workers: int | None = None) -> LocalCluster:
+def local_cluster(workers: int | None = None, *, gpus: Sequence[str] = ()) -> LocalCluster:
     """A :class:`distributed.LocalCluster` of ``workers`` single-threaded processes (default: one per core),
     every server on 127.0.0.1 (the scheduler's HTTP endpoint on a free port there).
+
+    With ``gpus`` (ids as ``CUDA_VISIBLE_DEVICES`` names them: :func:`gpu_workers`), one process per GPU
+    instead, named ``cuda-ID``, each with ``CUDA_VISIBLE_DEVICES=ID`` in its environment (set by its nanny
+    before the worker starts, so CUDA, which reads it when a process first calls the driver, shows the
+    worker that GPU alone, as its device 0) and ``1/len(gpus)`` of the host's memory.
 
     The workers run with glibc's own ``malloc`` thresholds. Dask starts its workers with
     ``MALLOC_TRIM_THRESHOLD_=65536`` (``distributed.nanny.pre-spawn-environ``, also left set in the process
@@ -68,9 +75,62 @@ def local_cluster(workers: int | None = None) -> LocalCluster:
 
     n = (os.cpu_count() or 1) if workers is None else int(workers)
     with _glibc_malloc_defaults(), _interrupts_ignored():
-        return LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                            dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"},
-                            silence_logs=logging.CRITICAL)
+        cluster = LocalCluster(n_workers=0 if gpus else n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               dashboard_address="127.0.0.1:0", env={"NUMBA_NUM_THREADS": "1"},
+                               silence_logs=logging.CRITICAL)
+        if gpus:
+            _start_one_worker_per_gpu(cluster, gpus)
+    return cluster
+
+
+def _start_one_worker_per_gpu(cluster: LocalCluster, gpus: Sequence[str]) -> None:
+    """Start on ``cluster`` (none of its own yet) one worker per GPU of ``gpus``, from its worker template with
+    the GPU's ``CUDA_VISIBLE_DEVICES``: distributed's ``SpecCluster`` starts what its ``worker_spec`` adds
+    (entries need not be alike) when it corrects its state. A worker that fails to start closes the cluster."""
+    template = cluster.new_spec
+    for gpu in gpus:
+        options = dict(template["options"], env={**template["options"]["env"], "CUDA_VISIBLE_DEVICES": gpu},
+                       memory_limit=1 / len(gpus))  # a fraction of the host's memory
+        cluster.worker_spec[f"cuda-{gpu}"] = {"cls": template["cls"], "options": options}
+    try:
+        cluster.sync(cluster._correct_state)
+    except BaseException:
+        cluster.close()
+        raise
+
+
+def visible_gpus(environ: Mapping[str, str] = os.environ, count: int | None = None) -> list[str]:
+    """The GPUs this process may use, each named as ``CUDA_VISIBLE_DEVICES`` names it to a child process.
+
+    CUDA numbers the GPUs a process sees 0, 1, …: those ``CUDA_VISIBLE_DEVICES`` lists (indices or UUIDs),
+    in its order, up to its first entry that names none, or every GPU where it is unset. ``count`` is how
+    many this process sees (default: the length of numba.cuda's device list, 0 where numba.cuda finds no
+    GPU; its simulator's list has one). So visible GPU ``i`` is the ``i``-th entry of
+    ``CUDA_VISIBLE_DEVICES``, or ``"i"`` where it is unset, and a child given it sees that GPU alone."""
+    if count is None:
+        from numba import cuda
+
+        count = len(cuda.gpus) if cuda.is_available() else 0
+    listed = environ.get("CUDA_VISIBLE_DEVICES")
+    if listed is None:
+        return [str(i) for i in range(count)]
+    return [entry.strip() for entry in listed.split(",")][:count]
+
+
+def gpu_workers(workers: int | None, gpus: Sequence[str] | None = None) -> list[str]:
+    """The GPUs of ``gpus`` (default :func:`visible_gpus`) on which a sweep with ``device="cuda"`` and no
+    client runs its chunks, one worker process each (:func:`local_cluster`); none: in this process.
+
+    ``workers=None``: every GPU where there are more than one, none with one (or none: the run then says
+    that it needs a GPU). ``workers=0``: none. ``workers=N``: the first ``N``; more than there are is
+    refused, naming ``workers`` and the GPUs found."""
+    gpus = visible_gpus() if gpus is None else list(gpus)
+    if workers is None:
+        return gpus if len(gpus) > 1 else []
+    if int(workers) > len(gpus):
+        raise ValidationError(f"workers: device='cuda' runs one worker per GPU, and numba.cuda finds "
+                              f"{len(gpus)} GPU{'' if len(gpus) == 1 else 's'} here; got workers={workers}")
+    return gpus[:int(workers)]
 
 
 @contextmanager
@@ -153,9 +213,11 @@ def _numba_settings_from_environment() -> None:
 
 
 def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, workers: int | None = None,
-               progress: Callable[[int, int], None] | None = None, retries: int = 2) -> int:
+               gpus: Sequence[str] = (), progress: Callable[[int, int], None] | None = None,
+               retries: int = 2) -> int:
     """Compute the chunks missing from ``store`` on Dask and write each as it completes; return how many
-    were computed. ``progress(done, total)`` counts chunks (those already in the store included)."""
+    were computed. ``gpus``: the sweep's own cluster has one worker per GPU (:func:`local_cluster`).
+    ``progress(done, total)`` counts chunks (those already in the store included)."""
     from distributed import Client, as_completed
 
     missing = store.missing()
@@ -172,7 +234,7 @@ def run_chunks(plan: Plan, store: SweepStore, *, client: Client | None = None, w
         return len(missing)
     cluster = None
     if client is None:
-        cluster = local_cluster(workers)
+        cluster = local_cluster(workers, gpus=gpus)
         client = Client(cluster)
     elif workers is not None:
         raise ValidationError("workers: give it only without client= (a client's cluster has its own workers)")
