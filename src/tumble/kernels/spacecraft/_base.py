@@ -88,23 +88,23 @@ def lane(ndim: int) -> Lane:
     (``put(y, i, j, 1.0 if x else 0.0)`` stores nothing) inside an inlined function.
     """
     if ndim == 1:
-        @inline
+        @njit
         def at(y, i, j):
             return y[i]
 
-        @inline
+        @njit
         def put(y, i, j, value):
             y[i] = value
     else:
-        @inline
+        @njit
         def at(y, i, j):
             return y[i, j]
 
-        @inline
+        @njit
         def put(y, i, j, value):
             y[i, j] = value
 
-    @inline
+    @njit
     def put3(y, i, j, v1, v2, v3):
         put(y, i, j, v1)
         put(y, i + 1, j, v2)
