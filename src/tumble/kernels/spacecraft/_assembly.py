@@ -46,6 +46,7 @@ ACTUATORS = {
     "slosh": lambda lane, direct: slosh.kernel(lane),
 }
 
+
 def _unrolled(name, arguments, parts, call, sums=0, routed=False):
     """One inlined function ``name(arguments)`` that runs ``call`` for each of ``parts`` [(kind index,
     (has, where), function)] present, in their order, and returns the ``sums`` values it adds up (none: returns
