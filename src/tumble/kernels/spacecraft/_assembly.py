@@ -19,7 +19,8 @@ from tumble._vec import cross, matvec_flat, solve_symmetric
 from tumble.kernels.spacecraft import (_commands, cmgs, damper, drag, environment, environment_table,
                                       flexible_modes, flight_software, laws, magnetorquers, residual_dipole,
                                       slosh, solar_pressure, thrusters, wheels)
-from tumble.kernels.spacecraft._base import inline, lane, no_added_inertia, no_finish, no_project, no_sample
+from tumble.kernels.spacecraft._base import (inline, lane, no_added_inertia, no_energy, no_finish, no_momentum,
+                                             no_project, no_sample)
 from tumble.kernels.spacecraft._layout import (AUX_ACTUATOR, AUX_DIPOLE_COMMAND, AUX_ENERGY, AUX_EXTERNAL, AUX_FIELD,
                                                AUX_GRAVITY, AUX_MOMENTUM, AUX_TORQUE_COMMAND, HELD_TORQUE,
                                                HELD_WHEELS, J,
@@ -45,166 +46,97 @@ ACTUATORS = {
     "slosh": lambda lane, direct: slosh.kernel(lane),
 }
 
-# The empty sums (Numba's inliner takes no *args, so one per signature).
-_no_momenta = inline(lambda model, y, j: (0.0, 0.0, 0.0))
-_no_energy = inline(lambda model, y, j: 0.0)
-_no_torques = inline(lambda model, t, y, j, out, aux, store, w1, w2, w3, cmd: (0.0, 0.0, 0.0))
-_no_samples = inline(lambda model, t, y, j: None)
-_no_finishes = inline(lambda model, y, j, out, a1, a2, a3: None)
-_no_added_inertia = inline(lambda model, y, j: (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
-_no_projections = inline(lambda model, y, j: None)
-_none_discrete = inline(lambda model: False)
+
+def _unrolled(name, arguments, parts, call, sums=0, routed=False):
+    """One inlined function ``name(arguments)`` that runs ``call`` for each of ``parts`` [(kind index,
+    (has, where), function)] present, in their order, and returns the ``sums`` values it adds up (none: returns
+    nothing). ``call`` names the part's function ``f`` and may use its place ``p, n, s, a`` and ``routed`` (the
+    controller's torque command is this part's to deliver).
+
+    Written out as one flat function rather than a chain of closures each calling the previous: Numba's IR
+    inliner (0.68) re-runs its passes on, and copies, the whole chain below each link it inlines, so a chain of
+    ``N`` parts costs ``N²/2`` parts' compilation. The sums start at 0.0 and add the parts' terms in the same
+    order as such a chain, so the result is the same to the bit.
+    """
+    totals = ", ".join(f"r{i}" for i in range(sums))
+    terms = ", ".join(f"b{i}" for i in range(sums))
+    lines = [f"def {name}({arguments}):"]
+    if sums:
+        lines.append(f"    {' = '.join(f'r{i}' for i in range(sums))} = 0.0")
+    namespace = {}
+    for i, (k, (has, where), function) in enumerate(parts):
+        namespace.update({f"has_{i}": has, f"where_{i}": where, f"f_{i}": function})
+        lines += [f"    if has_{i}(model):", f"        p, n, s, a = where_{i}(model)"]
+        if routed:
+            lines.append(f"        routed = model.route == {k}")
+        invocation = call.replace("f(", f"f_{i}(")
+        if sums:
+            lines += [f"        {terms} = {invocation}",
+                      f"        {totals} = {', '.join(f'r{j} + b{j}' for j in range(sums))}"]
+        else:
+            lines.append(f"        {invocation}")
+    lines.append(f"    return {totals}" if sums else "    return None")
+    exec(compile("\n".join(lines), f"<tumble.kernels.spacecraft {name}>", "exec"), namespace)
+    return inline(namespace[name])
+
+
+def _with(parts, function, absent):
+    """``parts`` [(kind index, (has, where), Actuator)] reduced to those whose ``function`` (a field of
+    :class:`~tumble.kernels.spacecraft._base.Actuator`) is not ``absent``, with that function."""
+    return [(k, located, getattr(part, function)) for k, located, part in parts
+            if getattr(part, function) is not absent]
 
 
 def _sum_momenta(parts):
     """``Σ h_k`` (N·m·s) of the actuators ``parts`` [(kind index, (has, where), Actuator)] present."""
-    total = _no_momenta
-    for _, (has, where), part in parts:
-        total = _add_momentum(total, has, where, part.momentum)
-    return total
-
-
-def _add_momentum(previous, has, where, momentum):
-    @inline
-    def total(model, y, j):
-        a1, a2, a3 = previous(model, y, j)
-        if has(model):
-            p, n, s, _ = where(model)
-            b1, b2, b3 = momentum(model, p, n, s, y, j)
-            a1, a2, a3 = a1 + b1, a2 + b2, a3 + b3
-        return a1, a2, a3
-
-    return total
+    return _unrolled("momenta", "model, y, j", _with(parts, "momentum", no_momentum), "f(model, p, n, s, y, j)", 3)
 
 
 def _sum_energies(parts):
-    total = _no_energy
-    for _, (has, where), part in parts:
-        total = _add_energy(total, has, where, part.energy)
-    return total
-
-
-def _add_energy(previous, has, where, energy):
-    @inline
-    def total(model, y, j):
-        e = previous(model, y, j)
-        if has(model):
-            p, n, s, _ = where(model)
-            e += energy(model, p, n, s, y, j)
-        return e
-
-    return total
+    return _unrolled("energies", "model, y, j", _with(parts, "energy", no_energy), "f(model, p, n, s, y, j)", 1)
 
 
 def _sum_torques(parts):
     """``Σ τ_k`` (N·m) of the actuators present, each writing its state derivatives and diagnostics."""
-    total = _no_torques
-    for k, (has, where), part in parts:
-        total = _add_torque(total, k, has, where, part.act)
-    return total
-
-
-def _add_torque(previous, k, has, where, act):
-    @inline
-    def total(model, t, y, j, out, aux, store, w1, w2, w3, cmd):
-        a1, a2, a3 = previous(model, t, y, j, out, aux, store, w1, w2, w3, cmd)
-        if has(model):
-            p, n, s, a = where(model)
-            b1, b2, b3 = act(model, p, n, s, a, model.route == k, t, y, j, out, aux, store, w1, w2, w3, cmd)
-            a1, a2, a3 = a1 + b1, a2 + b2, a3 + b3
-        return a1, a2, a3
-
-    return total
+    return _unrolled("torques", "model, t, y, j, out, aux, store, w1, w2, w3, cmd", _with(parts, "act", None),
+                     "f(model, p, n, s, a, routed, t, y, j, out, aux, store, w1, w2, w3, cmd)", 3, routed=True)
 
 
 def _sample_all(parts):
     """``(sample, discrete)``: the discrete updates of the actuators present that have some, and
     ``discrete(model)``, True when the spacecraft carries one of them."""
-    total, discrete = _no_samples, _none_discrete
-    for _, (has, where), part in parts:
-        if part.sample is not no_sample:
-            total, discrete = _add_sample(total, has, where, part.sample), _or_present(discrete, has)
-    return total, discrete
-
-
-def _add_sample(previous, has, where, sample):
-    @inline
-    def total(model, t, y, j):
-        previous(model, t, y, j)
-        if has(model):
-            p, n, s, _ = where(model)
-            sample(model, p, n, s, t, y, j)
-
-    return total
+    sampled = _with(parts, "sample", no_sample)
+    return (_unrolled("samples", "model, t, y, j", sampled, "f(model, p, n, s, t, y, j)"),
+            _any_present(sampled))
 
 
 def _finish_all(parts):
     """The second phase of the actuators present that have one: each completes its state derivatives in
     ``out`` from the hub's ``ω̇ = (a₁, a₂, a₃)``."""
-    total = _no_finishes
-    for _, (has, where), part in parts:
-        if part.finish is not no_finish:
-            total = _add_finish(total, has, where, part.finish)
-    return total
-
-
-def _add_finish(previous, has, where, finish):
-    @inline
-    def total(model, y, j, out, a1, a2, a3):
-        previous(model, y, j, out, a1, a2, a3)
-        if has(model):
-            p, n, s, _ = where(model)
-            finish(model, p, n, s, y, j, out, a1, a2, a3)
-
-    return total
+    return _unrolled("finishes", "model, y, j, out, a1, a2, a3", _with(parts, "finish", no_finish),
+                     "f(model, p, n, s, y, j, out, a1, a2, a3)")
 
 
 def _added_inertia_all(parts):
     """``(added, coupled)``: ``Σ ΔM`` (upper triangle, kg·m²) of the actuators present that add to the hub's
     matrix, and ``coupled(model)``, True when the spacecraft carries one of them."""
-    total, coupled = _no_added_inertia, _none_discrete
-    for _, (has, where), part in parts:
-        if part.added_inertia is not no_added_inertia:
-            total, coupled = _add_inertia(total, has, where, part.added_inertia), _or_present(coupled, has)
-    return total, coupled
-
-
-def _add_inertia(previous, has, where, added_inertia):
-    @inline
-    def total(model, y, j):
-        m00, m01, m02, m11, m12, m22 = previous(model, y, j)
-        if has(model):
-            p, n, s, _ = where(model)
-            d00, d01, d02, d11, d12, d22 = added_inertia(model, p, n, s, y, j)
-            m00, m01, m02, m11, m12, m22 = m00 + d00, m01 + d01, m02 + d02, m11 + d11, m12 + d12, m22 + d22
-        return m00, m01, m02, m11, m12, m22
-
-    return total
+    adding = _with(parts, "added_inertia", no_added_inertia)
+    return _unrolled("added_inertia", "model, y, j", adding, "f(model, p, n, s, y, j)", 6), _any_present(adding)
 
 
 def _project_all(parts):
     """The projections of the actuators present that have one: each puts its states back on their
     constraints."""
-    total = _no_projections
-    for _, (has, where), part in parts:
-        if part.project is not no_project:
-            total = _add_projection(total, has, where, part.project)
-    return total
+    return _unrolled("projections", "model, y, j", _with(parts, "project", no_project), "f(model, p, n, s, y, j)")
 
 
-def _add_projection(previous, has, where, project):
-    @inline
-    def total(model, y, j):
-        previous(model, y, j)
-        if has(model):
-            p, n, s, _ = where(model)
-            project(model, p, n, s, y, j)
-
-    return total
-
-
-def _or_present(previous, has):
-    return inline(lambda model: previous(model) or has(model))
+def _any_present(parts):
+    """``present(model)``: True when the spacecraft carries one of ``parts``."""
+    namespace = {f"has_{i}": has for i, (_, (has, _), _) in enumerate(parts)}
+    test = " or ".join(f"has_{i}(model)" for i in range(len(parts))) or "False"
+    exec(compile(f"def present(model):\n    return {test}\n", "<tumble.kernels.spacecraft present>", "exec"),
+         namespace)
+    return inline(namespace["present"])
 
 
 def _environment(python):

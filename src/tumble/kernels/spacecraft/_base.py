@@ -82,29 +82,29 @@ class Lane(NamedTuple):
 def lane(ndim: int) -> Lane:
     """The :class:`Lane` access for state vectors (``ndim`` 1, ``j`` unused) or blocks (``ndim`` 2).
 
-    Plain inlined closures, one set per ``ndim``: an ``overload`` dispatching on
-    ``y.ndim`` would be shorter, but Numba's IR inliner (0.68) drops an inlined
-    overload's call whose argument is a conditional expression
-    (``put(y, i, j, 1.0 if x else 0.0)`` stores nothing) inside an inlined function.
+    Plain compiled closures, one set per ``ndim``, which LLVM inlines: not inlined in Numba's IR (``inline``),
+    where each of their ~200 call sites would cost a run of Numba's passes over a copy of the function
+    (a sixth of the spacecraft's compile time), and not an ``overload`` dispatching on ``y.ndim``, whose
+    inlined calls Numba's IR inliner (0.68) drops when an argument is a conditional expression.
     """
     if ndim == 1:
-        @inline
+        @njit
         def at(y, i, j):
             return y[i]
 
-        @inline
+        @njit
         def put(y, i, j, value):
             y[i] = value
     else:
-        @inline
+        @njit
         def at(y, i, j):
             return y[i, j]
 
-        @inline
+        @njit
         def put(y, i, j, value):
             y[i, j] = value
 
-    @inline
+    @njit
     def put3(y, i, j, v1, v2, v3):
         put(y, i, j, v1)
         put(y, i + 1, j, v2)
