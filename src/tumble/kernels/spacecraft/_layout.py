@@ -7,8 +7,9 @@ from __future__ import annotations
 import functools
 from typing import NamedTuple
 
+from numba import njit
+
 from tumble._validate import ValidationError
-from tumble.kernels.spacecraft._base import inline
 
 #: The kinds of part, in the order of their state slices.
 PARTS = ("hold", "wheels", "cmgs", "thrusters", "magnetorquers", "damper", "pd", "mrp", "mrp_integral",
@@ -88,11 +89,11 @@ def locator(kind: str):
     (_, b0), (s1, b1), (s2, b2), (s3, b3) = _BITS
     m0, m1, m2, m3 = (1 << b0) - 1, (1 << b1) - 1, (1 << b2) - 1, (1 << b3) - 1
 
-    @inline
+    @njit
     def has(model):
         return model[field] >= 0
 
-    @inline
+    @njit
     def where(model):
         v = model[field]
         return v & m0, (v >> s1) & m1, (v >> s2) & m2, (v >> s3) & m3
