@@ -22,7 +22,7 @@ from tumble.spacecraft import (CMGCluster, Environment, FlexibleModes, MRPFeedba
 from tumble.spacecraft.surfaces import Drag, SolarPressure, box_facets
 
 # The tests marked slow compile the spacecraft's kernels on a cold Numba cache (its assembled right-hand side
-# alone ~35 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
+# alone ~25 CPU s, in every process that compiles a spacecraft driver); the spacecraft's modules run on one xdist
 # worker (tests/conftest.py, KINDS), so that one process pays it.
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])
