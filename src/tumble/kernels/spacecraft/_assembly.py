@@ -93,11 +93,14 @@ def _sum_momenta(parts):
 
 
 def _sum_energies(parts):
+    """``Σ T_k`` (J): the kinetic energies of the actuators present (the hub's ``½ ωᵀ J_ω ω`` is added by the
+    diagnostics)."""
     return _unrolled("energies", "model, y, j", _with(parts, "energy", no_energy), "f(model, p, n, s, y, j)", 1)
 
 
 def _sum_torques(parts):
     """``Σ τ_k`` (N·m) of the actuators present, each writing its state derivatives and diagnostics."""
+    # Every actuator has an ``act`` (no default to leave out).
     return _unrolled("torques", "model, t, y, j, out, aux, store, w1, w2, w3, cmd", _with(parts, "act", None),
                      "f(model, p, n, s, a, routed, t, y, j, out, aux, store, w1, w2, w3, cmd)", 3, routed=True)
 
