@@ -16,16 +16,25 @@ os.environ.setdefault("TUMBLE_QUIET", "1")
 #: driver compiles them again (~50 CPU s); the robot's kernels are shared by its modules.
 KINDS = ("tests/spacecraft/", "tests/robot/")
 
+#: Tests outside those folders that compile a kind's code, by the start of their node id -> the kind's folder:
+#: the spacecraft's row of the model × method matrix compiles its block (state × lanes) path, as the flight
+#: software's tests do (~50 CPU s each time).
+JOINS = {"tests/test_models.py::test_every_model_under_every_method[Spacecraft-": "tests/spacecraft/"}
+
 
 def pytest_xdist_make_scheduler(config, log):
     """Under ``--dist loadfile`` (pyproject.toml): each module runs on one worker, and so do all the modules of
-    a kind of :data:`KINDS`, so that the two workers do not compile the same code, each for itself."""
+    a kind of :data:`KINDS` and the tests of :data:`JOINS`, so that the two workers do not compile the same code,
+    each for itself."""
     if config.getvalue("dist") != "loadfile":
         return None
     from xdist.scheduler import LoadFileScheduling
 
     class KindScheduling(LoadFileScheduling):
         def _split_scope(self, nodeid):
+            joined = next((kind for start, kind in JOINS.items() if nodeid.startswith(start)), None)
+            if joined:
+                return joined
             module = super()._split_scope(nodeid)
             return next((kind for kind in KINDS if module.startswith(kind)), module)
 
