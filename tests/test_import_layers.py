@@ -36,7 +36,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("kernels", ("tumble.kernels",)),
     ("integrate", ("tumble.integrate",)),
     ("front door", ("tumble", "tumble.model", "tumble.rigid_model", "tumble._rigid_cuda", "tumble.simulate")),
-    ("domain", ("tumble.analytic", "tumble.axisymmetric", "tumble.flexible", "tumble.ins", "tumble.lorentz",
+    ("domain", ("tumble.analytic", "tumble.axisymmetric", "tumble.flexible", "tumble.fluid", "tumble.ins", "tumble.lorentz",
                 "tumble.measure", "tumble.robot", "tumble.slosh", "tumble.spacecraft", "tumble.variable")),
     ("sweeps", ("tumble.ensemble", "tumble.sweep", "tumble.sweeps")),
     ("scenario, viz", ("tumble.scenario", "tumble.viz", "tumble.examples")),
