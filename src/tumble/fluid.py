@@ -27,7 +27,8 @@ linear then angular: surge, sway, heave, roll, pitch, yaw), so that
 ``A = I_B + M_A[3:, 3:]`` (kg·m²), ``B = M_A[3:, :3]`` (kg·m),
 ``C = m 1 + M_A[:3, :3]`` (kg). ``M_A`` is the positive semi-definite matrix
 of the fluid's energy ``½ νᵀ M_A ν`` (``ν = [v; ω]``), i.e. minus Fossen's
-hydrodynamic derivatives (``M_A = −[[X_u̇, …]]``). The impulses
+hydrodynamic derivatives (``M_A = −[[X_u̇, …]]``); the model needs
+``M_RB + M_A`` positive definite (``T > 0`` for every motion). The impulses
 (Lamb § 119: the impulsive wrench that would start the motion from rest) are::
 
     K = ∂T/∂ω = Aω + Bv     (angular, N·m·s, about the origin, body axes)
@@ -90,7 +91,8 @@ from tumble.trajectory import Extra, Trajectory
 
 __all__ = ["KirchhoffBody", "ellipsoid_added_mass", "kirchhoff_matrix"]
 
-#: Relative tolerances (of the largest |entry|) of the added mass's symmetry and of its smallest eigenvalue.
+#: Relative tolerances (of the largest |entry|) of the added mass's symmetry and of the smallest eigenvalue of the
+#: kinetic-energy matrix.
 _SYMMETRY_TOL = 1e-12
 _DEFINITE_TOL = 1e-12
 
@@ -107,7 +109,8 @@ def kirchhoff_matrix(fossen: ArrayLike) -> np.ndarray:
 
 def _check_added_mass(value: ArrayLike) -> np.ndarray:
     """``added_mass`` as a read-only (6, 6) array: finite, symmetric (to 1e-12 of its largest entry; then made
-    exactly so) and positive semi-definite (the fluid's energy is ≥ 0)."""
+    exactly so), with a diagonal ≥ 0 (the fluid's energy of a motion along one axis is ≥ 0; a diagonal < 0 is
+    a table of Fossen's hydrodynamic derivatives, ``X_u̇ = −M_A[0, 0]``, given by mistake)."""
     M = as_array(value, "added_mass")
     if M.shape != (6, 6):
         raise ValidationError(f"added_mass: must have shape (6, 6) (Fossen's order: surge, sway, heave, roll, "
@@ -118,11 +121,11 @@ def _check_added_mass(value: ArrayLike) -> np.ndarray:
         raise ValidationError(f"added_mass: must be symmetric (an ideal fluid's added mass is), got max |M − Mᵀ| = "
                               f"{asymmetry:.3g}")
     M = 0.5 * (M + M.T)
-    smallest = float(np.linalg.eigvalsh(M)[0])
-    if smallest < -_DEFINITE_TOL * scale:
-        raise ValidationError(f"added_mass: must be positive semi-definite (the fluid's kinetic energy "
-                              f"½ νᵀ M_A ν ≥ 0: give M_A = −[X_u̇ …], not the derivatives), got the eigenvalue "
-                              f"{smallest:.6g}")
+    negative = np.flatnonzero(np.diagonal(M) < 0.0)
+    if negative.size:
+        k = int(negative[0])
+        raise ValidationError(f"added_mass: its diagonal must be ≥ 0 (the added mass, M_A = −[X_u̇ …], not the "
+                              f"hydrodynamic derivatives), got added_mass[{k}, {k}] = {M[k, k]:g}")
     M.setflags(write=False)
     return M
 
@@ -134,8 +137,9 @@ class KirchhoffBody(Model):
     body       : a :class:`tumble.RigidBody` with its ``mass`` (kg); its inertia is about the centre of mass,
                  the body origin (``com`` None or zero)
     added_mass : (6, 6) ``M_A`` in Fossen's order (surge, sway, heave, roll, pitch, yaw: kg, kg·m, kg·m²) about
-                 the centre of mass, body axes: finite, symmetric, positive semi-definite, and
-                 ``M_RB + M_A`` positive definite
+                 the centre of mass, body axes: finite, symmetric, its diagonal ≥ 0, and ``M_RB + M_A`` positive
+                 definite (an ideal fluid's ``M_A`` is positive semi-definite; a table measured or computed
+                 otherwise may be slightly indefinite, which the total's energy allows)
 
     A model of :func:`tumble.simulate`: ``tumble.simulate(kbody, omega0=..., velocity0=..., t=...)``
     integrates Kirchhoff's equations (``dop853``, ``rk4``, ``cf4``; no torque: the body is free). Initial
@@ -161,10 +165,11 @@ class KirchhoffBody(Model):
             raise ValidationError("body: its centre of mass must be the body origin (com None or zero): the "
                                   "added mass is taken about it, and the centres of mass and buoyancy coincide")
         object.__setattr__(self, "added_mass", _check_added_mass(self.added_mass))
-        if not np.linalg.eigvalsh(self.mass_matrix)[0] > _DEFINITE_TOL * np.abs(self.mass_matrix).max():
+        total = self.mass_matrix
+        smallest = float(np.linalg.eigvalsh(total)[0])
+        if not smallest > _DEFINITE_TOL * np.abs(total).max():
             raise ValidationError("added_mass: the body's mass matrix plus the added mass must be positive definite "
-                                  f"(the kinetic energy of body and fluid), got the eigenvalue "
-                                  f"{np.linalg.eigvalsh(self.mass_matrix)[0]:.6g}")
+                                  f"(the kinetic energy of body and fluid), got the eigenvalue {smallest:.6g}")
 
     @property
     def mass_matrix(self) -> np.ndarray:
