@@ -49,8 +49,8 @@ moved_modules(_RENAMED)
 # `tumble.simulate(...)` work after a plain `import tumble`; so do the old names of the renamed modules
 # (`tumble.analysis`), with their warning at the line that reads them.
 _LAZY = ("attitude", "dynamics", "integrate", "torques", "model", "rigid_body", "rigid_model", "kernels", "analytic",
-         "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "fluid", "ins", "spacecraft", "robot", "sweep",
-         "sweeps", "examples", "estimation")
+         "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "fluid", "ins", "spacecraft", "robot",
+         "sweep", "sweeps", "examples", "estimation")
 if _typing.TYPE_CHECKING:  # what a type checker reads (mypy does not run __getattr__); imported on first use
     from tumble import attitude, dynamics, integrate, torques  # noqa: F401
     from tumble.integrate import SolverError  # noqa: F401

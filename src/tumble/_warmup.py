@@ -24,8 +24,8 @@ from tumble._kinds import MODEL_KINDS, resolve
 if TYPE_CHECKING:
     from tumble.simulate import Model, SolverOptions
 
-__all__ = ["example", "flexible", "fluid", "gimbaled_gyro", "gyroscope", "human", "kind_path", "methods", "paths", "rigid",
-           "robot_tree", "serial_chain", "slosh", "spacecraft", "variable"]
+__all__ = ["example", "flexible", "fluid", "gimbaled_gyro", "gyroscope", "human", "kind_path", "methods", "paths",
+           "rigid", "robot_tree", "serial_chain", "slosh", "spacecraft", "variable"]
 
 _OMEGA0 = np.array([0.1, 1.0, 0.1])  # rad/s
 _T = np.array([0.0, 0.02, 0.04])  # s: a few steps

@@ -78,6 +78,7 @@ translation and none in rotation.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -174,6 +175,7 @@ class KirchhoffBody(Model):
     @property
     def mass_matrix(self) -> np.ndarray:
         """``M_RB + M_A`` (6, 6), Fossen's order (linear, angular), body axes: ``M_RB = diag(m 1, I_B)``."""
+        assert self.body.mass is not None  # checked in __post_init__
         rigid = np.zeros((6, 6))
         rigid[:3, :3] = self.body.mass * np.eye(3)
         rigid[3:, 3:] = self.body.inertia
@@ -227,7 +229,7 @@ class KirchhoffBody(Model):
         (``momentum_inertial``) and ``R P``, and the Casimirs ``|P|²`` and ``K·P``."""
         K, P = traj.angular_impulse, traj.linear_impulse
         return {"energy": traj.energy, "momentum_inertial": traj.momentum_inertial,
-                "linear_impulse_inertial": attitude.rotate(traj.q, P),
+                "linear_impulse_inertial": attitude.rotate(cast(np.ndarray, traj.q), P),
                 "impulse_squared": np.sum(P * P, axis=-1), "impulse_product": np.sum(K * P, axis=-1)}
 
 

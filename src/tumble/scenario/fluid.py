@@ -1,4 +1,5 @@
-"""Scenario kind ``"fluid"``: a rigid body in an ideal fluid, Kirchhoff's equations (:class:`tumble.fluid.KirchhoffBody`).
+"""Scenario kind ``"fluid"``: a rigid body in an ideal fluid, Kirchhoff's equations
+(:class:`tumble.fluid.KirchhoffBody`).
 
 The body is the shared ``[body]`` table, with its ``mass`` (kg; inertia about
 its centre of mass, the body origin, body axes); the fluid is ``[fluid]``:
@@ -28,7 +29,7 @@ The body is free: no ``[[torque]]``.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, cast
 
 import numpy as np
 from pydantic import Field, model_validator
@@ -120,6 +121,6 @@ class FluidScenario(Scenario):
     def rows(self, traj: Trajectory) -> list[tuple[str, str]]:
         """The distance travelled and the turn of the body's x axis from its start."""
         x = traj.position
-        ends = attitude.rotate(traj.q[[0, -1]], np.array([1.0, 0.0, 0.0]))  # body x, inertial, at both ends
+        ends = attitude.rotate(cast(np.ndarray, traj.q)[[0, -1]], np.array([1.0, 0.0, 0.0]))  # body x, inertial, at both ends
         turn = np.degrees(np.arccos(np.clip(ends[0] @ ends[1], -1.0, 1.0)))
         return [("path", f"{np.linalg.norm(x[-1] - x[0]):.4g} m from the start; body x turned {turn:.4g} deg")]
