@@ -4,6 +4,7 @@ key; `tumble run` writes the trajectory, the figure and the summary row."""
 
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -115,3 +116,9 @@ def test_tumble_run_writes_the_trajectory_the_figure_and_the_summary(tmp_path, e
     (label, value), = example[0].rows(example[1])
     assert label == "path" and value.startswith("37.68 m from the start; body x turned ")
     assert f"{label} {value}" in " ".join(result.stdout.split())
+
+
+def test_the_docs_show_the_example_as_it_is():
+    docs = (Path(__file__).resolve().parents[2] / "docs" / "scenarios.md").read_text(encoding="utf-8")
+    shown = dict(re.findall(r"```toml\n# examples/(\S+)\n(.*?)```", docs, flags=re.S))
+    assert shown["fluid/munk_moment.toml"] == TEXT
