@@ -158,8 +158,9 @@ def test_a_sphere_adds_half_its_displaced_mass_and_no_inertia():
 
 def test_a_prolate_spheroid_matches_the_closed_forms_in_its_eccentricity():
     # a > b = c: α₀ = 2(1 − e²)/e³ (½ ln((1 + e)/(1 − e)) − e), β₀ = γ₀ = 1/e² − (1 − e²)/(2e³) ln((1 + e)/(1 − e))
-    # (Lamb § 114), independent of the Carlson integrals; translational k = α₀/(2 − α₀), rotational (about y)
-    # k' = e⁴ (β₀ − α₀) / ((2 − e²)(2e² − (2 − e²)(β₀ − α₀))) of ρV(a² + b²)/5 (Lamb § 115)
+    # (Lamb §§ 114–115), independent of the Carlson integrals; translational k = α₀/(2 − α₀), rotational (about y)
+    # k' = e⁴ (β₀ − α₀) / ((2 − e²)(2e² − (2 − e²)(β₀ − α₀))) of ρV(a² + b²)/5 (Lamb § 115; Newman, Marine
+    # Hydrodynamics, 1977, ch. 4)
     rho, a, b = 1000.0, 2.0, 1.0
     e = math.sqrt(1.0 - (b / a) ** 2)
     log = math.log((1.0 + e) / (1.0 - e))
@@ -174,7 +175,8 @@ def test_a_prolate_spheroid_matches_the_closed_forms_in_its_eccentricity():
 
 def test_a_thin_disk_has_the_broadside_and_rocking_added_mass_of_a_disk():
     # a circular disk of radius a (the limit c → 0 of the ellipsoid a, a, c): broadside 8/3 ρa³, about a
-    # diameter 16/45 ρa⁵ (Lamb § 108), edgewise and about its axis none; the error is O(c/a)
+    # diameter 16/45 ρa⁵ (the tabulated values: Newman, Marine Hydrodynamics, 1977, ch. 4), edgewise and about its
+    # axis none; the error is O(c/a)
     rho, a, c = 1000.0, 0.5, 1e-7
     added = np.diagonal(ellipsoid_added_mass([a, a, c], rho))
     np.testing.assert_allclose(added[[2, 3, 4]], [8.0 / 3.0 * rho * a**3, 16.0 / 45.0 * rho * a**5,

@@ -11,8 +11,8 @@ tensor about the centre of mass in body axes. See ``docs/conventions.md``.
     >>> traj = tumble.simulate(body, [1e-3, 1.0, 1e-3], t=np.linspace(0, 100, 1001))
 
 ``tumble.simulate`` is the one front door: every model (rigid bodies, flexible,
-sloshing and shape-changing bodies, spacecraft, robot arms, gyroscopes)
-implements :class:`tumble.Model` and runs through it.
+sloshing and shape-changing bodies, bodies in an ideal fluid, spacecraft, robot
+arms, gyroscopes) implements :class:`tumble.Model` and runs through it.
 """
 
 import sys as _sys

@@ -16,26 +16,26 @@ origin, both relative to the fluid at infinity (inertial) and in body axes;
 the position of the origin.
 
 **Kinetic energy and impulses.** The kinetic energy of body and fluid is
-(Lamb § 121, with Kirchhoff's order: angular, then linear)::
+(Lamb §§ 117–121, with Kirchhoff's order: angular, then linear)::
 
     T = ½ ωᵀAω + ωᵀBv + ½ vᵀCv,     [[A, B], [Bᵀ, C]] = M_RB + M_A (reordered)
 
 ``M_RB = diag(m 1, I_B)`` is the body's own (mass ``m``, inertia ``I_B`` about
 the centre of mass) and ``M_A`` the added mass, both given in Fossen's order
-(*Handbook of Marine Craft Hydrodynamics and Motion Control*, 2011, § 6.3:
+(*Handbook of Marine Craft Hydrodynamics and Motion Control*, 2011, ch. 6:
 linear then angular: surge, sway, heave, roll, pitch, yaw), so that
 ``A = I_B + M_A[3:, 3:]`` (kg·m²), ``B = M_A[3:, :3]`` (kg·m),
 ``C = m 1 + M_A[:3, :3]`` (kg). ``M_A`` is the positive semi-definite matrix
 of the fluid's energy ``½ νᵀ M_A ν`` (``ν = [v; ω]``), i.e. minus Fossen's
 hydrodynamic derivatives (``M_A = −[[X_u̇, …]]``); the model needs
 ``M_RB + M_A`` positive definite (``T > 0`` for every motion). The impulses
-(Lamb § 119: the impulsive wrench that would start the motion from rest) are::
+(Lamb §§ 117–121: the impulsive wrench that would start the motion from rest) are::
 
     K = ∂T/∂ω = Aω + Bv     (angular, N·m·s, about the origin, body axes)
     P = ∂T/∂v = Bᵀω + Cv    (linear, N·s, body axes)
 
-**Kirchhoff's equations** (Lamb § 124, eq. (2) there written with ``d/dt``
-of the components on moving axes)::
+**Kirchhoff's equations** (Lamb §§ 123–124; ``d/dt`` of the components on the
+moving body axes)::
 
     K̇ = K × ω + P × v,      Ṗ = P × ω,      q̇ = ½ q ⊗ [0, ω],      ẋ = R(q) v
 

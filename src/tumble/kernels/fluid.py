@@ -9,7 +9,7 @@ energy of body and fluid (Kirchhoff's order: angular, then linear; see
 :mod:`tumble.fluid`)::
 
     [ω; v] = W [K; P]                          (rad/s, m/s; body axes)
-    K̇ = K × ω + P × v,     Ṗ = P × ω           (Lamb, Hydrodynamics, § 124)
+    K̇ = K × ω + P × v,     Ṗ = P × ω           (Lamb, Hydrodynamics, §§ 123–124)
     q̇ = ½ q ⊗ [0, ω],      ẋ = R(q) v
 
 ``project`` normalises ``q``. The impulses, not the velocities, are the state:
