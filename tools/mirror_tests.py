@@ -52,7 +52,7 @@ FOLDERS = {
     "test_attitude.py": "", "test_body.py": "", "test_cache.py": "", "test_compiling.py": "",
     "test_dynamics.py": "", "test_ensemble.py": "", "test_flexible.py": "", "test_frames.py": "",
     "test_front_door.py": "", "test_kinds.py": "", "test_limits.py": "", "test_lorentz.py": "",
-    "test_simulate.py": "", "test_slosh.py": "", "test_torques.py": "", "test_trajectory.py": "",
+    "test_simulate.py": "", "test_slosh.py": "", "test_fluid.py": "", "test_torques.py": "", "test_trajectory.py": "",
     # cross-cutting: every model, the package, the docs, the import graph, the renamed modules
     "test_models.py": "", "test_package.py": "", "test_docs.py": "", "test_import_layers.py": "",
     "test_module_size.py": "", "test_moved.py": "", "test_moved_modules.py": "", "test_layout.py": "",

@@ -11,8 +11,8 @@ tensor about the centre of mass in body axes. See ``docs/conventions.md``.
     >>> traj = tumble.simulate(body, [1e-3, 1.0, 1e-3], t=np.linspace(0, 100, 1001))
 
 ``tumble.simulate`` is the one front door: every model (rigid bodies, flexible,
-sloshing and shape-changing bodies, spacecraft, robot arms, gyroscopes)
-implements :class:`tumble.Model` and runs through it.
+sloshing and shape-changing bodies, bodies in an ideal fluid, spacecraft, robot
+arms, gyroscopes) implements :class:`tumble.Model` and runs through it.
 """
 
 import sys as _sys
@@ -49,8 +49,8 @@ moved_modules(_RENAMED)
 # `tumble.simulate(...)` work after a plain `import tumble`; so do the old names of the renamed modules
 # (`tumble.analysis`), with their warning at the line that reads them.
 _LAZY = ("attitude", "dynamics", "integrate", "torques", "model", "rigid_body", "rigid_model", "kernels", "analytic",
-         "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "ins", "spacecraft", "robot", "sweep",
-         "sweeps", "examples", "estimation")
+         "viz", "scenario", "measure", "ensemble", "variable", "flexible", "slosh", "fluid", "ins", "spacecraft", "robot",
+         "sweep", "sweeps", "examples", "estimation")
 if _typing.TYPE_CHECKING:  # what a type checker reads (mypy does not run __getattr__); imported on first use
     from tumble import attitude, dynamics, integrate, torques  # noqa: F401
     from tumble.integrate import SolverError  # noqa: F401
@@ -112,6 +112,7 @@ __all__ = [
     "estimation",
     "examples",
     "flexible",
+    "fluid",
     "ins",
     "integrate",
     "limits",

@@ -91,6 +91,8 @@ MODEL_KINDS: dict[str, ModelKind] = {
                              "tumble._warmup:serial_chain"),
     "RobotTree": ModelKind("tumble.robot.tree:RobotTree", "tumble.kernels.robot", "robot", None,
                            "tumble._warmup:robot_tree"),
+    "KirchhoffBody": ModelKind("tumble.fluid:KirchhoffBody", "tumble.kernels.fluid", "fluid", "fluid",
+                               "tumble._warmup:fluid"),
 }
 
 #: Scenario kind (a file's ``kind``) -> its table.
@@ -115,4 +117,7 @@ SCENARIOS: dict[str, ScenarioKind] = {
                               "tumble.ins.GimbaledGyro)"),
     "robot": ScenarioKind("tumble.scenario.robot:RobotScenario", "robot",
                           "a robot arm on a fixed base from a DH table or URDF file (tumble.robot.SerialChain)"),
+    "fluid": ScenarioKind("tumble.scenario.fluid:FluidScenario", "fluid",
+                          "a rigid body in an ideal fluid: Kirchhoff's equations with an added mass "
+                          "(tumble.fluid.KirchhoffBody)"),
 }

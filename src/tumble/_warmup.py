@@ -24,8 +24,8 @@ from tumble._kinds import MODEL_KINDS, resolve
 if TYPE_CHECKING:
     from tumble.simulate import Model, SolverOptions
 
-__all__ = ["example", "flexible", "gimbaled_gyro", "gyroscope", "human", "kind_path", "methods", "paths", "rigid",
-           "robot_tree", "serial_chain", "slosh", "spacecraft", "variable"]
+__all__ = ["example", "flexible", "fluid", "gimbaled_gyro", "gyroscope", "human", "kind_path", "methods", "paths",
+           "rigid", "robot_tree", "serial_chain", "slosh", "spacecraft", "variable"]
 
 _OMEGA0 = np.array([0.1, 1.0, 0.1])  # rad/s
 _T = np.array([0.0, 0.02, 0.04])  # s: a few steps
@@ -63,6 +63,17 @@ def slosh() -> tuple[Model, dict[str, Any]]:
     pendulum = Pendulum(mass=2.0, length=0.5, hinge=np.array([0.3, -0.2, 0.4]))
     body = SloshBody(tumble.RigidBody(_INERTIA, mass=10.0), pendulum)
     return body, {"omega0": _OMEGA0, "direction0": [1.0, 1.0, 0.0]}
+
+
+def fluid() -> tuple[Model, dict[str, Any]]:
+    """A body in an ideal fluid with a full added mass (coupled: B ≠ 0), moving and turning."""
+    import tumble
+    from tumble.fluid import KirchhoffBody
+
+    added_mass = np.diag([5.0, 8.0, 12.0, 1.0, 1.5, 2.0])
+    added_mass[0, 4] = added_mass[4, 0] = 0.3
+    return KirchhoffBody(tumble.RigidBody(_INERTIA, mass=10.0), added_mass), {"omega0": _OMEGA0,
+                                                                             "velocity0": [1.0, 0.2, -0.3]}
 
 
 def variable() -> tuple[Model, dict[str, Any]]:

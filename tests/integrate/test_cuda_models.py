@@ -24,6 +24,7 @@ from helpers import compile_ptx, nvvm_available
 import tumble
 from tumble import robot, torques
 from tumble.flexible import FlexibleBody, Mode
+from tumble.fluid import KirchhoffBody
 from tumble.ins import GimbaledGyro
 from tumble.simulate import as_model
 from tumble.slosh import Pendulum, SloshBody
@@ -63,10 +64,14 @@ def cases():
     flexible_craft = Spacecraft(inertia=INERTIA, wheels=pyramid_wheels(0.02), flexible_modes=modes,
                                 controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
     rigid = [tumble.RigidBody(INERTIA), tumble.RigidBody(np.diag([1.0, 2.0, 2.5]))]
+    added_mass = np.diag([5.0, 8.0, 12.0, 1.0, 1.5, 2.0])
+    added_mass[0, 4] = added_mass[4, 0] = 0.8  # surge–pitch coupling: B ≠ 0
+    fluid = KirchhoffBody(tumble.RigidBody(INERTIA, mass=10.0), added_mass)
     wheel_speeds = {"wheel_speeds0": [[10.0, -5.0, 3.0, 0.0], [0.0, 20.0, -8.0, 4.0]]}
     return {
         "flexible, rk4": (flexible, "rk4", TORQUE, {"eta0": [[0.1, -0.05], [0.0, 0.2]], "eta_rate0": [0.3, 0.0]}),
         "flexible, cf4": (flexible, "cf4", None, {"eta0": [[0.1, -0.05], [0.0, 0.2]]}),
+        "fluid, cf4": (fluid, "cf4", None, {"velocity0": [[1.0, 0.2, -0.3], [0.0, -0.5, 0.4]]}),
         "slosh, rk4": (slosh, "rk4", TORQUE, {"direction0": [[0.0, 0.0, -1.0], [0.3, 0.1, -1.0]],
                                               "rate0": [0.2, -0.1, 0.0]}),
         "spacecraft: wheels, MRP feedback, rk4": (wheels_mrp, "rk4", None, wheel_speeds),
@@ -187,7 +192,7 @@ def test_methods_without_a_device_kernel_are_refused():
 # body (a spacecraft's PTX takes about 50 CPU s, and NVVM's output is not cached); the simulator runs every case.
 @pytest.mark.slow
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
-@pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "spacecraft: wheels, MRP feedback, rk4",
+@pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "fluid, cf4", "spacecraft: wheels, MRP feedback, rk4",
                                   "rigid, one body each, cf4", "robot: planar two-link chain, rk4"])
 def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""

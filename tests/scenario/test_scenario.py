@@ -9,6 +9,7 @@ import pytest
 import tumble
 from tumble import attitude
 from tumble.scenario import Scenario, ScenarioError, Time, load_scenario, parse_scenario, run_scenario
+from tumble.scenario.kinds import KINDS
 
 EXAMPLES = tumble.examples.directory()
 
@@ -366,9 +367,9 @@ def test_kind_is_given_or_inferred_from_the_tables():
 
 
 def test_every_kind_of_the_table_is_a_scenario():
-    from tumble.scenario.kinds import KINDS, scenario_class
+    from tumble.scenario.kinds import scenario_class
 
-    assert set(KINDS) == {"rigid", "spacecraft", "flexible", "slosh", "variable", "human", "gyroscope", "robot"}
+    assert {"rigid", "spacecraft"} <= set(KINDS)  # and every kind of the registry (tests/test_kinds.py)
     for kind in KINDS:
         assert issubclass(scenario_class(kind), Scenario)
 
@@ -378,8 +379,9 @@ def test_unknown_kind_is_refused_naming_the_kinds(tmp_path, kind, got):
     path = write(tmp_path, f"kind = {kind}\n" + BASE)
     with pytest.raises(ScenarioError) as info:
         load_scenario(path)
-    assert str(info.value) == (f"{path}: kind: must be one of 'rigid', 'spacecraft', 'flexible', 'slosh', 'variable', "
-                               f"'human', 'gyroscope', 'robot', got {got}")
+    kinds = ", ".join(map(repr, KINDS))  # the registry's, in its order: 'rigid', 'spacecraft', ...
+    assert kinds.startswith("'rigid', 'spacecraft', ")
+    assert str(info.value) == f"{path}: kind: must be one of {kinds}, got {got}"
     assert info.value.field == "kind"
 
 
