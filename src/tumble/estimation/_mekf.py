@@ -305,8 +305,10 @@ def mekf(t: ArrayLike, rate: ArrayLike, *, q0: ArrayLike, P0: ArrayLike, arw: fl
             raise ValidationError(f"vector_sigma: must be > 0 (rad), got {sig}")
     q_out, beta_out = np.empty((runs, K, 4)), np.empty((runs, K, 3))
     P_out, nis, dof = np.empty((runs, K, 6, 6)), np.empty((runs, K)), np.empty((runs, K), dtype=np.int64)
-    _mekf_batch(readonly(t), rate_runs, q0, bias0, P0, arw2, rrw2, readonly(q_st), R_st, readonly(vec), ref,
-                readonly(sig), q_out, beta_out, P_out, nis, dof)
+    # every input read-only (the one form of readonly()), with or without star tracker and vectors: one compiled
+    # copy of the filter (about 20 CPU s), not one per combination of the measurements given
+    _mekf_batch(readonly(t), rate_runs, q0, bias0, readonly(P0), arw2, rrw2, readonly(q_st), readonly(R_st),
+                readonly(vec), readonly(ref), readonly(sig), q_out, beta_out, P_out, nis, dof)
     lead = (runs,) if batched else ()
     return FilterResult(t=t, q=q_out.reshape((*lead, K, 4)), bias=beta_out.reshape((*lead, K, 3)),
                         covariance=P_out.reshape((*lead, K, 6, 6)), nis=nis.reshape((*lead, K)),
