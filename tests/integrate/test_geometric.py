@@ -273,6 +273,27 @@ def test_fused_cf4_equals_its_stages_over_a_block_bit_for_bit():
     assert np.abs(fused - y0).max() > 0.1  # the bodies moved
 
 
+@pytest.mark.slow  # compiles a flexible body's cf4 paths, alone and in a block (~12 CPU s on a cold cache)
+def test_a_lone_body_runs_cf4_on_its_state_vector_as_a_batch_member_runs_it_in_a_block():
+    # A model without point_rates runs CF4's stages (_cf4_step) on one body's state vector, as rk4 and dop853
+    # run a lone body: its right-hand side on a state vector serves every method, and no block of one lane is
+    # compiled for it. Each lane of a block does the same operations in the same order: bit for bit.
+    from tumble.flexible import FlexibleBody, Mode
+    from tumble.simulate import as_model
+
+    flexible = FlexibleBody(np.diag([10.0, 12.0, 8.0]), [Mode(3.0, 0.02, [0.3, 0.5, 0.2])])
+    omega0 = np.array([[0.3, 1.0, -0.4], [-0.5, 0.2, 0.9]])
+    t = np.linspace(0.0, 2.0, 5)
+    batch = tumble.simulate(flexible, omega0, t=t, method="cf4", dt=0.05, eta0=[0.1])
+    lone = tumble.simulate(flexible, omega0[1], t=t, method="cf4", dt=0.05, eta0=[0.1])
+    np.testing.assert_array_equal(lone.q, batch.q[:, 1])
+    np.testing.assert_array_equal(lone.omega, batch.omega[:, 1])
+    assert np.abs(lone.q - lone.q[0]).max() > 0.1  # it moved
+    kernel = numba.typeof(as_model(flexible).compile(None, 0.0))
+    steps = [signature for signature in _liegroup._cf4_step.signatures if signature[0] == kernel]
+    assert {signature[4].ndim for signature in steps} == {1, 2}, steps
+
+
 # -- batches -------------------------------------------------------------------------------
 
 

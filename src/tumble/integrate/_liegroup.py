@@ -41,6 +41,7 @@ from typing import NamedTuple
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from tumble import _protocol, _quat
 from tumble._protocol import body_rate, evaluating, model_workspace, point_rates, project, quaternion_scale, rhs
@@ -131,12 +132,11 @@ def _cf4_workspace(scheme, model, b0, Y):
         return _fused.workspace(model, Y)
 
     def impl(scheme, model, b0, Y):
-        lanes = Y.size // Y.shape[0]  # 1 for one body's state vector
-        n = Y.shape[0]
-        # derivatives k₁…k₄ and the stage state (state × lanes), stage rates ω₁…ω₄, Q₂
+        n, tail = Y.shape[0], Y.shape[1:]  # tail: () for one body's state vector, (lanes,) for a block
+        # derivatives k₁…k₄ and the stage state (state [× lanes]), stage rates ω₁…ω₄, Q₂,
         # then the model's scratch (a robot's), if any
-        return (np.empty((4, n, lanes)), np.empty((n, lanes)), np.empty((4, 3, lanes)),
-                np.empty((4, lanes))) + model_workspace(model, Y)
+        return (np.empty((4, n) + tail), np.empty((n,) + tail), np.empty((4, 3) + tail),
+                np.empty((4,) + tail)) + model_workspace(model, Y)
 
     return impl
 
@@ -149,69 +149,135 @@ def _cf4_advance(scheme, model, b0, t0, h, m, Y, work):
     def impl(scheme, model, b0, t0, h, m, Y, work):
         K, S, W, Q2 = work[0], work[1], work[2], work[3]
         model = evaluating(model, work)
-        # one body's state vector runs as a block of one lane
-        y = Y.reshape((Y.shape[0], Y.size // Y.shape[0]))
         for s in range(m):
             t = t0 + s * h
-            _cf4_step(model, b0, t, h, y, K, S, W, Q2)
-            project(model, b0, t + h, y)
+            _cf4_step(model, b0, t, h, Y, K, S, W, Q2)
+            project(model, b0, t + h, Y)
 
+    return impl
+
+
+def cell(A, i, j):  # pragma: no cover - replaced by the overload in compiled code
+    """``A[i]`` of an array of one body (a state vector, its stage rates), ``A[i, j]`` (lane ``j``) of a block's."""
+    raise NotImplementedError
+
+
+def put(A, i, j, value):  # pragma: no cover - replaced by the overload in compiled code
+    """``A[i] = value`` of an array of one body, ``A[i, j] = value`` of a block's (see :func:`cell`)."""
+    raise NotImplementedError
+
+
+def lanes(Y):  # pragma: no cover - replaced by the overload in compiled code
+    """The lanes of a block (state × lanes); 1 for one body's state vector."""
+    raise NotImplementedError
+
+
+# In their callers' IR, so that a lane loop holds no call.
+@overload(lanes, inline="always", jit_options={"cache": True})
+def _lanes(Y):
+    if Y.ndim == 1:
+        return lambda Y: 1
+    return lambda Y: Y.shape[1]
+
+
+@overload(cell, inline="always", jit_options={"cache": True})
+def _cell(A, i, j):
+    if A.ndim == 1:
+        return lambda A, i, j: A[i]
+    return lambda A, i, j: A[i, j]
+
+
+@overload(put, inline="always", jit_options={"cache": True})
+def _put(A, i, j, value):
+    if A.ndim == 1:
+        def impl(A, i, j, value):
+            A[i] = value
+    else:
+        def impl(A, i, j, value):
+            A[i, j] = value
     return impl
 
 
 # The stage functions take the stage's rows (K[s], W[s]), not the index s: a literal index would make Numba
 # compile one version per stage (four of _stage per model, 1-1.6 s of CPU each, measured with Numba 0.68).
+# Each runs on a block (state × lanes) or on one body's state vector (its own, as every other method runs a lone
+# body: so a model compiles its right-hand side on state vectors once for every method, not also on blocks of
+# one lane for this one).
 @njit(cache=True)
 def _stage(model, b0, t, S, k, w):
-    """Evaluate a stage at the stage state ``S`` (state × lanes): ``k = f(t, S)`` and ``w = ω(S)`` (3 × lanes)."""
+    """Evaluate a stage at the stage state ``S``: ``k = f(t, S)`` and ``w = ω(S)`` (3 [× lanes])."""
     rhs(model, b0, t, S, k)
-    for j in range(S.shape[1]):
-        w[0, j], w[1, j], w[2, j] = body_rate(model, S, j)
+    for j in range(lanes(S)):
+        w1, w2, w3 = body_rate(model, S, j)
+        put(w, 0, j, w1)
+        put(w, 1, j, w2)
+        put(w, 2, j, w3)
+
+
 
 
 @njit(cache=True)
 def _euclidean(Y, k, c, S):
     """``S[4:] = Y[4:] + c k[4:]``: the Runge–Kutta stage of the state after the quaternion."""
     for i in range(4, Y.shape[0]):
-        for j in range(Y.shape[1]):
-            S[i, j] = Y[i, j] + c * k[i, j]
+        for j in range(lanes(Y)):
+            put(S, i, j, cell(Y, i, j) + c * cell(k, i, j))
+
+
+@njit(cache=True, inline="always")
+def _quaternion(Y, j):
+    """The quaternion ``Y[0:4]`` of lane ``j``."""
+    return cell(Y, 0, j), cell(Y, 1, j), cell(Y, 2, j), cell(Y, 3, j)
+
+
+@njit(cache=True, inline="always")
+def _put_quaternion(Y, j, q):
+    """``Y[0:4] = q`` in lane ``j``."""
+    put(Y, 0, j, q[0])
+    put(Y, 1, j, q[1])
+    put(Y, 2, j, q[2])
+    put(Y, 3, j, q[3])
 
 
 # error_model="numpy": IEEE division without Python's zero check (2x in the
 # rotation loops of the splitting methods); no divisor here can be zero.
 @njit(cache=True, error_model="numpy")
 def _cf4_step(model, b0, t, h, Y, K, S, W, Q2):
-    """One CF4 step of ``h`` (s) from ``t`` for the block ``Y`` (state × lanes), in place."""
-    lanes = Y.shape[1]
+    """One CF4 step of ``h`` (s) from ``t`` for the block ``Y`` (state × lanes) or one body's state vector, in
+    place."""
+    n_lanes = lanes(Y)
     _stage(model, b0, t, Y, K[0], W[0])
-    for j in range(lanes):
-        q = rotate_right(Y[0, j], Y[1, j], Y[2, j], Y[3, j], 0.5 * h * W[0, 0, j], 0.5 * h * W[0, 1, j],
-                         0.5 * h * W[0, 2, j])
-        S[0, j], S[1, j], S[2, j], S[3, j] = q
-        Q2[0, j], Q2[1, j], Q2[2, j], Q2[3, j] = q
+    for j in range(n_lanes):
+        qw, qx, qy, qz = _quaternion(Y, j)
+        q = rotate_right(qw, qx, qy, qz, 0.5 * h * cell(W[0], 0, j), 0.5 * h * cell(W[0], 1, j),
+                         0.5 * h * cell(W[0], 2, j))
+        _put_quaternion(S, j, q)
+        _put_quaternion(Q2, j, q)
     _euclidean(Y, K[0], 0.5 * h, S)
     _stage(model, b0, t + 0.5 * h, S, K[1], W[1])
-    for j in range(lanes):
-        S[0, j], S[1, j], S[2, j], S[3, j] = rotate_right(
-            Y[0, j], Y[1, j], Y[2, j], Y[3, j], 0.5 * h * W[1, 0, j], 0.5 * h * W[1, 1, j], 0.5 * h * W[1, 2, j]
-        )
+    for j in range(n_lanes):
+        qw, qx, qy, qz = _quaternion(Y, j)
+        _put_quaternion(S, j, rotate_right(qw, qx, qy, qz, 0.5 * h * cell(W[1], 0, j), 0.5 * h * cell(W[1], 1, j),
+                                           0.5 * h * cell(W[1], 2, j)))
     _euclidean(Y, K[1], 0.5 * h, S)
     _stage(model, b0, t + 0.5 * h, S, K[2], W[2])
-    for j in range(lanes):
-        S[0, j], S[1, j], S[2, j], S[3, j] = rotate_right(
-            Q2[0, j], Q2[1, j], Q2[2, j], Q2[3, j], h * (W[2, 0, j] - 0.5 * W[0, 0, j]),
-            h * (W[2, 1, j] - 0.5 * W[0, 1, j]), h * (W[2, 2, j] - 0.5 * W[0, 2, j])
-        )
+    for j in range(n_lanes):
+        qw, qx, qy, qz = _quaternion(Q2, j)
+        _put_quaternion(S, j, rotate_right(qw, qx, qy, qz, h * (cell(W[2], 0, j) - 0.5 * cell(W[0], 0, j)),
+                                           h * (cell(W[2], 1, j) - 0.5 * cell(W[0], 1, j)),
+                                           h * (cell(W[2], 2, j) - 0.5 * cell(W[0], 2, j))))
     _euclidean(Y, K[2], h, S)
     _stage(model, b0, t + h, S, K[3], W[3])
-    for j in range(lanes):
+    for j in range(n_lanes):
         r1 = _combine(W, _W1, h, j)
         r2 = _combine(W, _W2, h, j)
-        q = rotate_right(Y[0, j], Y[1, j], Y[2, j], Y[3, j], r1[0], r1[1], r1[2])
-        Y[0, j], Y[1, j], Y[2, j], Y[3, j] = rotate_right(q[0], q[1], q[2], q[3], r2[0], r2[1], r2[2])
+        qw, qx, qy, qz = _quaternion(Y, j)
+        q = rotate_right(qw, qx, qy, qz, r1[0], r1[1], r1[2])
+        _put_quaternion(Y, j, rotate_right(q[0], q[1], q[2], q[3], r2[0], r2[1], r2[2]))
     for i in range(4, Y.shape[0]):
-        for j in range(lanes):
-            Y[i, j] += h / 6.0 * (K[0, i, j] + 2.0 * K[1, i, j] + 2.0 * K[2, i, j] + K[3, i, j])
+        for j in range(n_lanes):
+            put(Y, i, j, cell(Y, i, j) + h / 6.0 * (cell(K[0], i, j) + 2.0 * cell(K[1], i, j)
+                                                     + 2.0 * cell(K[2], i, j) + cell(K[3], i, j)))
 
 
 @njit(cache=True)
@@ -219,9 +285,9 @@ def _combine(W, weights, h, j):
     """The rotation vector ``h Σₛ weights[s] ωₛ`` of lane ``j`` (rad)."""
     a, b, c, d = weights
     return (
-        h * (a * W[0, 0, j] + b * W[1, 0, j] + c * W[2, 0, j] + d * W[3, 0, j]),
-        h * (a * W[0, 1, j] + b * W[1, 1, j] + c * W[2, 1, j] + d * W[3, 1, j]),
-        h * (a * W[0, 2, j] + b * W[1, 2, j] + c * W[2, 2, j] + d * W[3, 2, j]),
+        h * (a * cell(W[0], 0, j) + b * cell(W[1], 0, j) + c * cell(W[2], 0, j) + d * cell(W[3], 0, j)),
+        h * (a * cell(W[0], 1, j) + b * cell(W[1], 1, j) + c * cell(W[2], 1, j) + d * cell(W[3], 1, j)),
+        h * (a * cell(W[0], 2, j) + b * cell(W[1], 2, j) + c * cell(W[2], 2, j) + d * cell(W[3], 2, j)),
     )
 
 
