@@ -227,17 +227,23 @@ def test_a_device_sweep_refuses_what_it_cannot_run():
 
 
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
-@pytest.mark.parametrize("name", ["block_moments_kernel", "bitonic_kernel", "count_kernel", "gather_kernel"])
+@pytest.mark.parametrize("name", ["block_moments_kernel", "bitonic_kernel", "count_kernel", "gather_kernel",
+                                  "pointing_kernel", "nutation_kernel", "momentum_kernel", "energy_kernel",
+                                  "component_kernel", "max_kernel", "settling_kernel", "crossing_kernel"])
 def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
     """What the simulator cannot see: each reduction kernel types and compiles for sm_90, allocating nothing."""
     from numba import float64, int64
 
     from tumble.integrate import _cuda_reductions as device
 
-    a2 = float64[:, ::1]
-    signatures = {"block_moments_kernel": (a2, int64, float64[:, :, ::1]), "bitonic_kernel": (a2, int64, int64),
+    a1, a2, a3 = float64[::1], float64[:, ::1], float64[:, :, ::1]
+    signatures = {"block_moments_kernel": (a2, int64, a3), "bitonic_kernel": (a2, int64, int64),
                   "count_kernel": (a2, int64[::1]),
-                  "gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
+                  "gather_kernel": (a2, int64[:, ::1], int64[:, ::1], a3),
+                  "pointing_kernel": (a3, float64, float64, float64, float64, a2),
+                  "nutation_kernel": (a3, a3, float64, float64, float64, a2), "momentum_kernel": (a3, a3, int64, a2),
+                  "energy_kernel": (a3, a3, a2), "component_kernel": (a3, int64, a2), "max_kernel": (a2, int64, a1),
+                  "settling_kernel": (a2, a1, float64, a1), "crossing_kernel": (a2, a1, float64, a1)}
     ptx = compile_ptx(monkeypatch, getattr(device, name), signatures[name])
     assert ptx.count(".entry") == 1
     assert "malloc" not in ptx

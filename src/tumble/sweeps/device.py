@@ -104,17 +104,23 @@ def percentiles(values: ArrayLike, p: ArrayLike, *, ignore_nan: bool = False) ->
     return out
 
 
+def _samples(traj: Trajectory) -> tuple[int, int]:
+    """The output times and samples ``(n, m)`` of a device trajectory."""
+    q: Any = traj.q  # a device array
+    return q.shape[0], q.shape[1]
+
+
 def _inertia(traj: Trajectory) -> Any:
     """The inertia tensors of a device trajectory as (m or 1, 3, 3) (kg·m², body axes): one per sample, or the
     one they share."""
-    inertia = traj.inertia
+    inertia: Any = traj.inertia  # a device array
     return inertia if len(inertia.shape) == 3 else inertia.reshape((1, 3, 3))
 
 
 def _component(f: Component, traj: Trajectory) -> Any:
     """A :class:`Component` of ``q``, ``omega``, ``momentum_body`` (``I ω``) or ``energy`` (``½ ω·Iω``) as a
     device table (n, m), or None: another field, or an ``index`` the host refuses."""
-    n, m = traj.q.shape[:2]
+    n, m = _samples(traj)
     if f.name == "energy":
         return series_table(energy_kernel, n, m, traj.omega, _inertia(traj)) if f.index == () else None
     size = {"q": 4, "omega": 3, "momentum_body": 3}.get(f.name)
@@ -129,7 +135,7 @@ def _component(f: Component, traj: Trajectory) -> Any:
 def series(f: Any, traj: Trajectory) -> Any:
     """The series ``f`` (a built-in of :mod:`tumble.sweeps.outcomes`) of the device trajectory ``traj`` as a
     device table (n, m), evaluated on the GPU; None where the host evaluates it (the module docstring)."""
-    n, m = traj.q.shape[:2]
+    n, m = _samples(traj)
     if isinstance(f, PointingError):
         return series_table(pointing_kernel, n, m, traj.q, *f.target)
     if isinstance(f, NutationAngle):

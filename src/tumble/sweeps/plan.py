@@ -285,9 +285,14 @@ def _evaluated(kind: str, f: Callable[[Trajectory], np.ndarray], traj: Trajector
     if traj.on_device:
         from tumble.sweeps import device
 
-        value = device.outcome(f, traj) if kind == "outcome" else device.series(f, traj)
-        if value is not None:
-            return value if kind == "outcome" else value.copy_to_host()
+        if kind == "outcome":
+            value = device.outcome(f, traj)
+            if value is not None:
+                return value
+        else:
+            table = device.series(f, traj)  # a device array
+            if table is not None:
+                return table.copy_to_host()
     return f(host())
 
 
