@@ -107,7 +107,13 @@ for name in ("table", "with_nan"):
     out[name + "/percentiles"] = device.percentiles(values, module["P"])
     out[name + "/nanpercentiles"] = device.percentiles(values, module["P"], ignore_nan=True)
     out[name + "/moments"] = np.array(device.moments(values))
+from tumble.trajectory import Trajectory
+to_host = Trajectory.to_host
+copies = []  # the chunks' results copied to the host: counted, then copied as ever
+Trajectory.to_host = lambda traj: (copies.append(traj.on_device), to_host(traj))[1]
 ds = sweep(module["tumble"].RigidBody(np.diag([1.0, 2.0, 2.5])), device="cuda", **module["_sweep_arguments"]())
+Trajectory.to_host = to_host
+out["sweep host copies"] = np.array(copies)
 for name in ds.data_vars:
     out["sweep/" + name] = ds[name].values
 for name, (on_gpu, on_host) in module["evaluated_on_the_device"]().items():
@@ -176,6 +182,8 @@ def test_the_sweep_on_the_device_writes_the_cpus_store(simulated):
         np.testing.assert_allclose(gpu[f"sweep/{name}"], cpu[name].values, rtol=0, atol=1e-14)
     np.testing.assert_allclose(gpu["sweep/wy_std"], cpu["wy_std"].values, rtol=0, atol=1e-14)
     assert np.ptp(cpu["wy"].values[:, -1]) > 1e-3  # the samples differ
+    # the chunks' results stayed on the GPU, but for one copy per chunk (of 3 and 2 samples) for the Python outcome
+    assert gpu["sweep host copies"].tolist() == [True, True]
     # the percentiles are those of the stored values, bit for bit
     np.testing.assert_array_equal(gpu["sweep/wy_percentiles"], np.percentile(gpu["sweep/wy"], P, axis=0))
     np.testing.assert_array_equal(gpu["sweep/pointing_percentiles"], np.nanpercentile(gpu["sweep/pointing"], P))
