@@ -176,11 +176,12 @@ def test_simulated_gpu_equals_cpu(simulated, name):
      r"^controller: a Python function cannot run on the GPU \(device='cuda'\)"),
     (lambda: FlexibleBody(INERTIA, [Mode(3.0, 0.02, [0.3, 0.5, 0.2])]),
      r"^torque: a Python function cannot run on the GPU \(device='cuda'\)"),
+    (growing_body, r"^torque: a Python function cannot run on the GPU \(device='cuda'\)"),
 ])
 def test_what_cannot_run_on_a_gpu_is_refused_naming_the_part(make, message):
     # refused before anything is compiled or launched, with or without a GPU
     model = make()
-    torque = (lambda t, q, w: -w) if isinstance(model, FlexibleBody) else None
+    torque = (lambda t, q, w: -w) if isinstance(model, (FlexibleBody, VariableBody)) else None
     with pytest.raises(tumble.ValidationError, match=message):
         tumble.simulate(model, OMEGA0[0], t=T, method="rk4", dt=DT, torque=torque, device="cuda")
 
