@@ -23,12 +23,14 @@ from helpers import compile_ptx, nvvm_available
 
 import tumble
 from tumble import robot, torques
+from tumble.axisymmetric import AxisymmetricBody
 from tumble.flexible import FlexibleBody, Mode
 from tumble.fluid import KirchhoffBody
 from tumble.ins import GimbaledGyro
 from tumble.simulate import as_model
 from tumble.slosh import Pendulum, SloshBody
 from tumble.spacecraft import FlexibleModes, FlightSoftware, MRPFeedback, QuaternionPD, Spacecraft, pyramid_wheels
+from tumble.variable import Human, Motion, VariableBody
 
 INERTIA = np.array([[10.0, 0.3, -0.2], [0.3, 12.0, 0.1], [-0.2, 0.1, 8.0]])  # kg·m², body axes
 TARGET = [np.cos(0.2), 0.0, np.sin(0.2), 0.0]
@@ -51,6 +53,17 @@ def branching_tree():
     return robot.RobotTree(links, [-1, 0, 1, 0])
 
 
+def growing_body():
+    """A body whose inertia grows by 20 % a second while a shape momentum turns on: a VariableBody of splines."""
+    def inertia(t):
+        return INERTIA * (1.0 + 0.2 * np.asarray(t))[:, None, None]
+
+    def shape_momentum(t):
+        return np.outer(np.sin(np.asarray(t)), [0.5, -0.2, 0.3])
+
+    return VariableBody.from_functions(inertia, shape_momentum, t_span=(0.0, 1.0), dt=0.01)
+
+
 def cases():
     """name -> (model, method, torque, initial state): one of each model kind, two members each."""
     flexible = FlexibleBody(INERTIA, [Mode(3.0, 0.02, [0.3, 0.5, 0.2]), Mode(7.0, 0.01, [0.1, -0.4, 0.6])])
@@ -68,6 +81,9 @@ def cases():
     added_mass[0, 4] = added_mass[4, 0] = 0.8  # surge–pitch coupling: B ≠ 0
     fluid = KirchhoffBody(tumble.RigidBody(INERTIA, mass=10.0), added_mass)
     wheel_speeds = {"wheel_speeds0": [[10.0, -5.0, 3.0, 0.0], [0.0, 20.0, -8.0, 4.0]]}
+    diver = Human.de_leva().moving({"left_shoulder_abduction": Motion(np.pi, [(0.0, 1.0, 0.0)])}, t_span=(0.0, 1.0))
+    gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
+                        outer_gimbal=1e-3, imbalance=0.01, spin_friction=1e-4)
     return {
         "flexible, rk4": (flexible, "rk4", TORQUE, {"eta0": [[0.1, -0.05], [0.0, 0.2]], "eta_rate0": [0.3, 0.0]}),
         "flexible, cf4": (flexible, "cf4", None, {"eta0": [[0.1, -0.05], [0.0, 0.2]]}),
@@ -79,6 +95,13 @@ def cases():
         "spacecraft: wheels, MRP feedback, flexible modes, rk4": (flexible_craft, "rk4", TORQUE,
                                                                   {**wheel_speeds, "eta0": [[0.1, -0.05], [0.0, 0.2]]}),
         "rigid, one body each, cf4": (rigid, "cf4", TORQUE, {}),
+        "variable inertia, rk4": (growing_body(), "rk4", TORQUE, {}),
+        "variable inertia, cf4": (growing_body(), "cf4", None, {}),
+        "moving human, rk4": (diver, "rk4", None, {}),
+        "moving human, cf4": (diver, "cf4", TORQUE, {}),
+        # the gimbal's state has no body rate (cf4's need): rk4 only; its omega is the rotor's rate
+        "gimbaled gyro, rk4": (gyro, "rk4", None, {"spin": [[100.0], [-60.0]], "theta0": [[1.0], [0.6]],
+                                                   "phi_dot0": [[0.5], [-0.2]]}),
         # robots provide no body rate (cf4's need): rk4 only
         "robot: planar two-link chain, rk4": (robot.load(tumble.examples.directory() / "robots/planar_2link.toml"),
                                               "rk4", [1.0, -0.5], {"q0": [[0.3, -0.5], [1.0, 0.2]],
@@ -101,7 +124,8 @@ def _run(device, name):
                   "omega": np.concatenate([traj.base_omega, traj.base_velocity, traj.joint_velocity], axis=-1)
                   if base else traj.joint_velocity}
     else:
-        traj = tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, device=device, **state)
+        rate = {} if isinstance(model, GimbaledGyro) else {"omega0": OMEGA0}  # a gimbal starts from its rates
+        traj = tumble.simulate(model, t=T, method=method, dt=DT, torque=torque, device=device, **rate, **state)
         motion = {"q": traj.q, "omega": traj.omega}
     return {**motion, **{k: traj.info[k] for k in ("n_steps", "n_rhs")}}
 
@@ -157,11 +181,12 @@ def test_simulated_gpu_equals_cpu(simulated, name):
      r"^controller: a Python function cannot run on the GPU \(device='cuda'\)"),
     (lambda: FlexibleBody(INERTIA, [Mode(3.0, 0.02, [0.3, 0.5, 0.2])]),
      r"^torque: a Python function cannot run on the GPU \(device='cuda'\)"),
+    (growing_body, r"^torque: a Python function cannot run on the GPU \(device='cuda'\)"),
 ])
 def test_what_cannot_run_on_a_gpu_is_refused_naming_the_part(make, message):
     # refused before anything is compiled or launched, with or without a GPU
     model = make()
-    torque = (lambda t, q, w: -w) if isinstance(model, FlexibleBody) else None
+    torque = (lambda t, q, w: -w) if isinstance(model, (FlexibleBody, VariableBody)) else None
     with pytest.raises(tumble.ValidationError, match=message):
         tumble.simulate(model, OMEGA0[0], t=T, method="rk4", dt=DT, torque=torque, device="cuda")
 
@@ -174,11 +199,10 @@ def test_a_robot_under_a_python_torque_law_is_refused_naming_torque():
 
 
 def test_a_model_kind_without_a_device_path_is_refused_naming_device():
-    gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
-                        outer_gimbal=1e-3, imbalance=0.01)
-    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a GimbaledGyro: its compiled "
+    body = AxisymmetricBody(tumble.RigidBody(np.diag([1.0, 1.0, 2.0])))
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a AxisymmetricBody: its compiled "
                                                      r"model does not run on a GPU$"):
-        tumble.simulate(gyro, t=T, method="rk4", dt=DT, spin=100.0, theta0=1.0, device="cuda")
+        tumble.simulate(body, OMEGA0[0], t=T, method="rk4", dt=DT, device="cuda")
 
 
 def test_methods_without_a_device_kernel_are_refused():
@@ -193,7 +217,8 @@ def test_methods_without_a_device_kernel_are_refused():
 @pytest.mark.slow
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "fluid, cf4", "spacecraft: wheels, MRP feedback, rk4",
-                                  "rigid, one body each, cf4", "robot: planar two-link chain, rk4"])
+                                  "rigid, one body each, cf4", "robot: planar two-link chain, rk4",
+                                  "variable inertia, rk4", "moving human, cf4", "gimbaled gyro, rk4"])
 def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""
     from numba import typeof

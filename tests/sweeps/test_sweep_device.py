@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 
 import tumble
-from tumble.sweeps import Component, Final, Inertia, Max, Normal, PointingError, sweep
+from tumble.sweeps import (Component, CrossingTime, Final, Inertia, Max, Normal, NutationAngle, PointingError,
+                           SettlingTime, sweep)
 
 from helpers import compile_ptx, nvvm_available
 
@@ -29,14 +30,65 @@ T = np.array([0.0, 0.02, 0.05])
 DT = 0.01
 
 
+def roll_rate_squared(traj):
+    """A Python outcome (evaluated on the host, from the chunk's results copied back): ω_x² at the end, rad²/s²."""
+    return traj.omega[-1, :, 0] ** 2
+
+
 def _sweep_arguments():
-    """A sweep of 5 rigid bodies with dispersed inertia and rates, two chunks, series and outcomes."""
+    """A sweep of 5 rigid bodies with dispersed inertia and rates, two chunks, series and outcomes: built-ins
+    (evaluated on the GPU) and a Python function (on the host)."""
     return dict(dispersions={"inertia": Inertia([1.0, 2.0, 2.4], [0.05, 0.05, 0.05], angle=0.3),
                              "omega0": Normal([0.2, 1.0, 0.0], 0.1)},
                 samples=5, seed=11, chunk=3, t=T, method="rk4", dt=DT,
-                statistics={"wy": Component("omega", 1)},
-                outcomes={"pointing": Final(PointingError()), "peak": Max(Component("omega", 0))},
+                statistics={"wy": Component("omega", 1), "nutation": NutationAngle([0.0, 1.0, 0.2])},
+                outcomes={"pointing": Final(PointingError()), "peak": Max(Component("omega", 0)),
+                          "roll": roll_rate_squared},
                 percentiles=P, workers=0)
+
+
+# The built-ins evaluated on a chunk's results on the GPU (tumble.sweeps.device), by name.
+TARGET = (np.cos(0.15), 0.0, np.sin(0.15), 0.0)
+SERIES = {
+    "pointing": PointingError(TARGET),
+    "nutation": NutationAngle([0.2, 0.1, 1.0]),
+    "wy": Component("omega", 1),
+    "qz": Component("q", -1),
+    "Lz": Component("momentum_body", 2),
+    "energy": Component("energy"),
+}
+OUTCOMES = {
+    "final pointing": Final(PointingError(TARGET)),
+    "final energy": Final(Component("energy")),
+    "peak nutation after 0.2 s": Max(NutationAngle([0.2, 0.1, 1.0]), after=0.2),
+    "peak wx": Max(Component("omega", 0)),
+    "settling of wz": SettlingTime(Component("omega", 2), below=0.3),
+    "crossing of the pointing error": CrossingTime(PointingError(TARGET), above=0.4),
+}
+T_RUN = np.linspace(0.0, 0.5, 11)
+OMEGA0 = np.array([[0.2, 1.0, 0.0], [0.01, 0.02, 0.0], [-0.5, 0.3, 0.8], [0.0, 0.0, 0.1], [1.5, -0.2, 0.4],
+                   [0.3, 0.3, 0.3]])  # rad/s, body axes: some cross and settle, some never
+Q0 = np.array([[1.0, 0.0, 0.0, 0.0]] * 3 + [[np.cos(0.5), np.sin(0.5), 0.0, 0.0]] + [[1.0, 0.0, 0.0, 0.0]] * 2)
+TENSORS = np.array([[[1.0, 0.1, -0.05], [0.1, 2.0, 0.02], [-0.05, 0.02, 2.4]], np.diag([1.0, 2.0, 2.5]),
+                    [[1.5, -0.2, 0.1], [-0.2, 1.2, 0.0], [0.1, 0.0, 2.0]], np.diag([2.0, 2.0, 1.0]),
+                    [[1.1, 0.0, 0.3], [0.0, 1.9, 0.0], [0.3, 0.0, 2.2]], np.diag([3.0, 2.0, 1.5])])  # kg·m²
+
+
+def evaluated_on_the_device():
+    """name -> (device value, host value) of every built-in series and outcome of two runs left on the GPU (one
+    inertia per sample, and one body for all), each also evaluated on the host from the results copied back."""
+    from tumble.sweeps import device
+
+    out = {}
+    for bodies, model in (("each", TENSORS), ("shared", tumble.RigidBody(TENSORS[0]))):
+        traj = tumble.simulate(model, OMEGA0, q0=Q0, t=T_RUN, method="rk4", dt=DT, device="cuda", output="device")
+        assert traj.on_device
+        host = traj.to_host()
+        for name, f in SERIES.items():
+            out[f"{bodies}: {name}"] = (device.series(f, traj).copy_to_host(), f(host))
+        for name, f in OUTCOMES.items():
+            out[f"{bodies}: {name}"] = (device.outcome(f, traj), f(host))
+    return out
 
 
 _CHILD = """
@@ -55,9 +107,17 @@ for name in ("table", "with_nan"):
     out[name + "/percentiles"] = device.percentiles(values, module["P"])
     out[name + "/nanpercentiles"] = device.percentiles(values, module["P"], ignore_nan=True)
     out[name + "/moments"] = np.array(device.moments(values))
+from tumble.trajectory import Trajectory
+to_host = Trajectory.to_host
+copies = []  # the chunks' results copied to the host: counted, then copied as ever
+Trajectory.to_host = lambda traj: (copies.append(traj.on_device), to_host(traj))[1]
 ds = sweep(module["tumble"].RigidBody(np.diag([1.0, 2.0, 2.5])), device="cuda", **module["_sweep_arguments"]())
+Trajectory.to_host = to_host
+out["sweep host copies"] = np.array(copies)
 for name in ds.data_vars:
     out["sweep/" + name] = ds[name].values
+for name, (on_gpu, on_host) in module["evaluated_on_the_device"]().items():
+    out["evaluated/" + name] = np.stack([on_gpu, on_host])
 np.savez(sys.argv[3], **out)
 """
 
@@ -118,14 +178,49 @@ def test_the_sweep_on_the_device_writes_the_cpus_store(simulated):
     for name in ("inertia", "omega0", "done"):  # the inputs: the same draws
         np.testing.assert_array_equal(gpu[f"sweep/{name}"], cpu[name].values)
     # the outcomes: each sample's run, its principal axes found by Jacobi on the device (tests/integrate/test_cuda_rigid.py)
-    for name in ("wy", "pointing", "peak", "wy_mean", "wy_min", "wy_max"):
+    for name in ("wy", "nutation", "pointing", "peak", "roll", "wy_mean", "wy_min", "wy_max"):
         np.testing.assert_allclose(gpu[f"sweep/{name}"], cpu[name].values, rtol=0, atol=1e-14)
     np.testing.assert_allclose(gpu["sweep/wy_std"], cpu["wy_std"].values, rtol=0, atol=1e-14)
     assert np.ptp(cpu["wy"].values[:, -1]) > 1e-3  # the samples differ
+    # the chunks' results stayed on the GPU, but for one copy per chunk (of 3 and 2 samples) for the Python outcome
+    assert gpu["sweep host copies"].tolist() == [True, True]
     # the percentiles are those of the stored values, bit for bit
     np.testing.assert_array_equal(gpu["sweep/wy_percentiles"], np.percentile(gpu["sweep/wy"], P, axis=0))
     np.testing.assert_array_equal(gpu["sweep/pointing_percentiles"], np.nanpercentile(gpu["sweep/pointing"], P))
     np.testing.assert_array_equal(gpu["sweep/pointing_count"], cpu["pointing_count"].values)
+
+
+# What reads the angular momentum L = I ω sums its three terms in another order than NumPy's einsum, which the host
+# uses (tumble.dynamics.angular_momentum): a few units in the last place of L, and as many of ε in the nutation angle.
+SUMS_OF_I_OMEGA = {"nutation", "Lz", "peak nutation after 0.2 s"}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("bodies", ["each", "shared"])
+@pytest.mark.parametrize("name", [*SERIES, *OUTCOMES])
+def test_built_in_outcomes_on_the_device_equal_the_hosts(simulated, bodies, name):
+    # the same arithmetic on the chunk's device arrays as on the host's copy: under the simulator, which rounds
+    # as the CPU does, the same bits, but for the order of the sums of I ω (a GPU fuses multiply-adds: docs/gpu.md)
+    _, gpu = simulated
+    on_gpu, on_host = gpu[f"evaluated/{bodies}: {name}"]
+    assert on_gpu.shape[-1] == len(OMEGA0)
+    if name in SUMS_OF_I_OMEGA:
+        np.testing.assert_allclose(on_gpu, on_host, rtol=0, atol=4 * EPS * np.abs(on_host).max())
+    else:
+        np.testing.assert_array_equal(on_gpu, on_host)
+
+
+@pytest.mark.slow
+def test_the_outcomes_on_the_device_see_each_case(simulated):
+    # the runs reach each branch of the reductions: samples that cross at once, later and never, that settle at
+    # once, later and never; a maximum after 0.2 s below the whole run's
+    _, gpu = simulated
+    crossing, settling = (np.concatenate([gpu[f"evaluated/{bodies}: {name}"][0] for bodies in ("each", "shared")])
+                          for name in ("crossing of the pointing error", "settling of wz"))
+    for times in (crossing, settling):
+        assert np.isnan(times).any() and (times == 0.0).any() and ((times > 0.0) & (times <= T_RUN[-1])).any()
+    nutation = gpu["evaluated/each: nutation"][0]
+    assert (gpu["evaluated/each: peak nutation after 0.2 s"][0] < nutation.max(axis=0)).any()
 
 
 def test_a_device_sweep_refuses_what_it_cannot_run():
@@ -140,17 +235,23 @@ def test_a_device_sweep_refuses_what_it_cannot_run():
 
 
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
-@pytest.mark.parametrize("name", ["block_moments_kernel", "bitonic_kernel", "count_kernel", "gather_kernel"])
+@pytest.mark.parametrize("name", ["block_moments_kernel", "bitonic_kernel", "count_kernel", "gather_kernel",
+                                  "pointing_kernel", "nutation_kernel", "momentum_kernel", "energy_kernel",
+                                  "component_kernel", "max_kernel", "settling_kernel", "crossing_kernel"])
 def test_reduction_kernels_compile_for_a_gpu(monkeypatch, name):
     """What the simulator cannot see: each reduction kernel types and compiles for sm_90, allocating nothing."""
     from numba import float64, int64
 
     from tumble.integrate import _cuda_reductions as device
 
-    a2 = float64[:, ::1]
-    signatures = {"block_moments_kernel": (a2, int64, float64[:, :, ::1]), "bitonic_kernel": (a2, int64, int64),
+    a1, a2, a3 = float64[::1], float64[:, ::1], float64[:, :, ::1]
+    signatures = {"block_moments_kernel": (a2, int64, a3), "bitonic_kernel": (a2, int64, int64),
                   "count_kernel": (a2, int64[::1]),
-                  "gather_kernel": (a2, int64[:, ::1], int64[:, ::1], float64[:, :, ::1])}
+                  "gather_kernel": (a2, int64[:, ::1], int64[:, ::1], a3),
+                  "pointing_kernel": (a3, float64, float64, float64, float64, a2),
+                  "nutation_kernel": (a3, a3, float64, float64, float64, a2), "momentum_kernel": (a3, a3, int64, a2),
+                  "energy_kernel": (a3, a3, a2), "component_kernel": (a3, int64, a2), "max_kernel": (a2, int64, a1),
+                  "settling_kernel": (a2, a1, float64, a1), "crossing_kernel": (a2, a1, float64, a1)}
     ptx = compile_ptx(monkeypatch, getattr(device, name), signatures[name])
     assert ptx.count(".entry") == 1
     assert "malloc" not in ptx

@@ -229,3 +229,15 @@ def test_documented_example_prints_what_it_claims(capsys):
     exec(compile(text[start:text.index("```", start)], "variable_inertia.md", "exec"), {})  # the project's own text
     printed = capsys.readouterr().out
     assert "37.30" in printed and "34.32 34.32" in printed
+
+
+def test_the_spline_piece_is_numpy_searchsorted_clamped_to_the_end_pieces():
+    # the kernel's bisection (device code has no np.searchsorted) must pick NumPy's piece for every clock:
+    # on each breakpoint, between them, outside them (the end pieces), and for NaN (the last piece)
+    from tumble.kernels.variable import piece
+
+    for breaks in (np.array([0.0, 1.0]), np.array([0.0, 0.1, 0.25, 0.5, 1.0]), VariableBody.grid((0.0, 2.0), 0.01)):
+        mids = 0.5 * (breaks[1:] + breaks[:-1])
+        clocks = np.concatenate([breaks, mids, np.nextafter(breaks, -np.inf), [-1.0, 5.0, -np.inf, np.inf, np.nan]])
+        expected = np.clip(np.searchsorted(breaks, clocks, side="right") - 1, 0, breaks.size - 2)
+        assert [piece(breaks, s) for s in clocks] == expected.tolist()

@@ -1,7 +1,17 @@
 """The compiled CUDA kernels of a sweep's reductions on the GPU (:mod:`tumble.sweeps.device` launches them and
 reads their results): per-block moments, a bitonic sorting network, the count of numbers in a sorted row, and
-the gather of order statistics. Here, in a compiled layer, so that their code is in the cache's content key
-(:mod:`tumble._cache`); the sweeps layer above compiles nothing.
+the gather of order statistics; and the built-in series and outcomes of :mod:`tumble.sweeps.outcomes` evaluated
+on a chunk's results left on the GPU. Here, in a compiled layer, so that their code is in the cache's content
+key (:mod:`tumble._cache`); the sweeps layer above compiles nothing.
+
+The series are tables (n, m): output time ``k``, sample ``b``, one thread each, from the chunk's ``q`` (n, m, 4)
+and ``omega`` (n, m, 3) (body axes) and its inertia (m or 1, 3, 3) (kg·m², body axes), with the host's
+arithmetic, operation for operation: :func:`pointing_angle` that of :func:`tumble.attitude.relative_angle`,
+:func:`nutation_kernel` that of :func:`tumble.spacecraft.damper.nutation_angle` over ``L = I ω``
+(:func:`tumble.dynamics.angular_momentum`), :func:`energy_kernel` ``T = ½ Σᵢⱼ ωᵢ Iᵢⱼ ωⱼ``
+(:func:`tumble.dynamics.kinetic_energy`, its terms in the order of NumPy's ``einsum``). The reductions of a
+series over the output times run one thread per sample. On a GPU, NVVM fuses multiply–adds and libdevice
+evaluates ``atan2`` and ``sqrt``: the results differ from the host's in the last bits (docs/gpu.md).
 
 Import this module only when a GPU run is asked for: it imports ``numba.cuda``.
 """
@@ -13,12 +23,16 @@ from typing import Any
 
 import numpy as np
 from numba import cuda
+from numba.extending import register_jitable
 from numpy.typing import ArrayLike
 
+from tumble._quat import qlog, qmul
 from tumble.integrate._cuda import THREADS_PER_BLOCK, on_device
 
-__all__ = ["bitonic_kernel", "block_moments", "block_moments_kernel", "count_kernel", "gather", "gather_kernel",
-           "launch", "numbers_in_rows", "sorted_columns"]
+__all__ = ["bitonic_kernel", "block_moments", "block_moments_kernel", "component_kernel", "count_kernel",
+           "crossing_kernel", "energy_kernel", "gather", "gather_kernel", "launch", "max_kernel", "momentum_kernel",
+           "numbers_in_rows", "nutation_kernel", "pointing_angle", "pointing_kernel", "series_table",
+           "settling_kernel", "sorted_columns"]
 
 
 def launch(n: int) -> tuple[int, int]:
@@ -146,3 +160,140 @@ def gather(keys: Any, previous: np.ndarray, following: np.ndarray) -> np.ndarray
     ends = cuda.device_array((2,) + previous.shape)
     gather_kernel[launch(previous.size)](keys, cuda.to_device(previous), cuda.to_device(following), ends)
     return ends.copy_to_host()
+
+
+# -- the built-in series and outcomes of tumble.sweeps.outcomes on a chunk's device arrays ---------------------
+
+
+@register_jitable
+def pointing_angle(tw, tx, ty, tz, qw, qx, qy, qz):
+    """The angle θ ∈ [0, π] (rad) of ``t* ⊗ q``, as :func:`tumble.attitude.relative_angle` computes it: the
+    product scaled by the power of two that brings its largest |component| into [0.5, 1) (exact), then
+    ``θ = |qlog(·)|``."""
+    w, x, y, z = qmul(tw, -tx, -ty, -tz, qw, qx, qy, qz)
+    e = math.frexp(max(abs(w), abs(x), abs(y), abs(z)))[1]
+    rx, ry, rz = qlog(math.ldexp(w, -e), math.ldexp(x, -e), math.ldexp(y, -e), math.ldexp(z, -e))
+    return math.sqrt(rx * rx + ry * ry + rz * rz)
+
+
+@register_jitable
+def _momentum(inertia, b, w1, w2, w3):
+    """``L = I ω`` (N·m·s, body axes) of sample ``b`` (its row of ``inertia``, or the one shared), the terms of
+    each component summed in order."""
+    r = b if inertia.shape[0] > 1 else 0
+    return (inertia[r, 0, 0] * w1 + inertia[r, 0, 1] * w2 + inertia[r, 0, 2] * w3,
+            inertia[r, 1, 0] * w1 + inertia[r, 1, 1] * w2 + inertia[r, 1, 2] * w3,
+            inertia[r, 2, 0] * w1 + inertia[r, 2, 1] * w2 + inertia[r, 2, 2] * w3)
+
+
+@cuda.jit(cache=True)
+def pointing_kernel(q, tw, tx, ty, tz, out):
+    """Thread ``(k, b)``: ``out[k, b]``, the pointing error (rad) of ``q[k, b]`` from the target ``t``."""
+    index = cuda.grid(1)
+    m = out.shape[1]
+    k, b = index // m, index % m
+    if k >= out.shape[0]:
+        return
+    out[k, b] = pointing_angle(tw, tx, ty, tz, q[k, b, 0], q[k, b, 1], q[k, b, 2], q[k, b, 3])
+
+
+@cuda.jit(cache=True)
+def nutation_kernel(omega, inertia, a1, a2, a3, out):
+    """Thread ``(k, b)``: ``out[k, b] = atan2(|L × a|, L · a)`` (rad), ``L = I ω``, ``a`` a unit body axis."""
+    index = cuda.grid(1)
+    m = out.shape[1]
+    k, b = index // m, index % m
+    if k >= out.shape[0]:
+        return
+    x, y, z = _momentum(inertia, b, omega[k, b, 0], omega[k, b, 1], omega[k, b, 2])
+    along = x * a1 + y * a2 + z * a3
+    c1, c2, c3 = y * a3 - z * a2, z * a1 - x * a3, x * a2 - y * a1
+    out[k, b] = math.atan2(math.sqrt(c1 * c1 + c2 * c2 + c3 * c3), along)
+
+
+@cuda.jit(cache=True)
+def momentum_kernel(omega, inertia, i, out):
+    """Thread ``(k, b)``: ``out[k, b]``, component ``i`` of ``L = I ω`` (N·m·s, body axes)."""
+    index = cuda.grid(1)
+    m = out.shape[1]
+    k, b = index // m, index % m
+    if k >= out.shape[0]:
+        return
+    out[k, b] = _momentum(inertia, b, omega[k, b, 0], omega[k, b, 1], omega[k, b, 2])[i]
+
+
+@cuda.jit(cache=True)
+def energy_kernel(omega, inertia, out):
+    """Thread ``(k, b)``: ``out[k, b] = ½ Σᵢⱼ ωᵢ Iᵢⱼ ωⱼ`` (J), the nine terms summed in the order of ``(i, j)``."""
+    index = cuda.grid(1)
+    m = out.shape[1]
+    k, b = index // m, index % m
+    if k >= out.shape[0]:
+        return
+    r = b if inertia.shape[0] > 1 else 0
+    total = 0.0
+    for i in range(3):
+        for j in range(3):
+            total += omega[k, b, i] * inertia[r, i, j] * omega[k, b, j]
+    out[k, b] = 0.5 * total
+
+
+@cuda.jit(cache=True)
+def component_kernel(values, i, out):
+    """Thread ``(k, b)``: ``out[k, b] = values[k, b, i]``."""
+    index = cuda.grid(1)
+    m = out.shape[1]
+    k, b = index // m, index % m
+    if k >= out.shape[0]:
+        return
+    out[k, b] = values[k, b, i]
+
+
+@cuda.jit(cache=True)
+def max_kernel(series, first, out):
+    """Thread ``b``: ``out[b]``, the largest of ``series[first:, b]``; NaN where one is NaN (NumPy's ``max``)."""
+    b = cuda.grid(1)
+    if b >= out.shape[0]:
+        return
+    best = series[first, b]
+    for k in range(first + 1, series.shape[0]):
+        x = series[k, b]
+        if x > best or x != x:
+            best = x if best == best else best
+    out[b] = best
+
+
+@cuda.jit(cache=True)
+def settling_kernel(series, t, below, out):
+    """Thread ``b``: ``out[b] = t[k]`` for the first ``k`` from which ``|series[k:, b]| <= below`` holds (a NaN
+    is not outside the band), NaN if the last sample is outside it."""
+    b = cuda.grid(1)
+    if b >= out.shape[0]:
+        return
+    n = series.shape[0]
+    first_in = 0
+    for k in range(n - 1, -1, -1):
+        if abs(series[k, b]) > below:
+            first_in = k + 1
+            break
+    out[b] = t[first_in] if first_in < n else math.nan
+
+
+@cuda.jit(cache=True)
+def crossing_kernel(series, t, above, out):
+    """Thread ``b``: ``out[b] = t[k]`` for the first ``k`` with ``series[k, b] >= above``, NaN if there is none."""
+    b = cuda.grid(1)
+    if b >= out.shape[0]:
+        return
+    out[b] = math.nan
+    for k in range(series.shape[0]):
+        if series[k, b] >= above:
+            out[b] = t[k]
+            return
+
+
+def series_table(kernel, n: int, m: int, *args) -> Any:
+    """The device table (n, m) that ``kernel(*args, out)`` fills, one thread per output time and sample."""
+    out = cuda.device_array((n, m))
+    kernel[launch(n * m)](*args, out)
+    return out

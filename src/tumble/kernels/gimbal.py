@@ -35,8 +35,9 @@ class GimbalModel(NamedTuple):
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side."""
-        return frozenset({"rhs"})
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side, which also runs on an NVIDIA
+        GPU (``"cuda"``)."""
+        return frozenset({"rhs", "cuda"})
 
     @property
     def calls_python(self) -> bool:

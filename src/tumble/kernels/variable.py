@@ -48,13 +48,19 @@ class VariableModel(NamedTuple):
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate."""
-        return frozenset({"rhs", "body_rate"})
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side and the body rate; ``"cuda"``
+        without a Python torque function."""
+        return frozenset({"rhs", "body_rate", *(() if self.calls_python else ("cuda",))})
 
     @property
     def calls_python(self) -> bool:
         """True when the torque program calls a Python function (the batch then runs on one core)."""
         return torques.program_calls_python(self)
+
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this kernel cannot run on an NVIDIA GPU (a ValidationError message), or None: a Python torque."""
+        return _protocol.python_on_gpu("torque") if self.calls_python else None
 
 
 def build(body, torque) -> VariableModel:
@@ -73,17 +79,32 @@ def _channel(c, k, x, i):
     return ((c[k, 0, i] * x + c[k, 1, i]) * x + c[k, 2, i]) * x + c[k, 3, i]
 
 
+@njit(cache=True, inline="always")
+def piece(breaks, s):
+    """The spline piece ``k`` whose interval ``[breaks[k], breaks[k+1])`` holds the clock ``s`` (s), by
+    bisection over the increasing ``breaks``: ``searchsorted(breaks, s, side="right") − 1``, clamped to the end
+    pieces ``0 … len(breaks) − 2`` (the last for a NaN ``s``). A loop of comparisons, which code on a GPU runs
+    (numba.cuda compiles no ``np.searchsorted``)."""
+    lo, hi = 0, breaks.shape[0] - 1  # breaks[lo] <= s < breaks[hi], or s outside them: the end piece
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if s < breaks[mid]:
+            hi = mid
+        else:
+            lo = mid
+    return lo
+
+
 @njit(cache=True)
 def angular_rate(breaks, c, s, qw, qx, qy, qz, lx, ly, lz):
     """``ω = I(s)⁻¹ (q* L_N q − A(s))`` (rad/s, body axes) at clock ``s`` for attitude ``q`` and ``L_N``.
 
-    The spline piece is found by bisection (times outside the breakpoints use
-    the end pieces; the Python layer refuses such times). ``I⁻¹ b`` is solved
-    by the adjugate (Cramer's rule): ``I`` is symmetric positive definite and
-    its condition number for a human body is below 30.
+    The spline piece is found by bisection (:func:`piece`; times outside the
+    breakpoints use the end pieces; the Python layer refuses such times).
+    ``I⁻¹ b`` is solved by the adjugate (Cramer's rule): ``I`` is symmetric
+    positive definite and its condition number for a human body is below 30.
     """
-    k = np.searchsorted(breaks, s, side="right") - 1
-    k = min(max(k, 0), breaks.shape[0] - 2)
+    k = piece(breaks, s)
     x = s - breaks[k]
     a = _channel(c, k, x, 0)
     d = _channel(c, k, x, 1)

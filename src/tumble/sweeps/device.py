@@ -24,20 +24,38 @@ reduces its series and outcomes here when it writes the store
   ``v = (n − 1) p/100``, ``x = a + (b − a) γ`` (``b − (b − a)(1 − γ)`` for
   ``γ ≥ 0.5``), ``γ = v − ⌊v⌋``, so no fused multiply–add enters.
 
+A chunk's own series and outcomes are evaluated here too, where its results
+stay on the GPU (a chunk of rigid bodies: ``simulate(..., output="device")``):
+:func:`series` and :func:`outcome` evaluate the built-ins of
+:mod:`tumble.sweeps.outcomes` there, so that only their values (a series'
+table, an outcome's value per sample) come back, not the trajectories. They
+return None for what the host evaluates, from a copy of the results: a Python
+function, a :class:`~tumble.sweeps.outcomes.Component` of another field than
+``q``, ``omega``, ``momentum_body`` and ``energy``, or one whose ``index``
+(or a :class:`~tumble.sweeps.outcomes.Max` whose ``after``) the host refuses
+with its message.
+
 The device work is :mod:`tumble.integrate._cuda_reductions`'s; this module merges and interpolates on the
 host. Import it only when a GPU run is asked for: it imports ``numba.cuda``.
 """
 
 from __future__ import annotations
 
+from typing import Any
 
 import numpy as np
+from numba import cuda
 from numpy.typing import ArrayLike
 
-from tumble.integrate._cuda_reductions import block_moments, gather, numbers_in_rows, sorted_columns
+from tumble.integrate._cuda import on_device
+from tumble.integrate._cuda_reductions import (block_moments, component_kernel, crossing_kernel, energy_kernel, gather,
+                                               launch, max_kernel, momentum_kernel, numbers_in_rows, nutation_kernel,
+                                               pointing_kernel, series_table, settling_kernel, sorted_columns)
 from tumble.sweeps.moments import merge
+from tumble.sweeps.outcomes import Component, CrossingTime, Final, Max, NutationAngle, PointingError, SettlingTime
+from tumble.trajectory import Trajectory
 
-__all__ = ["BLOCK", "moments", "percentiles"]
+__all__ = ["BLOCK", "moments", "outcome", "percentiles", "series"]
 
 #: Samples per thread in :func:`moments`: a column of 10⁶ samples is summed by 245 threads.
 BLOCK = 4096
@@ -84,3 +102,72 @@ def percentiles(values: ArrayLike, p: ArrayLike, *, ignore_nan: bool = False) ->
     out = np.where(gamma >= 0.5, b - diff * (1 - gamma), a + diff * gamma)
     out[:, (n == 0) if ignore_nan else (n < samples)] = np.nan
     return out
+
+
+def _samples(traj: Trajectory) -> tuple[int, int]:
+    """The output times and samples ``(n, m)`` of a device trajectory."""
+    q: Any = traj.q  # a device array
+    return q.shape[0], q.shape[1]
+
+
+def _inertia(traj: Trajectory) -> Any:
+    """The inertia tensors of a device trajectory as (m or 1, 3, 3) (kg·m², body axes): one per sample, or the
+    one they share."""
+    inertia: Any = traj.inertia  # a device array
+    return inertia if len(inertia.shape) == 3 else inertia.reshape((1, 3, 3))
+
+
+def _component(f: Component, traj: Trajectory) -> Any:
+    """A :class:`Component` of ``q``, ``omega``, ``momentum_body`` (``I ω``) or ``energy`` (``½ ω·Iω``) as a
+    device table (n, m), or None: another field, or an ``index`` the host refuses."""
+    n, m = _samples(traj)
+    if f.name == "energy":
+        return series_table(energy_kernel, n, m, traj.omega, _inertia(traj)) if f.index == () else None
+    size = {"q": 4, "omega": 3, "momentum_body": 3}.get(f.name)
+    if size is None or len(f.index) != 1 or not -size <= f.index[0] < size:
+        return None
+    i = f.index[0] % size
+    if f.name == "momentum_body":
+        return series_table(momentum_kernel, n, m, traj.omega, _inertia(traj), i)
+    return series_table(component_kernel, n, m, getattr(traj, f.name), i)
+
+
+def series(f: Any, traj: Trajectory) -> Any:
+    """The series ``f`` (a built-in of :mod:`tumble.sweeps.outcomes`) of the device trajectory ``traj`` as a
+    device table (n, m), evaluated on the GPU; None where the host evaluates it (the module docstring)."""
+    n, m = _samples(traj)
+    if isinstance(f, PointingError):
+        return series_table(pointing_kernel, n, m, traj.q, *f.target)
+    if isinstance(f, NutationAngle):
+        axis = np.asarray(f.axis)
+        axis = axis / np.linalg.norm(axis)  # as nutation_angle normalises it
+        return series_table(nutation_kernel, n, m, traj.omega, _inertia(traj), *axis)
+    if isinstance(f, Component):
+        return _component(f, traj)
+    return None
+
+
+def outcome(f: Any, traj: Trajectory) -> np.ndarray | None:
+    """The outcome ``f`` (a built-in reduction of a built-in series, :mod:`tumble.sweeps.outcomes`) of the device
+    trajectory ``traj``, (m,), reduced on the GPU and copied back; None where the host evaluates it."""
+    if not isinstance(f, (Final, Max, SettlingTime, CrossingTime)):
+        return None
+    first = 0
+    if isinstance(f, Max):
+        after = np.flatnonzero(traj.t >= f.after)  # the output times increase: a tail of them
+        if not after.size:
+            return None
+        first = int(after[0])
+    table = series(f.of, traj)
+    if table is None:
+        return None
+    if isinstance(f, Final):
+        return table[table.shape[0] - 1].copy_to_host()
+    out = cuda.device_array(table.shape[1])
+    if isinstance(f, Max):
+        max_kernel[launch(out.shape[0])](table, first, out)
+    elif isinstance(f, SettlingTime):
+        settling_kernel[launch(out.shape[0])](table, on_device(traj.t), float(f.below), out)
+    else:
+        crossing_kernel[launch(out.shape[0])](table, on_device(traj.t), float(f.above), out)
+    return out.copy_to_host()

@@ -25,6 +25,7 @@ How a chunk is batched:
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import inspect
 import json
@@ -130,32 +131,36 @@ class Plan:
         """Simulate chunk ``k`` and reduce it (what a Dask task does)."""
         lo, hi = self.chunks.bounds(k)
         inputs = self.inputs(lo, hi)
-        traj = self.simulate(inputs)
+        traj = self.simulate(inputs, output="device" if self.device == "cuda" else "host")
+        host = functools.cache(traj.to_host)  # the results on the host, copied once where they are on a GPU
         m = hi - lo
         outcomes = {}
         for name, f in self.outcomes.items():
-            value = np.asarray(f(traj))
+            value = np.asarray(_evaluated("outcome", f, traj, host))
             if value.ndim < 1 or value.shape[0] != m:
                 raise ValidationError(f"outcomes[{name!r}]: must give one value per sample ({m}, ...), "
                                       f"got shape {value.shape}")
             outcomes[name] = value
         series = {}
         for name, f in self.series.items():
-            value = np.asarray(f(traj), dtype=np.float64)
+            value = np.asarray(_evaluated("series", f, traj, host), dtype=np.float64)
             if value.shape != (len(self.t), m):
                 raise ValidationError(f"statistics[{name!r}]: must give one value per output time and sample "
                                       f"({len(self.t)}, {m}), got shape {value.shape}")
             series[name] = np.ascontiguousarray(value.T)
         kept = {}
         if self.trajectories:  # sample-major, as the store is chunked
+            traj = host()
             momentum = traj.momentum_body if traj.q is not None or "momentum_body" in traj.totals else None
             fields = {"q": traj.q, "omega": traj.omega, **{name: e.data for name, e in traj.extras.items()},
                       "energy": traj.energy, "momentum_body": momentum}
             kept = {name: np.ascontiguousarray(np.swapaxes(v, 0, 1)) for name, v in fields.items() if v is not None}
         return ChunkResult(lo, hi, inputs, outcomes, series, kept)
 
-    def simulate(self, inputs: Mapping[str, np.ndarray]) -> Trajectory:
-        """The batched trajectory (axes (time, member, ...)) of the samples whose inputs are ``inputs``."""
+    def simulate(self, inputs: Mapping[str, np.ndarray], output: str = "host") -> Trajectory:
+        """The batched trajectory (axes (time, member, ...)) of the samples whose inputs are ``inputs``; with
+        ``output="device"`` (and ``device="cuda"``), its results left on the GPU where :func:`tumble.simulate`
+        keeps them there (rigid bodies), on the host otherwise."""
         m = len(next(iter(inputs.values()))) if inputs else 0
         state = {**self.fixed, **{name: inputs[name].reshape(m, -1) for name in self.states}}
         parameters = {name: v for name, v in inputs.items() if name not in self.states}
@@ -166,10 +171,12 @@ class Plan:
                 model = parameters["inertia"] if self.device == "cuda" else RigidBodies.of(parameters["inertia"])
             elif not any(np.ndim(v) == 2 for v in state.values()):
                 state = {name: np.broadcast_to(v, (m, np.size(v))) for name, v in state.items()}
-            return simulate(model, **run, **state)
+            model, kept = _kept_on_device(model, self.method, output)
+            return simulate(model, **run, output=kept, **state)
         models = [self.model(**{name: v[j] for name, v in parameters.items()}) for j in range(m)]
         if all(isinstance(b, RigidBody) for b in models):
-            return simulate(RigidBodies.of(models), **run, **_members(state, m))
+            bodies, kept = _kept_on_device(RigidBodies.of(models), self.method, output)
+            return simulate(bodies, **run, output=kept, **_members(state, m))
         members = [simulate(model, **run, **{name: v[j:j + 1] if np.ndim(v) == 2 else v for name, v in
                                              _members(state, m).items()}) for j, model in enumerate(models)]
         return _stack(members)
@@ -256,6 +263,37 @@ def _describe_model(model) -> str:
     inertia = getattr(model, "inertia", None)
     extra = "" if inertia is None or not isinstance(inertia, np.ndarray) else f", inertia {inertia.tolist()}"
     return repr(model) + extra
+
+
+def _kept_on_device(model: Any, method: str, output: str) -> tuple[Any, str]:
+    """``(model, output)`` for :func:`tumble.simulate`: with ``output="device"``, the model set up on the GPU
+    (:func:`tumble._rigid_cuda.as_device_model`) and ``"device"`` where its results stay there (rigid bodies),
+    ``"host"`` for any other model (its outputs are made on the host)."""
+    if output != "device":
+        return model, output
+    from tumble import _rigid_cuda  # imports numba.cuda: only for a sweep on a GPU
+
+    model = _rigid_cuda.as_device_model(model, method)
+    return model, "device" if isinstance(model, _rigid_cuda.DeviceRigidBodies) else "host"
+
+
+def _evaluated(kind: str, f: Callable[[Trajectory], np.ndarray], traj: Trajectory,
+               host: Callable[[], Trajectory]) -> Any:
+    """The outcome or series (``kind``) ``f`` of a chunk's trajectory: on the GPU where ``traj``'s results are
+    there and ``f`` is a built-in that runs there (:mod:`tumble.sweeps.device`), otherwise ``f`` of the
+    host's copy ``host()``."""
+    if traj.on_device:
+        from tumble.sweeps import device
+
+        if kind == "outcome":
+            value = device.outcome(f, traj)
+            if value is not None:
+                return value
+        else:
+            table = device.series(f, traj)  # a device array
+            if table is not None:
+                return table.copy_to_host()
+    return f(host())
 
 
 def _inertia_of(member: Trajectory) -> np.ndarray:
