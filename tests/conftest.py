@@ -17,9 +17,11 @@ os.environ.setdefault("TUMBLE_QUIET", "1")
 KINDS = ("tests/spacecraft/", "tests/robot/")
 
 #: Tests outside those folders that compile a kind's code, by the start of their node id -> the kind's folder:
-#: the spacecraft's row of the model × method matrix compiles its block (state × lanes) path, as the flight
-#: software's tests do (~50 CPU s each time).
-JOINS = {"tests/test_models.py::test_every_model_under_every_method[Spacecraft-": "tests/spacecraft/"}
+#: the spacecraft's rows of the model × method matrix, and the GPU path's tests, whose CPU runs compile the
+#: spacecraft's right-hand side on a state vector as the spacecraft's tests do (~40 CPU s each time, with its
+#: sample and start sample); a whole module joins, so that its module fixtures run once.
+JOINS = {"tests/test_models.py::test_every_model_under_every_method[Spacecraft-": "tests/spacecraft/",
+         "tests/integrate/test_cuda_models.py": "tests/spacecraft/"}
 
 
 def pytest_xdist_make_scheduler(config, log):
