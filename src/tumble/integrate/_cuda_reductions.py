@@ -31,7 +31,7 @@ from tumble.integrate._cuda import THREADS_PER_BLOCK, on_device
 
 __all__ = ["bitonic_kernel", "block_moments", "block_moments_kernel", "component_kernel", "count_kernel",
            "crossing_kernel", "energy_kernel", "gather", "gather_kernel", "launch", "max_kernel", "momentum_kernel",
-           "numbers_in_rows", "nutation_kernel", "pointing_angle", "pointing_kernel", "series_table",
+           "numbers_in_rows", "nutation_kernel", "per_sample", "pointing_angle", "pointing_kernel", "series_table",
            "settling_kernel", "sorted_columns"]
 
 
@@ -297,3 +297,10 @@ def series_table(kernel, n: int, m: int, *args) -> Any:
     out = cuda.device_array((n, m))
     kernel[launch(n * m)](*args, out)
     return out
+
+
+def per_sample(kernel, m: int, *args) -> np.ndarray:
+    """The host array (m,) that ``kernel(*args, out)`` fills on the device, one thread per sample."""
+    out = cuda.device_array(m)
+    kernel[launch(m)](*args, out)
+    return out.copy_to_host()

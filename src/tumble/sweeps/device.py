@@ -44,13 +44,13 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numba import cuda
 from numpy.typing import ArrayLike
 
 from tumble.integrate._cuda import on_device
 from tumble.integrate._cuda_reductions import (block_moments, component_kernel, crossing_kernel, energy_kernel, gather,
-                                               launch, max_kernel, momentum_kernel, numbers_in_rows, nutation_kernel,
-                                               pointing_kernel, series_table, settling_kernel, sorted_columns)
+                                               max_kernel, momentum_kernel, numbers_in_rows, nutation_kernel,
+                                               per_sample, pointing_kernel, series_table, settling_kernel,
+                                               sorted_columns)
 from tumble.sweeps.moments import merge
 from tumble.sweeps.outcomes import Component, CrossingTime, Final, Max, NutationAngle, PointingError, SettlingTime
 from tumble.trajectory import Trajectory
@@ -163,11 +163,9 @@ def outcome(f: Any, traj: Trajectory) -> np.ndarray | None:
         return None
     if isinstance(f, Final):
         return table[table.shape[0] - 1].copy_to_host()
-    out = cuda.device_array(table.shape[1])
+    m = table.shape[1]
     if isinstance(f, Max):
-        max_kernel[launch(out.shape[0])](table, first, out)
-    elif isinstance(f, SettlingTime):
-        settling_kernel[launch(out.shape[0])](table, on_device(traj.t), float(f.below), out)
-    else:
-        crossing_kernel[launch(out.shape[0])](table, on_device(traj.t), float(f.above), out)
-    return out.copy_to_host()
+        return per_sample(max_kernel, m, table, first)
+    if isinstance(f, SettlingTime):
+        return per_sample(settling_kernel, m, table, on_device(traj.t), float(f.below))
+    return per_sample(crossing_kernel, m, table, on_device(traj.t), float(f.above))
