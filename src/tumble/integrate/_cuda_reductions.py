@@ -186,12 +186,18 @@ def _momentum(inertia, b, w1, w2, w3):
             inertia[r, 2, 0] * w1 + inertia[r, 2, 1] * w2 + inertia[r, 2, 2] * w3)
 
 
+@register_jitable
+def _table_cell(out):
+    """The cell ``(k, b)`` (output time, sample) of the table ``out`` (n, m) that this thread fills: thread
+    ``k·m + b`` of the launch (``k ≥ n`` for a thread past the table)."""
+    index = cuda.grid(1)
+    return index // out.shape[1], index % out.shape[1]
+
+
 @cuda.jit(cache=True)
 def pointing_kernel(q, tw, tx, ty, tz, out):
     """Thread ``(k, b)``: ``out[k, b]``, the pointing error (rad) of ``q[k, b]`` from the target ``t``."""
-    index = cuda.grid(1)
-    m = out.shape[1]
-    k, b = index // m, index % m
+    k, b = _table_cell(out)
     if k >= out.shape[0]:
         return
     out[k, b] = pointing_angle(tw, tx, ty, tz, q[k, b, 0], q[k, b, 1], q[k, b, 2], q[k, b, 3])
@@ -200,9 +206,7 @@ def pointing_kernel(q, tw, tx, ty, tz, out):
 @cuda.jit(cache=True)
 def nutation_kernel(omega, inertia, a1, a2, a3, out):
     """Thread ``(k, b)``: ``out[k, b] = atan2(|L × a|, L · a)`` (rad), ``L = I ω``, ``a`` a unit body axis."""
-    index = cuda.grid(1)
-    m = out.shape[1]
-    k, b = index // m, index % m
+    k, b = _table_cell(out)
     if k >= out.shape[0]:
         return
     x, y, z = _momentum(inertia, b, omega[k, b, 0], omega[k, b, 1], omega[k, b, 2])
@@ -214,9 +218,7 @@ def nutation_kernel(omega, inertia, a1, a2, a3, out):
 @cuda.jit(cache=True)
 def momentum_kernel(omega, inertia, i, out):
     """Thread ``(k, b)``: ``out[k, b]``, component ``i`` of ``L = I ω`` (N·m·s, body axes)."""
-    index = cuda.grid(1)
-    m = out.shape[1]
-    k, b = index // m, index % m
+    k, b = _table_cell(out)
     if k >= out.shape[0]:
         return
     out[k, b] = _momentum(inertia, b, omega[k, b, 0], omega[k, b, 1], omega[k, b, 2])[i]
@@ -225,9 +227,7 @@ def momentum_kernel(omega, inertia, i, out):
 @cuda.jit(cache=True)
 def energy_kernel(omega, inertia, out):
     """Thread ``(k, b)``: ``out[k, b] = ½ Σᵢⱼ ωᵢ Iᵢⱼ ωⱼ`` (J), the nine terms summed in the order of ``(i, j)``."""
-    index = cuda.grid(1)
-    m = out.shape[1]
-    k, b = index // m, index % m
+    k, b = _table_cell(out)
     if k >= out.shape[0]:
         return
     r = b if inertia.shape[0] > 1 else 0
@@ -241,9 +241,7 @@ def energy_kernel(omega, inertia, out):
 @cuda.jit(cache=True)
 def component_kernel(values, i, out):
     """Thread ``(k, b)``: ``out[k, b] = values[k, b, i]``."""
-    index = cuda.grid(1)
-    m = out.shape[1]
-    k, b = index // m, index % m
+    k, b = _table_cell(out)
     if k >= out.shape[0]:
         return
     out[k, b] = values[k, b, i]
