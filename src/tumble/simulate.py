@@ -149,9 +149,12 @@ def simulate(
         model = _rigid_cuda.as_device_model(model, method)
     else:
         model = as_model(model)
-    if output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies):
-        raise ValidationError(f"output: 'device' keeps the results of rigid bodies on the GPU; a {model.kind}'s "
-                              "outputs are made on the host: use output='host'")
+    # rigid bodies make their outputs on the GPU; a model with its attitude in its state, its q and omega there
+    deferred = output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies)
+    if deferred and not model.attitude_in_state:
+        raise ValidationError(f"output: 'device' keeps on the GPU the results of rigid bodies and the q and omega of "
+                              f"the models whose attitude is their state's (docs/gpu.md); a {model.kind}'s outputs "
+                              "are made on the host: use output='host'")
     times = output_times(t)
     if omega0 is not None:
         initial_state["omega0"] = omega0
@@ -184,6 +187,8 @@ def simulate(
             if progress is not None:
                 raise ValidationError("progress: device='cuda' reports no progress; got a progress callback")
         y0 = model.initial_states(kernel, values, float(times[0]))
+        if deferred:
+            y0 = _cuda.on_device(y0)  # the states stay on the GPU
         grid, kept = _with_step_ends(times, model.step_ends(times, options.get("dt")))
         _check_memory(grid.size, y0)
         try:
@@ -191,11 +196,26 @@ def simulate(
                                        overwrite_y0=True, **options)
         except integrate.Diverged as diverged:
             raise _divergence(model, kernel, grid, diverged) from None
-        out = model.outputs(kernel, times, solution.states if kept is None else solution.states[kept])
+        states = solution.states if kept is None else solution.states[kept]
+        if deferred:
+            from tumble.integrate import _cuda_outputs
+
+            q, omega = _cuda_outputs.attitude_and_rate(kernel, states)
+            out = Outputs(q=q, omega=omega, inertia=None, extras={}, totals={}, info={})
+        else:
+            out = model.outputs(kernel, times, states)
         if output == "host" and device == "cuda":
             out = _rigid_cuda.to_host(out)
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
+    if deferred:
+        def host() -> Trajectory:
+            """The whole trajectory, its outputs made on the host from the states copied back."""
+            states_on_host = states.copy_to_host()
+            whole = model.outputs(kernel, times, states_on_host)
+            return _trajectory(model, m.name, times, whole, {**whole.info, **info}, single=n is None)
+
+        return _trajectory(model, m.name, times, out, info, single=n is None, host=host)
     return _trajectory(model, m.name, times, out, info, single=n is None)
 
 
@@ -329,8 +349,10 @@ def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str
     return out
 
 
-def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool) -> Trajectory:
-    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run.
+def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool,
+                host: Callable[[], Trajectory] | None = None) -> Trajectory:
+    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run; ``host``, for a run
+    whose ``q`` and ``omega`` alone are on the GPU, makes the whole trajectory on the host (``to_host()``).
 
     ``q`` and ``omega`` are checked finite here, once, and handed over without a copy when ``out`` owns
     them (fresh C-ordered float64 arrays, as the models' outputs are), copied otherwise (a view of the states
@@ -352,4 +374,4 @@ def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: di
               for name, e in out.extras.items()}
     totals = {name: value[:, 0] if single else value for name, value in out.totals.items()}
     return Trajectory._of_run(np.array(t), pick(out.q, "q"), pick(out.omega, "omega"), inertia, method, info,
-                              extras, totals, model.kind)
+                              extras, totals, model.kind, host=host)
