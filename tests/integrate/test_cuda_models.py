@@ -37,6 +37,7 @@ TARGET = [np.cos(0.2), 0.0, np.sin(0.2), 0.0]
 T = np.array([0.0, 0.02, 0.06, 0.12])  # 2, 4 and 6 steps of DT (a sampled controller needs whole steps)
 DT = 0.01
 OMEGA0 = np.array([[0.3, 1.0, -0.4], [-0.5, 0.2, 0.9]])  # two members, rad/s, body axes
+EPS = np.finfo(np.float64).eps
 TORQUE = torques.ConstantBody([0.05, -0.02, 0.1]) + torques.ConstantInertial([0.0, 0.03, -0.01])
 
 
@@ -130,6 +131,35 @@ def _run(device, name):
     return {**motion, **{k: traj.info[k] for k in ("n_steps", "n_rhs")}}
 
 
+#: The cases whose model keeps its attitude in its state (``Model.attitude_in_state``): with ``output="device"``
+#: their ``q`` and ``omega`` are made on the GPU, the rest on the host by ``to_host()``.
+LEFT_ON_THE_GPU = [name for name, (model, *_) in cases().items()
+                   if not isinstance(model, list) and as_model(model).attitude_in_state]
+
+#: The body rate on the GPU is the kernel's (``body_rate``): a slice of the state, but for these, where the host
+#: computes ``ω = W [K; P]`` with NumPy's ``@`` and ``ω = I(t)⁻¹ (L_B − A)`` with ``numpy.linalg.solve``, the
+#: kernel by sums in order and Cramer's rule (tumble.kernels.variable.angular_rate).
+RATES_BY_OTHER_SUMS = {"fluid, cf4", "variable inertia, rk4", "variable inertia, cf4", "moving human, rk4",
+                       "moving human, cf4"}
+
+
+def _left_on_the_gpu(name):
+    """``simulate(..., output="device")`` of case ``name``: its ``q`` and ``omega`` as the GPU holds them, and its
+    whole trajectory copied back (``to_host()``): ``q``, ``omega``, the totals and every extra, by name."""
+    model, method, torque, state = cases()[name]
+    traj = tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, device="cuda", output="device",
+                           **state)
+    assert traj.on_device and traj.rest_on_host
+    host = traj.to_host()
+    return {"device q": traj.q.copy_to_host(), "device omega": traj.omega.copy_to_host(), **_fields(host)}
+
+
+def _fields(traj):
+    """A trajectory's sampled arrays by name: ``q``, ``omega``, ``energy``, ``momentum_body`` and each extra."""
+    return {"q": traj.q, "omega": traj.omega, "energy": traj.energy, "momentum_body": traj.momentum_body,
+            **{f"extra {name}": e.data for name, e in traj.extras.items()}}
+
+
 # In the child, with the simulator on: each case's GPU run into one .npz.
 _CHILD = """
 import os
@@ -142,6 +172,9 @@ out = {}
 for i, name in enumerate(module["cases"]()):
     for key, value in module["_run"]("cuda", name).items():
         out[f"{i}/{key}"] = value
+    if name in module["LEFT_ON_THE_GPU"]:
+        for key, value in module["_left_on_the_gpu"](name).items():
+            out[f"{i}/left/{key}"] = value
 np.savez(sys.argv[2], **out)
 """
 
@@ -154,7 +187,7 @@ def simulated(tmp_path_factory):
     env["PYTHONPATH"] = os.pathsep.join([str(Path(tumble.__file__).parents[1]), env.get("PYTHONPATH", "")])
     subprocess.run([sys.executable, "-c", _CHILD, __file__, str(out)], env=env, check=True, timeout=900)
     with np.load(out) as runs:
-        return {name: {key: runs[f"{i}/{key}"] for key in ("q", "omega", "n_steps", "n_rhs")}
+        return {name: {key.removeprefix(f"{i}/"): runs[key] for key in runs.files if key.startswith(f"{i}/")}
                 for i, name in enumerate(cases())}
 
 
@@ -169,6 +202,33 @@ def test_simulated_gpu_equals_cpu(simulated, name):
     # the members differ, and they moved: the comparison sees each one's own path
     assert np.abs(cpu["omega"][-1, 0] - cpu["omega"][-1, 1]).max() > 1e-2
     assert np.abs(cpu["omega"][-1] - cpu["omega"][0]).max() > 1e-4
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", LEFT_ON_THE_GPU)
+def test_results_left_on_the_gpu_equal_the_cpus(simulated, name):
+    # output="device": q and omega made on the GPU; to_host() gives the CPU's whole trajectory, bit for bit
+    left = {key.removeprefix("left/"): value for key, value in simulated[name].items() if key.startswith("left/")}
+    model, method, torque, state = cases()[name]
+    cpu = _fields(tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, **state))
+    assert {key for key in left if not key.startswith("device ")} == set(cpu)
+    for key, value in cpu.items():
+        np.testing.assert_array_equal(left[key], value, err_msg=key)
+    np.testing.assert_array_equal(left["device q"], cpu["q"])
+    if name in RATES_BY_OTHER_SUMS:  # the same rate by other sums: a few units in the last place
+        scale = np.abs(cpu["omega"]).max()
+        np.testing.assert_allclose(left["device omega"], cpu["omega"], rtol=0, atol=8 * EPS * scale)
+    else:  # a slice of the state
+        np.testing.assert_array_equal(left["device omega"], cpu["omega"])
+
+
+def test_output_device_is_refused_for_a_model_whose_attitude_is_not_its_state():
+    chain = robot.load(tumble.examples.directory() / "robots/planar_2link.toml")
+    with pytest.raises(tumble.ValidationError, match=r"^output: 'device' keeps on the GPU the results of rigid "
+                                                     r"bodies and the q and omega of the models whose attitude is "
+                                                     r"their state's \(docs/gpu.md\); a SerialChain's outputs are "
+                                                     r"made on the host: use output='host'$"):
+        tumble.simulate(chain, q0=[0.3, -0.5], t=T, method="rk4", dt=DT, device="cuda", output="device")
 
 
 @pytest.mark.parametrize(("make", "message"), [
