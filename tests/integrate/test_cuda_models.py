@@ -303,3 +303,22 @@ def _state_size(kernel):
     from tumble._protocol import state_size
 
     return njit(lambda k: state_size(k))(kernel)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.parametrize("name", ["flexible, rk4", "fluid, cf4", "variable inertia, rk4"])
+def test_attitude_and_rate_kernel_compiles_for_a_gpu(monkeypatch, name):
+    """The kernel that makes q and omega of states left on the GPU (tumble.integrate._cuda_outputs) types and
+    compiles for sm_90 with the kind's body_rate: a slice, sums of the state, Cramer's rule on a spline."""
+    from numba import typeof
+
+    from tumble.integrate import _cuda_outputs
+
+    model, method, torque, state = cases()[name]
+    kernel = as_model(model).compile(torque, 0.0)
+    n = _state_size(kernel)
+    signature = tuple(typeof(a) for a in (kernel, np.zeros((4, 2, n)), np.zeros((4, 2, 4)), np.zeros((4, 2, 3))))
+    ptx = compile_ptx(monkeypatch, _cuda_outputs._attitude_and_rate_kernel, signature)
+    assert ptx.count(".entry") == 1
+    assert "malloc" not in ptx
