@@ -81,6 +81,7 @@ def cases():
     added_mass = np.diag([5.0, 8.0, 12.0, 1.0, 1.5, 2.0])
     added_mass[0, 4] = added_mass[4, 0] = 0.8  # surge–pitch coupling: B ≠ 0
     fluid = KirchhoffBody(tumble.RigidBody(INERTIA, mass=10.0), added_mass)
+    oblate = AxisymmetricBody(tumble.RigidBody(np.diag([8.0, 8.0, 12.0])))  # kg·m², body axes
     wheel_speeds = {"wheel_speeds0": [[10.0, -5.0, 3.0, 0.0], [0.0, 20.0, -8.0, 4.0]]}
     diver = Human.de_leva().moving({"left_shoulder_abduction": Motion(np.pi, [(0.0, 1.0, 0.0)])}, t_span=(0.0, 1.0))
     gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
@@ -96,6 +97,8 @@ def cases():
         "spacecraft: wheels, MRP feedback, flexible modes, rk4": (flexible_craft, "rk4", TORQUE,
                                                                   {**wheel_speeds, "eta0": [[0.1, -0.05], [0.0, 0.2]]}),
         "rigid, one body each, cf4": (rigid, "cf4", TORQUE, {}),
+        # the frame does not spin with the body, whose attitude is no state: rk4 only (cf4 needs a body rate)
+        "axisymmetric body in a non-spinning frame, rk4": (oblate, "rk4", TORQUE, {}),
         "variable inertia, rk4": (growing_body(), "rk4", TORQUE, {}),
         "variable inertia, cf4": (growing_body(), "cf4", None, {}),
         "moving human, rk4": (diver, "rk4", None, {}),
@@ -258,11 +261,23 @@ def test_a_robot_under_a_python_torque_law_is_refused_naming_torque():
         tumble.simulate(chain, q0=[0.3, -0.5], t=T, method="rk4", dt=DT, torque=lambda t, q, qd: -qd, device="cuda")
 
 
-def test_a_model_kind_without_a_device_path_is_refused_naming_device():
-    body = AxisymmetricBody(tumble.RigidBody(np.diag([1.0, 1.0, 2.0])))
-    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a AxisymmetricBody: its compiled "
+def test_a_compiled_model_without_a_device_path_is_refused_naming_device():
+    # every model kind of simulate runs on a GPU; the heavy top's tangent equations (tumble.measure) do not
+    from tumble.integrate import _cuda
+    from tumble.kernels.tangent import TangentModel
+
+    kernel = TangentModel(np.ones(3), np.array([0.0, 0.0, 1.0]), 1)
+    assert "cuda" not in kernel.provides
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a TangentModel: its compiled "
                                                      r"model does not run on a GPU$"):
-        tumble.simulate(body, OMEGA0[0], t=T, method="rk4", dt=DT, device="cuda")
+        _cuda.check(kernel, "rk4", "a TangentModel")
+
+
+def test_an_axisymmetric_body_under_a_python_torque_is_refused_on_a_gpu_naming_torque():
+    body = AxisymmetricBody(tumble.RigidBody(np.diag([8.0, 8.0, 12.0])))
+    with pytest.raises(tumble.ValidationError, match=r"^torque: a Python function cannot run on the GPU "
+                                                     r"\(device='cuda'\)"):
+        tumble.simulate(body, OMEGA0[0], t=T, method="rk4", dt=DT, torque=lambda t, q, w: -w, device="cuda")
 
 
 def test_methods_without_a_device_kernel_are_refused():
@@ -278,7 +293,8 @@ def test_methods_without_a_device_kernel_are_refused():
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "fluid, cf4", "spacecraft: wheels, MRP feedback, rk4",
                                   "rigid, one body each, cf4", "robot: planar two-link chain, rk4",
-                                  "variable inertia, rk4", "moving human, cf4", "gimbaled gyro, rk4"])
+                                  "variable inertia, rk4", "moving human, cf4", "gimbaled gyro, rk4",
+                                  "axisymmetric body in a non-spinning frame, rk4"])
 def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""
     from numba import typeof
