@@ -116,9 +116,11 @@ def simulate(
         (compiled torques and laws; ``docs/gpu.md``). Rigid bodies are set up there too: the principal
         axes of a batch of inertia tensors (N, 3, 3), which may be a device array, and the changes of axes.
     output : {"host", "device"}
-        ``"device"`` (with ``device="cuda"``, rigid bodies): the Trajectory's ``q``, ``omega`` and
-        ``inertia`` stay on the GPU as device arrays (``__cuda_array_interface__``: CuPy and DLPack
-        consumers take them without a copy); ``traj.to_host()`` or ``np.asarray`` copies them back.
+        ``"device"`` (with ``device="cuda"``): the Trajectory's ``q`` and ``omega`` (and a rigid body's
+        ``inertia``) stay on the GPU as device arrays (``__cuda_array_interface__``: CuPy and DLPack
+        consumers take them without a copy); ``traj.to_host()`` copies them back. For a spacecraft, a
+        flexible, slosh, fluid or variable body (``Model.attitude_in_state``) the other outputs are made on
+        the host by ``to_host()``, from the states kept on the GPU; other models are refused (docs/gpu.md).
     store : path of a Zarr store, optional
         Deprecated (to be removed in 0.5): use
         :func:`tumble.sweeps.simulate_to_store`, which this then calls and
@@ -149,7 +151,8 @@ def simulate(
         model = _rigid_cuda.as_device_model(model, method)
     else:
         model = as_model(model)
-    # rigid bodies make their outputs on the GPU; a model with its attitude in its state, its q and omega there
+    # output="device": rigid bodies' outputs are made on the GPU; a model whose attitude is its state's has its
+    # q and omega made there, the rest on the host by Trajectory.to_host()
     deferred = output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies)
     if deferred and not model.attitude_in_state:
         raise ValidationError(f"output: 'device' keeps on the GPU the results of rigid bodies and the q and omega of "
@@ -196,7 +199,7 @@ def simulate(
                                        overwrite_y0=True, **options)
         except integrate.Diverged as diverged:
             raise _divergence(model, kernel, grid, diverged) from None
-        states = solution.states if kept is None else solution.states[kept]
+        states: Any = solution.states if kept is None else solution.states[kept]  # on the GPU where deferred
         if deferred:
             from tumble.integrate import _cuda_outputs
 
