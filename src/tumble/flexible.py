@@ -174,6 +174,8 @@ class FlexibleBody(Model):
 
     # -- the model interface (tumble.simulate.Model) ----------------------------------
 
+    attitude_in_state = True  # q = Y[0:4], omega = body_rate: made on the GPU with output="device"
+
     def state_fields(self) -> tuple[StateField, ...]:
         m = len(self.modes)
         return (

@@ -183,6 +183,8 @@ class KirchhoffBody(Model):
 
     # -- the model interface (tumble.simulate.Model) ----------------------------------
 
+    attitude_in_state = True  # q = Y[0:4], omega = body_rate: made on the GPU with output="device"
+
     def state_fields(self) -> tuple[StateField, ...]:
         return (
             StateField("omega0", 3, "initial angular velocity, rad/s, body axes"),

@@ -125,6 +125,12 @@ class Model(abc.ABC):
 
     torque: str | None = "external torque on the body, body axes (N·m): a tumble.torques model or f(t, q, omega)"
 
+    #: Whether the trajectory's ``q`` is the state's quaternion ``Y[0:4]`` (body → inertial) and its ``omega``
+    #: the kernel's ``body_rate`` (:mod:`tumble._protocol`): then both are made on the GPU from states left
+    #: there (``simulate(..., output="device")``, :mod:`tumble.integrate._cuda_outputs`), the other outputs on
+    #: the host when the trajectory is copied back (:meth:`tumble.Trajectory.to_host`).
+    attitude_in_state: bool = False
+
     @property
     def kind(self) -> str:
         """The name of the model kind, as a :class:`~tumble.Trajectory` (``traj.model``), its file and the

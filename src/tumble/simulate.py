@@ -116,9 +116,11 @@ def simulate(
         (compiled torques and laws; ``docs/gpu.md``). Rigid bodies are set up there too: the principal
         axes of a batch of inertia tensors (N, 3, 3), which may be a device array, and the changes of axes.
     output : {"host", "device"}
-        ``"device"`` (with ``device="cuda"``, rigid bodies): the Trajectory's ``q``, ``omega`` and
-        ``inertia`` stay on the GPU as device arrays (``__cuda_array_interface__``: CuPy and DLPack
-        consumers take them without a copy); ``traj.to_host()`` or ``np.asarray`` copies them back.
+        ``"device"`` (with ``device="cuda"``): the Trajectory's ``q`` and ``omega`` (and a rigid body's
+        ``inertia``) stay on the GPU as device arrays (``__cuda_array_interface__``: CuPy and DLPack
+        consumers take them without a copy); ``traj.to_host()`` copies them back. For a spacecraft, a
+        flexible, slosh, fluid or variable body (``Model.attitude_in_state``) the other outputs are made on
+        the host by ``to_host()``, from the states kept on the GPU; other models are refused (docs/gpu.md).
     store : path of a Zarr store, optional
         Deprecated (to be removed in 0.5): use
         :func:`tumble.sweeps.simulate_to_store`, which this then calls and
@@ -149,9 +151,13 @@ def simulate(
         model = _rigid_cuda.as_device_model(model, method)
     else:
         model = as_model(model)
-    if output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies):
-        raise ValidationError(f"output: 'device' keeps the results of rigid bodies on the GPU; a {model.kind}'s "
-                              "outputs are made on the host: use output='host'")
+    # output="device": rigid bodies' outputs are made on the GPU; a model whose attitude is its state's has its
+    # q and omega made there, the rest on the host by Trajectory.to_host()
+    deferred = output == "device" and not isinstance(model, _rigid_cuda.DeviceRigidBodies)
+    if deferred and not model.attitude_in_state:
+        raise ValidationError(f"output: 'device' keeps on the GPU the results of rigid bodies and the q and omega of "
+                              f"the models whose attitude is their state's (docs/gpu.md); a {model.kind}'s outputs "
+                              "are made on the host: use output='host'")
     times = output_times(t)
     if omega0 is not None:
         initial_state["omega0"] = omega0
@@ -184,6 +190,8 @@ def simulate(
             if progress is not None:
                 raise ValidationError("progress: device='cuda' reports no progress; got a progress callback")
         y0 = model.initial_states(kernel, values, float(times[0]))
+        if deferred:
+            y0 = _cuda.on_device(y0)  # the states stay on the GPU
         grid, kept = _with_step_ends(times, model.step_ends(times, options.get("dt")))
         _check_memory(grid.size, y0)
         try:
@@ -191,11 +199,26 @@ def simulate(
                                        overwrite_y0=True, **options)
         except integrate.Diverged as diverged:
             raise _divergence(model, kernel, grid, diverged) from None
-        out = model.outputs(kernel, times, solution.states if kept is None else solution.states[kept])
+        states: Any = solution.states if kept is None else solution.states[kept]  # on the GPU where deferred
+        if deferred:
+            from tumble.integrate import _cuda_outputs
+
+            q, omega = _cuda_outputs.attitude_and_rate(kernel, states)
+            out = Outputs(q=q, omega=omega, inertia=None, extras={}, totals={}, info={})
+        else:
+            out = model.outputs(kernel, times, states)
         if output == "host" and device == "cuda":
             out = _rigid_cuda.to_host(out)
     info = {**out.info, "torque": _describe(torque), **solution.statistics(), **options}
     info.pop("max_steps", None)
+    if deferred:
+        def host() -> Trajectory:
+            """The whole trajectory, its outputs made on the host from the states copied back."""
+            states_on_host = states.copy_to_host()
+            whole = model.outputs(kernel, times, states_on_host)
+            return _trajectory(model, m.name, times, whole, {**whole.info, **info}, single=n is None)
+
+        return _trajectory(model, m.name, times, out, info, single=n is None, host=host)
     return _trajectory(model, m.name, times, out, info, single=n is None)
 
 
@@ -329,8 +352,10 @@ def _broadcast(arrays: dict[str, np.ndarray], sizes: dict[str, int]) -> dict[str
     return out
 
 
-def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool) -> Trajectory:
-    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run.
+def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: dict, *, single: bool,
+                host: Callable[[], Trajectory] | None = None) -> Trajectory:
+    """The :class:`~tumble.Trajectory` of ``out``, without the member axis for a single run; ``host``, for a run
+    whose ``q`` and ``omega`` alone are on the GPU, makes the whole trajectory on the host (``to_host()``).
 
     ``q`` and ``omega`` are checked finite here, once, and handed over without a copy when ``out`` owns
     them (fresh C-ordered float64 arrays, as the models' outputs are), copied otherwise (a view of the states
@@ -352,4 +377,4 @@ def _trajectory(model: Model, method: str, t: np.ndarray, out: Outputs, info: di
               for name, e in out.extras.items()}
     totals = {name: value[:, 0] if single else value for name, value in out.totals.items()}
     return Trajectory._of_run(np.array(t), pick(out.q, "q"), pick(out.omega, "omega"), inertia, method, info,
-                              extras, totals, model.kind)
+                              extras, totals, model.kind, host=host)

@@ -141,6 +141,8 @@ class SloshBody(Model):
 
     # -- the model interface (tumble.simulate.Model) ----------------------------------
 
+    attitude_in_state = True  # q = Y[0:4], omega = body_rate: made on the GPU with output="device"
+
     def state_fields(self) -> tuple[StateField, ...]:
         return (
             StateField("omega0", 3, "initial hub rate, rad/s, body axes"),

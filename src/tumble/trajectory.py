@@ -259,14 +259,18 @@ class Trajectory:
 
     @classmethod
     def _of_run(cls, t: np.ndarray, q: np.ndarray | None, omega: np.ndarray | None, inertia: np.ndarray | None,
-                method: str, info: dict, extras: dict, totals: dict, model: str) -> Trajectory:
+                method: str, info: dict, extras: dict, totals: dict, model: str,
+                host: Callable[[], Trajectory] | None = None) -> Trajectory:
         """The trajectory of a run of :func:`tumble.simulate`, whose ``t``, ``q`` and ``omega`` were checked
         there: ``t`` (n,) strictly increasing and finite, ``q`` (n, [N,] 4) and ``omega`` (n, [N,] 3) finite
         float64 of the shapes of a run, arrays the caller owns and hands over. They are marked
         read-only, not copied nor checked again; ``inertia`` is shared when read-only (a model's own), copied
         otherwise; ``info``, ``extras`` and ``totals`` are checked as by the constructor. ``q``, ``omega`` and
-        ``inertia`` may be device arrays (``simulate(..., output="device")``), kept as they are."""
+        ``inertia`` may be device arrays (``simulate(..., output="device")``), kept as they are; ``host``, for
+        such a run of a model whose other outputs are made on the host, makes the whole trajectory there
+        (:meth:`to_host`)."""
         self = object.__new__(cls)
+        self.__dict__["_host"] = host
         if isinstance(inertia, np.ndarray) and inertia.flags.writeable:
             inertia = np.array(inertia, dtype=np.float64)
         for name, value in (("t", t), ("q", q), ("omega", omega), ("inertia", inertia)):  # device arrays as given
@@ -284,10 +288,22 @@ class Trajectory:
         without a copy). The invariants, views and files read host arrays: :meth:`to_host` first."""
         return self.q is not None and not isinstance(self.q, np.ndarray)
 
+    @property
+    def rest_on_host(self) -> bool:
+        """Whether this device trajectory holds ``q`` and ``omega`` alone, of a model whose other outputs (its
+        extras, inertia, and the system's energy and momentum) are made on the host by :meth:`to_host` from
+        the states left on the GPU (``simulate(..., output="device")`` of a spacecraft, a flexible body, ...:
+        docs/gpu.md)."""
+        return self.__dict__.get("_host") is not None
+
     def to_host(self) -> Trajectory:
-        """This trajectory with its device arrays copied to the host (itself when they are there already)."""
+        """This trajectory with its device arrays copied to the host (itself when they are there already); for
+        one whose other outputs are made on the host (:attr:`rest_on_host`), the whole trajectory, made there
+        from its states copied back: the trajectory of the same run with ``output="host"``."""
         if not self.on_device:
             return self
+        if self.rest_on_host:
+            return self.__dict__["_host"]()
 
         def host(a):
             return a.copy_to_host() if hasattr(a, "copy_to_host") else np.array(a, dtype=np.float64)
@@ -300,6 +316,9 @@ class Trajectory:
         extras = self.__dict__.get("extras", {})
         if name in extras:
             return extras[name].data
+        if self.__dict__.get("_host") is not None and not name.startswith("_"):
+            raise AttributeError(f"{name}: this trajectory holds q and omega on the GPU; its other outputs are made "
+                                 "on the host: traj.to_host()." + name)
         raise AttributeError(f"{type(self).__name__!r} has no attribute {name!r}"
                              + (f" (extras: {', '.join(extras)})" if extras else ""))
 

@@ -37,6 +37,7 @@ TARGET = [np.cos(0.2), 0.0, np.sin(0.2), 0.0]
 T = np.array([0.0, 0.02, 0.06, 0.12])  # 2, 4 and 6 steps of DT (a sampled controller needs whole steps)
 DT = 0.01
 OMEGA0 = np.array([[0.3, 1.0, -0.4], [-0.5, 0.2, 0.9]])  # two members, rad/s, body axes
+EPS = np.finfo(np.float64).eps
 TORQUE = torques.ConstantBody([0.05, -0.02, 0.1]) + torques.ConstantInertial([0.0, 0.03, -0.01])
 
 
@@ -80,6 +81,7 @@ def cases():
     added_mass = np.diag([5.0, 8.0, 12.0, 1.0, 1.5, 2.0])
     added_mass[0, 4] = added_mass[4, 0] = 0.8  # surge–pitch coupling: B ≠ 0
     fluid = KirchhoffBody(tumble.RigidBody(INERTIA, mass=10.0), added_mass)
+    oblate = AxisymmetricBody(tumble.RigidBody(np.diag([8.0, 8.0, 12.0])))  # kg·m², body axes
     wheel_speeds = {"wheel_speeds0": [[10.0, -5.0, 3.0, 0.0], [0.0, 20.0, -8.0, 4.0]]}
     diver = Human.de_leva().moving({"left_shoulder_abduction": Motion(np.pi, [(0.0, 1.0, 0.0)])}, t_span=(0.0, 1.0))
     gyro = GimbaledGyro(spin_inertia=2e-3, transverse_inertia=1.5e-3, inner_gimbal=(4e-4, 5e-4, 3e-4),
@@ -95,6 +97,8 @@ def cases():
         "spacecraft: wheels, MRP feedback, flexible modes, rk4": (flexible_craft, "rk4", TORQUE,
                                                                   {**wheel_speeds, "eta0": [[0.1, -0.05], [0.0, 0.2]]}),
         "rigid, one body each, cf4": (rigid, "cf4", TORQUE, {}),
+        # the frame does not spin with the body, whose attitude is no state: rk4 only (cf4 needs a body rate)
+        "axisymmetric body in a non-spinning frame, rk4": (oblate, "rk4", TORQUE, {}),
         "variable inertia, rk4": (growing_body(), "rk4", TORQUE, {}),
         "variable inertia, cf4": (growing_body(), "cf4", None, {}),
         "moving human, rk4": (diver, "rk4", None, {}),
@@ -130,6 +134,35 @@ def _run(device, name):
     return {**motion, **{k: traj.info[k] for k in ("n_steps", "n_rhs")}}
 
 
+#: The cases whose model keeps its attitude in its state (``Model.attitude_in_state``): with ``output="device"``
+#: their ``q`` and ``omega`` are made on the GPU, the rest on the host by ``to_host()``.
+LEFT_ON_THE_GPU = [name for name, (model, *_) in cases().items()
+                   if not isinstance(model, list) and as_model(model).attitude_in_state]
+
+#: The body rate on the GPU is the kernel's (``body_rate``): a slice of the state, but for these, where the host
+#: computes ``ω = W [K; P]`` with NumPy's ``@`` and ``ω = I(t)⁻¹ (L_B − A)`` with ``numpy.linalg.solve``, the
+#: kernel by sums in order and Cramer's rule (tumble.kernels.variable.angular_rate).
+RATES_BY_OTHER_SUMS = {"fluid, cf4", "variable inertia, rk4", "variable inertia, cf4", "moving human, rk4",
+                       "moving human, cf4"}
+
+
+def _left_on_the_gpu(name):
+    """``simulate(..., output="device")`` of case ``name``: its ``q`` and ``omega`` as the GPU holds them, and its
+    whole trajectory copied back (``to_host()``): ``q``, ``omega``, the totals and every extra, by name."""
+    model, method, torque, state = cases()[name]
+    traj = tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, device="cuda", output="device",
+                           **state)
+    assert traj.on_device and traj.rest_on_host
+    host = traj.to_host()
+    return {"device q": traj.q.copy_to_host(), "device omega": traj.omega.copy_to_host(), **_fields(host)}
+
+
+def _fields(traj):
+    """A trajectory's sampled arrays by name: ``q``, ``omega``, ``energy``, ``momentum_body`` and each extra."""
+    return {"q": traj.q, "omega": traj.omega, "energy": traj.energy, "momentum_body": traj.momentum_body,
+            **{f"extra {name}": e.data for name, e in traj.extras.items()}}
+
+
 # In the child, with the simulator on: each case's GPU run into one .npz.
 _CHILD = """
 import os
@@ -142,6 +175,9 @@ out = {}
 for i, name in enumerate(module["cases"]()):
     for key, value in module["_run"]("cuda", name).items():
         out[f"{i}/{key}"] = value
+    if name in module["LEFT_ON_THE_GPU"]:
+        for key, value in module["_left_on_the_gpu"](name).items():
+            out[f"{i}/left/{key}"] = value
 np.savez(sys.argv[2], **out)
 """
 
@@ -154,7 +190,7 @@ def simulated(tmp_path_factory):
     env["PYTHONPATH"] = os.pathsep.join([str(Path(tumble.__file__).parents[1]), env.get("PYTHONPATH", "")])
     subprocess.run([sys.executable, "-c", _CHILD, __file__, str(out)], env=env, check=True, timeout=900)
     with np.load(out) as runs:
-        return {name: {key: runs[f"{i}/{key}"] for key in ("q", "omega", "n_steps", "n_rhs")}
+        return {name: {key.removeprefix(f"{i}/"): runs[key] for key in runs.files if key.startswith(f"{i}/")}
                 for i, name in enumerate(cases())}
 
 
@@ -169,6 +205,33 @@ def test_simulated_gpu_equals_cpu(simulated, name):
     # the members differ, and they moved: the comparison sees each one's own path
     assert np.abs(cpu["omega"][-1, 0] - cpu["omega"][-1, 1]).max() > 1e-2
     assert np.abs(cpu["omega"][-1] - cpu["omega"][0]).max() > 1e-4
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", LEFT_ON_THE_GPU)
+def test_results_left_on_the_gpu_equal_the_cpus(simulated, name):
+    # output="device": q and omega made on the GPU; to_host() gives the CPU's whole trajectory, bit for bit
+    left = {key.removeprefix("left/"): value for key, value in simulated[name].items() if key.startswith("left/")}
+    model, method, torque, state = cases()[name]
+    cpu = _fields(tumble.simulate(model, OMEGA0, t=T, method=method, dt=DT, torque=torque, **state))
+    assert {key for key in left if not key.startswith("device ")} == set(cpu)
+    for key, value in cpu.items():
+        np.testing.assert_array_equal(left[key], value, err_msg=key)
+    np.testing.assert_array_equal(left["device q"], cpu["q"])
+    if name in RATES_BY_OTHER_SUMS:  # the same rate by other sums: a few units in the last place
+        scale = np.abs(cpu["omega"]).max()
+        np.testing.assert_allclose(left["device omega"], cpu["omega"], rtol=0, atol=8 * EPS * scale)
+    else:  # a slice of the state
+        np.testing.assert_array_equal(left["device omega"], cpu["omega"])
+
+
+def test_output_device_is_refused_for_a_model_whose_attitude_is_not_its_state():
+    chain = robot.load(tumble.examples.directory() / "robots/planar_2link.toml")
+    with pytest.raises(tumble.ValidationError, match=r"^output: 'device' keeps on the GPU the results of rigid "
+                                                     r"bodies and the q and omega of the models whose attitude is "
+                                                     r"their state's \(docs/gpu.md\); a SerialChain's outputs are "
+                                                     r"made on the host: use output='host'$"):
+        tumble.simulate(chain, q0=[0.3, -0.5], t=T, method="rk4", dt=DT, device="cuda", output="device")
 
 
 @pytest.mark.parametrize(("make", "message"), [
@@ -198,11 +261,23 @@ def test_a_robot_under_a_python_torque_law_is_refused_naming_torque():
         tumble.simulate(chain, q0=[0.3, -0.5], t=T, method="rk4", dt=DT, torque=lambda t, q, qd: -qd, device="cuda")
 
 
-def test_a_model_kind_without_a_device_path_is_refused_naming_device():
-    body = AxisymmetricBody(tumble.RigidBody(np.diag([1.0, 1.0, 2.0])))
-    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a AxisymmetricBody: its compiled "
+def test_a_compiled_model_without_a_device_path_is_refused_naming_device():
+    # every model kind of simulate runs on a GPU; the heavy top's tangent equations (tumble.measure) do not
+    from tumble.integrate import _cuda
+    from tumble.kernels.tangent import TangentModel
+
+    kernel = TangentModel(np.ones(3), np.array([0.0, 0.0, 1.0]), 1)
+    assert "cuda" not in kernel.provides
+    with pytest.raises(tumble.ValidationError, match=r"^device: 'cuda' cannot run a TangentModel: its compiled "
                                                      r"model does not run on a GPU$"):
-        tumble.simulate(body, OMEGA0[0], t=T, method="rk4", dt=DT, device="cuda")
+        _cuda.check(kernel, "rk4", "a TangentModel")
+
+
+def test_an_axisymmetric_body_under_a_python_torque_is_refused_on_a_gpu_naming_torque():
+    body = AxisymmetricBody(tumble.RigidBody(np.diag([8.0, 8.0, 12.0])))
+    with pytest.raises(tumble.ValidationError, match=r"^torque: a Python function cannot run on the GPU "
+                                                     r"\(device='cuda'\)"):
+        tumble.simulate(body, OMEGA0[0], t=T, method="rk4", dt=DT, torque=lambda t, q, w: -w, device="cuda")
 
 
 def test_methods_without_a_device_kernel_are_refused():
@@ -218,7 +293,8 @@ def test_methods_without_a_device_kernel_are_refused():
 @pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
 @pytest.mark.parametrize("name", ["flexible, rk4", "slosh, rk4", "fluid, cf4", "spacecraft: wheels, MRP feedback, rk4",
                                   "rigid, one body each, cf4", "robot: planar two-link chain, rk4",
-                                  "variable inertia, rk4", "moving human, cf4", "gimbaled gyro, rk4"])
+                                  "variable inertia, rk4", "moving human, cf4", "gimbaled gyro, rk4",
+                                  "axisymmetric body in a non-spinning frame, rk4"])
 def test_protocol_kernel_compiles_for_a_gpu(monkeypatch, name):
     """The protocol kernel of each kind types and compiles for sm_90: nothing in it calls Python or allocates."""
     from numba import typeof
@@ -243,3 +319,22 @@ def _state_size(kernel):
     from tumble._protocol import state_size
 
     return njit(lambda k: state_size(k))(kernel)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not nvvm_available(), reason="no NVVM (CUDA toolkit) to compile with")
+@pytest.mark.parametrize("name", ["flexible, rk4", "fluid, cf4", "variable inertia, rk4"])
+def test_attitude_and_rate_kernel_compiles_for_a_gpu(monkeypatch, name):
+    """The kernel that makes q and omega of states left on the GPU (tumble.integrate._cuda_outputs) types and
+    compiles for sm_90 with the kind's body_rate: a slice, sums of the state, Cramer's rule on a spline."""
+    from numba import typeof
+
+    from tumble.integrate import _cuda_outputs
+
+    model, method, torque, state = cases()[name]
+    kernel = as_model(model).compile(torque, 0.0)
+    n = _state_size(kernel)
+    signature = tuple(typeof(a) for a in (kernel, np.zeros((4, 2, n)), np.zeros((4, 2, 4)), np.zeros((4, 2, 3))))
+    ptx = compile_ptx(monkeypatch, _cuda_outputs._attitude_and_rate_kernel, signature)
+    assert ptx.count(".entry") == 1
+    assert "malloc" not in ptx

@@ -26,7 +26,6 @@ from helpers import compile_ptx, nvvm_available
 import tumble
 from tumble import attitude
 from tumble._inertia import principal_axes
-from tumble.spacecraft import MRPFeedback, Spacecraft, pyramid_wheels
 
 pytest.importorskip("numba.cuda")
 from tumble._rigid_cuda import BROKEN, THIN, principal_axes_of_one  # noqa: E402
@@ -102,11 +101,7 @@ def test_output_device_is_refused_where_it_cannot_be():
         tumble.simulate(body, [0.1, 1.0, 0.1], t=T, method="rk4", dt=DT, output="device")
     with pytest.raises(tumble.ValidationError, match=r"^output: must be 'host', or 'device'"):
         tumble.simulate(body, [0.1, 1.0, 0.1], t=T, method="rk4", dt=DT, device="cuda", output="gpu")
-    craft = Spacecraft(inertia=np.diag([10.0, 12.0, 8.0]), wheels=pyramid_wheels(0.02),
-                       controller=MRPFeedback(K=1.0, P=5.0))
-    with pytest.raises(tumble.ValidationError, match=r"^output: 'device' keeps the results of rigid bodies on the "
-                                                     r"GPU; a Spacecraft's outputs are made on the host"):
-        tumble.simulate(craft, [0.1, 0.0, 0.0], t=T, method="rk4", dt=DT, device="cuda", output="device")
+    # a model whose attitude is not its state's: tests/integrate/test_cuda_models.py
 
 
 # The simulated runs, in a child process: name -> arrays into one .npz.

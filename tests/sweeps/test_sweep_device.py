@@ -47,6 +47,30 @@ def _sweep_arguments():
                 percentiles=P, workers=0)
 
 
+def spacecraft():
+    """A spacecraft with four wheels in a pyramid and MRP feedback to a target attitude: the kind of the issue's
+    sweep of 10⁶ spacecraft."""
+    from tumble.spacecraft import MRPFeedback, Spacecraft, pyramid_wheels
+
+    return Spacecraft(inertia=np.diag([10.0, 12.0, 8.0]), wheels=pyramid_wheels(0.02),
+                      controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
+
+
+def spacecraft_sweeps():
+    """name -> the arguments of a sweep of 4 spacecraft (dispersed rates and wheel speeds, two chunks): with the
+    built-ins that read ``q`` and ``omega`` alone (evaluated on the GPU), and with one more that reads the
+    system's energy (wheels included: made on the host, from the chunk's states copied back)."""
+    on_the_gpu = dict(dispersions={"omega0": Normal([0.05, -0.02, 0.03], 0.02),
+                                   "wheel_speeds0": Normal([10.0, -5.0, 3.0, 0.0], 5.0)},
+                      samples=4, seed=3, chunk=2, t=T, method="rk4", dt=DT,
+                      statistics={"qw": Component("q", 0), "pointing_error": PointingError(TARGET)},
+                      outcomes={"pointing": Final(PointingError(TARGET)), "peak": Max(Component("omega", 2)),
+                                "settled": SettlingTime(PointingError(TARGET), below=0.2)},
+                      percentiles=P, workers=0)
+    energy = {**on_the_gpu, "outcomes": {**on_the_gpu["outcomes"], "energy": Final(Component("energy"))}}
+    return {"q and omega": on_the_gpu, "and the energy": energy}
+
+
 # The built-ins evaluated on a chunk's results on the GPU (tumble.sweeps.device), by name.
 TARGET = (np.cos(0.15), 0.0, np.sin(0.15), 0.0)
 SERIES = {
@@ -114,6 +138,14 @@ Trajectory.to_host = lambda traj: (copies.append(traj.on_device), to_host(traj))
 ds = sweep(module["tumble"].RigidBody(np.diag([1.0, 2.0, 2.5])), device="cuda", **module["_sweep_arguments"]())
 Trajectory.to_host = to_host
 out["sweep host copies"] = np.array(copies)
+for case, arguments in module["spacecraft_sweeps"]().items():
+    craft_copies = []
+    Trajectory.to_host = lambda traj: (craft_copies.append(traj.on_device), to_host(traj))[1]
+    crafts = sweep(module["spacecraft"](), device="cuda", **arguments)
+    Trajectory.to_host = to_host
+    out[f"{case} host copies"] = np.array(craft_copies, dtype=bool)
+    for variable in crafts.data_vars:
+        out[f"{case}/{variable}"] = crafts[variable].values
 for name in ds.data_vars:
     out["sweep/" + name] = ds[name].values
 for name, (on_gpu, on_host) in module["evaluated_on_the_device"]().items():
@@ -188,6 +220,25 @@ def test_the_sweep_on_the_device_writes_the_cpus_store(simulated):
     np.testing.assert_array_equal(gpu["sweep/wy_percentiles"], np.percentile(gpu["sweep/wy"], P, axis=0))
     np.testing.assert_array_equal(gpu["sweep/pointing_percentiles"], np.nanpercentile(gpu["sweep/pointing"], P))
     np.testing.assert_array_equal(gpu["sweep/pointing_count"], cpu["pointing_count"].values)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(spacecraft_sweeps()))
+def test_a_spacecraft_sweep_on_the_device_writes_the_cpus_store(simulated, name):
+    # q and ω stay on the GPU (the kernel's body rate: a slice of the state); the outcomes that read them are
+    # evaluated there, bit for bit the host's; what reads the system's energy copies the chunk back, once
+    _, gpu = simulated
+    cpu = sweep(spacecraft(), **spacecraft_sweeps()[name])
+    assert {key.removeprefix(f"{name}/") for key in gpu if key.startswith(f"{name}/")} == set(cpu.data_vars)
+    for variable in cpu.data_vars:
+        if variable.endswith(("_mean", "_std")):  # summed on the device in another order (the moments' test):
+            scale = np.abs(cpu[variable.rsplit("_", 1)[0]].values).max()  # to rounding of the values summed
+            np.testing.assert_allclose(gpu[f"{name}/{variable}"], cpu[variable].values, rtol=0, atol=4 * EPS * scale)
+        else:
+            np.testing.assert_array_equal(gpu[f"{name}/{variable}"], cpu[variable].values, err_msg=variable)
+    assert np.ptp(cpu["pointing"].values) > 1e-4 and np.ptp(cpu["peak"].values) > 1e-4  # the samples differ
+    # the chunks (of 2 samples) are copied to the host only for the energy, a total made there
+    assert gpu[f"{name} host copies"].tolist() == ([] if name == "q and omega" else [True, True])
 
 
 # What reads the angular momentum L = I ω sums its three terms in another order than NumPy's einsum, which the host

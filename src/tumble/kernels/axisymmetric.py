@@ -50,13 +50,19 @@ class FrameModel(NamedTuple):
 
     @property
     def provides(self) -> frozenset[str]:
-        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side."""
-        return frozenset({"rhs"})
+        """Capabilities (:data:`tumble._protocol.CAPABILITIES`): a right-hand side; ``"cuda"`` without a Python
+        torque function."""
+        return frozenset({"rhs", *(() if self.calls_python else ("cuda",))})
 
     @property
     def calls_python(self) -> bool:
         """True when the torque program calls a Python function (the batch then runs on one core)."""
         return torques.program_calls_python(self)
+
+    @property
+    def gpu_refusal(self) -> str | None:
+        """Why this kernel cannot run on an NVIDIA GPU (a ValidationError message), or None: a Python torque."""
+        return _protocol.python_on_gpu("torque") if self.calls_python else None
 
 
 def build(transverse: float, axial: float, frame_spin: float, axes: np.ndarray, torque) -> FrameModel:

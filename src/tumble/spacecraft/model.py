@@ -470,6 +470,8 @@ class Spacecraft(Model):
 
     # -- the model interface (tumble.simulate.Model) ---------------------------------------
 
+    attitude_in_state = True  # q = Y[0:4], omega = body_rate: made on the GPU with output="device"
+
     def state_fields(self) -> tuple[StateField, ...]:
         fields = [
             StateField("omega0", 3, "initial hub rate relative to inertial, rad/s, body axes"),

@@ -25,7 +25,9 @@ reduces its series and outcomes here when it writes the store
   ``γ ≥ 0.5``), ``γ = v − ⌊v⌋``, so no fused multiply–add enters.
 
 A chunk's own series and outcomes are evaluated here too, where its results
-stay on the GPU (a chunk of rigid bodies: ``simulate(..., output="device")``):
+stay on the GPU (``simulate(..., output="device")``: a chunk of rigid bodies,
+or the ``q`` and ``omega`` of a chunk of spacecraft, flexible, slosh, fluid or
+variable bodies):
 :func:`series` and :func:`outcome` evaluate the built-ins of
 :mod:`tumble.sweeps.outcomes` there, so that only their values (a series'
 table, an outcome's value per sample) come back, not the trajectories. They
@@ -33,7 +35,9 @@ return None for what the host evaluates, from a copy of the results: a Python
 function, a :class:`~tumble.sweeps.outcomes.Component` of another field than
 ``q``, ``omega``, ``momentum_body`` and ``energy``, or one whose ``index``
 (or a :class:`~tumble.sweeps.outcomes.Max` whose ``after``) the host refuses
-with its message.
+with its message, and what reads the angular momentum or the energy of a model
+other than a rigid body (a spacecraft's includes its wheels'): its totals are
+made on the host (:attr:`tumble.Trajectory.rest_on_host`).
 
 The device work is :mod:`tumble.integrate._cuda_reductions`'s; this module merges and interpolates on the
 host. Import it only when a GPU run is asked for: it imports ``numba.cuda``.
@@ -119,8 +123,11 @@ def _inertia(traj: Trajectory) -> Any:
 
 def _component(f: Component, traj: Trajectory) -> Any:
     """A :class:`Component` of ``q``, ``omega``, ``momentum_body`` (``I ω``) or ``energy`` (``½ ω·Iω``) as a
-    device table (n, m), or None: another field, or an ``index`` the host refuses."""
+    device table (n, m), or None: another field, an ``index`` the host refuses, or the momentum or energy
+    of a model whose own totals are made on the host (:attr:`~tumble.Trajectory.rest_on_host`)."""
     n, m = _samples(traj)
+    if f.name in ("energy", "momentum_body") and traj.rest_on_host:
+        return None
     if f.name == "energy":
         return series_table(energy_kernel, n, m, traj.omega, _inertia(traj)) if f.index == () else None
     size = {"q": 4, "omega": 3, "momentum_body": 3}.get(f.name)
@@ -138,7 +145,7 @@ def series(f: Any, traj: Trajectory) -> Any:
     n, m = _samples(traj)
     if isinstance(f, PointingError):
         return series_table(pointing_kernel, n, m, traj.q, *f.target)
-    if isinstance(f, NutationAngle):
+    if isinstance(f, NutationAngle) and not traj.rest_on_host:  # L = I ω: a rigid body's
         axis = np.asarray(f.axis)
         axis = axis / np.linalg.norm(axis)  # as nutation_angle normalises it
         return series_table(nutation_kernel, n, m, traj.omega, _inertia(traj), *axis)

@@ -160,7 +160,7 @@ class Plan:
     def simulate(self, inputs: Mapping[str, np.ndarray], output: str = "host") -> Trajectory:
         """The batched trajectory (axes (time, member, ...)) of the samples whose inputs are ``inputs``; with
         ``output="device"`` (and ``device="cuda"``), its results left on the GPU where :func:`tumble.simulate`
-        keeps them there (rigid bodies), on the host otherwise."""
+        keeps them there (rigid bodies; the ``q`` and ``omega`` of a spacecraft, ...), on the host otherwise."""
         m = len(next(iter(inputs.values()))) if inputs else 0
         state = {**self.fixed, **{name: inputs[name].reshape(m, -1) for name in self.states}}
         parameters = {name: v for name, v in inputs.items() if name not in self.states}
@@ -267,14 +267,16 @@ def _describe_model(model) -> str:
 
 def _kept_on_device(model: Any, method: str, output: str) -> tuple[Any, str]:
     """``(model, output)`` for :func:`tumble.simulate`: with ``output="device"``, the model set up on the GPU
-    (:func:`tumble._rigid_cuda.as_device_model`) and ``"device"`` where its results stay there (rigid bodies),
-    ``"host"`` for any other model (its outputs are made on the host)."""
+    (:func:`tumble._rigid_cuda.as_device_model`) and ``"device"`` where its results stay there (rigid bodies,
+    and the ``q`` and ``omega`` of a model whose attitude is its state's: a spacecraft, ...), ``"host"`` for
+    any other model (its outputs are made on the host)."""
     if output != "device":
         return model, output
     from tumble import _rigid_cuda  # imports numba.cuda: only for a sweep on a GPU
 
     model = _rigid_cuda.as_device_model(model, method)
-    return model, "device" if isinstance(model, _rigid_cuda.DeviceRigidBodies) else "host"
+    kept = isinstance(model, _rigid_cuda.DeviceRigidBodies) or model.attitude_in_state
+    return model, "device" if kept else "host"
 
 
 def _evaluated(kind: str, f: Callable[[Trajectory], np.ndarray], traj: Trajectory,

@@ -199,6 +199,8 @@ class VariableBody(Model):
 
     # -- the model interface (tumble.simulate.Model) ----------------------------------
 
+    attitude_in_state = True  # q = Y[0:4], omega = body_rate: made on the GPU with output="device"
+
     def state_fields(self) -> tuple[StateField, ...]:
         return (
             StateField("omega0", 3, "initial angular velocity of the body frame B, rad/s, B axes"),
