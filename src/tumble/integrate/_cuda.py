@@ -270,8 +270,13 @@ def _advance(scheme, model, b, t0, h, m, y, work):
     Compiled for the GPU, the overload below; the CUDA simulator runs this body, the same compiled
     function on the CPU, on its stand-in arrays.
     """
-    _advance_host(scheme, type(model)(*(np.asarray(f) if hasattr(f, "__cuda_ndarray__") else f for f in model)),
-                  b, t0, h, m, np.asarray(y), tuple(np.asarray(w) for w in work))
+    _advance_host(scheme, simulated_on_host(model), b, t0, h, m, np.asarray(y), tuple(np.asarray(w) for w in work))
+
+
+def simulated_on_host(model):
+    """The compiled ``model`` with the CUDA simulator's stand-in device arrays as NumPy arrays, for the CPU's
+    compiled functions that the simulated kernels call."""
+    return type(model)(*(np.asarray(f) if hasattr(f, "__cuda_ndarray__") else f for f in model))
 
 
 @overload(_advance, target="cuda")

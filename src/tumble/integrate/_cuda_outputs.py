@@ -33,7 +33,7 @@ from numba import cuda, njit
 from numba.extending import overload
 
 from tumble import _protocol
-from tumble.integrate._cuda import _LAUNCH_OPTIONS, THREADS_PER_BLOCK, _to_device
+from tumble.integrate._cuda import _LAUNCH_OPTIONS, THREADS_PER_BLOCK, _to_device, simulated_on_host
 
 __all__ = ["attitude_and_rate"]
 
@@ -48,8 +48,7 @@ def _rate(model, y):
 
     Compiled for the GPU, the overload below; the CUDA simulator runs this body, the same compiled function
     on the CPU, on its stand-in arrays."""
-    return _rate_host(type(model)(*(np.asarray(f) if hasattr(f, "__cuda_ndarray__") else f for f in model)),
-                      np.asarray(y))
+    return _rate_host(simulated_on_host(model), np.asarray(y))
 
 
 @overload(_rate, target="cuda")
