@@ -12,12 +12,18 @@ body-steps per second of the CUDA kernel (``tumble.integrate._cuda``) for batche
    for the first of the same bodies, and the largest difference between the two;
 3. the same with ``output="device"`` and 11 output times (set-up, conversions and results left on the
    GPU, synchronised before the clock is read): the target of docs/gpu.md, ≥ 10¹⁰ body-steps/s at
-   N = 1e6 and 1000 steps.
+   N = 1e6 and 1000 steps;
+4. a Monte-Carlo sweep of spacecraft with four wheels and MRP feedback over 600 s (``tumble.sweeps.sweep``,
+   dispersed rates and wheel speeds, the final pointing error and the peak yaw rate with their percentiles),
+   ``device="cuda"`` end to end beside ``device="cpu"`` on every core for the first ``--sweep-cpu`` samples,
+   and the largest difference of their outcomes and percentiles on those samples: the target of docs/gpu.md,
+   10⁶ spacecraft in ≤ 30 s.
 
 Without a GPU it says so and exits 0. Run by hand (not a test)::
 
     python benchmarks/bench_gpu.py            # N = 1e6, 1e7; 1000 steps
     python benchmarks/bench_gpu.py --quick    # N = 1e6; 100 steps
+    python benchmarks/bench_gpu.py --sweep-only --sweep-samples 1000000   # section 4 alone
 """
 
 from __future__ import annotations
@@ -40,6 +46,8 @@ DT = 1e-3                                   # s
 OMEGA0 = np.array([1e-3, 1.0, 1e-3])        # rad/s, near the intermediate axis, dispersed per body
 TORQUE = torques.ConstantBody([0.0, 0.0, 0.01]) + torques.Gravity(1.0, [0.0, 0.0, 0.1])  # N·m; kg, m
 CPU_BODIES = 100_000
+TARGET = (np.cos(0.15), 0.0, np.sin(0.15), 0.0)  # the spacecraft's commanded attitude (body -> inertial)
+SWEEP_DT = 0.1                              # s, the spacecraft sweep's RK4 step
 CORES = len(os.sched_getaffinity(0))
 
 
@@ -83,6 +91,46 @@ def kernel_timing(model, y0, t, kernel=_cuda._rk4_kernel):
     return measure(launch)
 
 
+def spacecraft_sweep(samples, seconds, device):
+    """The sweep of section 4: ``samples`` spacecraft (four wheels in a pyramid, MRP feedback to ``TARGET``)
+    with dispersed body rates and wheel speeds, ``seconds`` of RK4 at ``SWEEP_DT``, 61 output times; the final
+    pointing error (rad) and the peak yaw rate (rad/s) of each, and their 5th, 50th and 95th percentiles."""
+    from tumble.spacecraft import MRPFeedback, Spacecraft, pyramid_wheels
+    from tumble.sweeps import Component, Final, Max, Normal, PointingError, sweep
+
+    craft = Spacecraft(inertia=np.diag([10.0, 12.0, 8.0]), wheels=pyramid_wheels(0.02),
+                       controller=MRPFeedback(K=1.0, P=5.0, target=TARGET))
+    return sweep(craft, {"omega0": Normal([0.05, -0.02, 0.03], 0.02),
+                         "wheel_speeds0": Normal([10.0, -5.0, 3.0, 0.0], 5.0)},
+                 samples=samples, seed=3, t=np.linspace(0.0, seconds, 61), method="rk4", dt=SWEEP_DT,
+                 outcomes={"pointing": Final(PointingError(TARGET)), "peak_yaw_rate": Max(Component("omega", 2))},
+                 percentiles=(5.0, 50.0, 95.0), workers=0, device=device)
+
+
+def sweep_section(samples, seconds, cpu_samples):
+    """Section 4: the spacecraft sweep on the GPU (end to end), on the CPU's cores for the first samples, and
+    the largest difference of their outcomes and percentiles over the samples both ran."""
+    steps = samples * round(seconds / SWEEP_DT)
+    k = min(cpu_samples, samples)
+    print(f"\n   Monte-Carlo sweep of spacecraft (4 wheels, MRP feedback), {seconds:g} s of RK4 at {SWEEP_DT:g} s, "
+          "end to end (min / median):")
+    spacecraft_sweep(4, 2 * SWEEP_DT, "cuda"), spacecraft_sweep(4, 2 * SWEEP_DT, "cpu")  # compile / load
+    gpu = measure(lambda: spacecraft_sweep(samples, seconds, "cuda"))
+    cpu = measure(lambda: spacecraft_sweep(k, seconds, "cpu"))
+    same = spacecraft_sweep(k, seconds, "cuda")
+    rates = cpu.rates(k * round(seconds / SWEEP_DT), CORES)
+    wall = gpu.seconds()
+    print(f"   device='cuda', {samples:,d} samples: {wall[0]:.2f} / {wall[1]:.2f} s "
+          f"({fmt(gpu.rates(steps)['wall'])} spacecraft-steps/s); device='cpu' on {CORES} cores, {k:,d} samples: "
+          f"{fmt(rates['wall'])} wall, {fmt(rates['cpu'])} CPU-time based spacecraft-steps/s")
+    for name in ("pointing", "peak_yaw_rate"):
+        a, b = same[name].values, cpu.result[name].values
+        pa, pb = same[f"{name}_percentiles"].values, cpu.result[f"{name}_percentiles"].values
+        print(f"   {name}: max |GPU - CPU| over the {k:,d} samples {np.abs(a - b).max():.2e}, of their percentiles "
+              f"{np.abs(pa - pb).max():.2e}; percentiles of all {samples:,d} on the GPU: "
+              f"{np.array2string(gpu.result[f'{name}_percentiles'].values, precision=6)}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="N = 1e6 and 100 steps")
@@ -91,6 +139,10 @@ def main():
     parser.add_argument("--registers", type=int, nargs="+", default=[],
                         help="also time the torque-program kernel compiled with each of these caps on its registers "
                              "per thread (numba.cuda's max_registers), at the first N")
+    parser.add_argument("--sweep-samples", type=int, default=1_000_000, help="spacecraft in the sweep (section 4)")
+    parser.add_argument("--sweep-seconds", type=float, default=600.0, help="simulated time of the sweep, s")
+    parser.add_argument("--sweep-cpu", type=int, default=10_000, help="of them, the samples the CPU also runs")
+    parser.add_argument("--sweep-only", action="store_true", help="section 4 alone")
     args = parser.parse_args()
     if not _cuda.cuda_available():
         print("No CUDA GPU present (numba.cuda.is_available() is False): nothing measured.")
@@ -107,6 +159,9 @@ def main():
         device = f"{name} (compute capability {'.'.join(map(str, dev.compute_capability))})"
     print(machine())
     print(f"tumble {tumble.__version__}; GPU: {device}")
+    if args.sweep_only:
+        sweep_section(args.sweep_samples, args.sweep_seconds, args.sweep_cpu)
+        return
     print(f"RK4, float64, {steps} steps of {DT * 1e3:g} ms, {_cuda.THREADS_PER_BLOCK} threads per block; "
           "body-steps/s from wall time, min / median\n")
 
@@ -172,6 +227,8 @@ def main():
         kept(256)
         on_gpu = measure(lambda: kept(n))
         print(f"   {name} tensors: {fmt(on_gpu.rates(n * steps)['wall'])}")
+
+    sweep_section(args.sweep_samples, args.sweep_seconds, args.sweep_cpu)
 
 if __name__ == "__main__":
     main()
