@@ -58,6 +58,43 @@ def test_an_edit_of_an_inlined_kernel_recompiles_its_callers_and_an_edit_of_the_
     assert "[cache] data loaded" in unchanged.stdout and "[cache] data saved" not in unchanged.stdout
 
 
+# Adds to a cache index one more signature, an object of a class of a module that the test then deletes: the
+# index of a tumble version with a model kind this one does not have.
+REWRITE = """
+import pickle, sys
+from tumble_gone_kind import GoneModel
+with open(sys.argv[1], "rb") as f:
+    version = pickle.load(f)
+    stamp, overloads = pickle.loads(f.read())
+overloads[(GoneModel,)] = "gone.nbc"
+with open(sys.argv[1], "wb") as f:
+    pickle.dump(version, f, protocol=-1)
+    f.write(pickle.dumps((stamp, overloads), protocol=-1))
+"""
+
+
+@pytest.mark.slow
+def test_an_index_naming_a_class_that_is_gone_is_stale_not_an_error(tmp_path):
+    # a cache outlives the sources it was compiled from (a git branch, an upgrade or a downgrade): Numba
+    # unpickles an index before it checks its stamp, and a class the index names that is no longer there raised
+    # ModuleNotFoundError at every call; the function compiles again instead, and its index is rewritten
+    cache, gone = tmp_path / "cache", tmp_path / "gone"
+    assert _run(SRC.parent, cache).stdout.splitlines()[-1] == "[1.0, 0.0, 0.0]"
+    (index,) = cache.rglob("attitude._to_rotvec_loop-*.nbi")
+    gone.mkdir()
+    (gone / "tumble_gone_kind.py").write_text("class GoneModel:\n    pass\n")
+    subprocess.run([sys.executable, "-c", REWRITE, str(index)], env={**os.environ, "PYTHONPATH": str(gone)},
+                   check=True, timeout=60)
+    shutil.rmtree(gone)
+    assert b"tumble_gone_kind" in index.read_bytes()
+    again = _run(SRC.parent, cache)
+    assert again.stdout.splitlines()[-1] == "[1.0, 0.0, 0.0]"
+    assert "[cache] data saved" in again.stdout
+    assert b"tumble_gone_kind" not in index.read_bytes()
+    third = _run(SRC.parent, cache)
+    assert "[cache] data loaded" in third.stdout and "[cache] data saved" not in third.stdout
+
+
 def test_the_key_is_the_content_of_the_compiled_sources_and_the_compiler_versions(tmp_path):
     root = tmp_path / "tumble"
     shutil.copytree(SRC, root, ignore=shutil.ignore_patterns("__pycache__"))

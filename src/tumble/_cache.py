@@ -34,7 +34,9 @@ figures, the viewer, the examples), so editing those recompiles nothing;
 ``tests/test_cache.py`` checks that none of them compiles code and that no
 other module imports them at module level, i.e. that no compiled function
 can read them. The CPU (name and features) is part of Numba's own key of each
-entry; Python's version is in the index file's name.
+entry; Python's version is in the index file's name. An index written by
+another version of tumble that names a class this one lacks is stale too
+(:func:`tolerate_stale_indexes`), not an error.
 """
 
 from __future__ import annotations
@@ -155,11 +157,38 @@ def use_content_key() -> None:
     locators[:0] = [_keyed_by_content(locator) for locator in backed]
 
 
+def tolerate_stale_indexes() -> None:
+    """Make a cache index that names a class no longer there stale, not an error.
+
+    An index written by another version of tumble (a git branch, an upgrade or a downgrade: the cache files
+    outlive the sources they were compiled from) may name, in the signatures it lists, a compiled model's
+    class that this version does not have. Numba unpickles an index before it compares its stamp, so the
+    missing module or class raised ``ModuleNotFoundError`` (or ``AttributeError``) at every call of the
+    function. Such an index now reads as empty: the function compiles, and saving it rewrites the index.
+    Called once, before any compiled module is imported."""
+    from numba.core import caching
+
+    load_index = caching.IndexDataCacheFile._load_index
+    if getattr(load_index, "tolerates_stale", False):
+        return
+
+    def _load_index(self):
+        try:
+            return load_index(self)
+        except (ImportError, AttributeError):
+            return {}
+
+    _load_index.tolerates_stale = True  # type: ignore[attr-defined]
+    caching.IndexDataCacheFile._load_index = _load_index
+
+
 def prepare() -> None:
     """What Numba needs before it decorates any of tumble's functions: a writable cache
-    (:func:`ensure_writable_cache`) and the content key (:func:`use_content_key`)."""
+    (:func:`ensure_writable_cache`), the content key (:func:`use_content_key`) and indexes of other versions
+    read as stale (:func:`tolerate_stale_indexes`)."""
     ensure_writable_cache()
     use_content_key()
+    tolerate_stale_indexes()
 
 
 class _AfterNumbaLoads(importlib.abc.MetaPathFinder):
