@@ -167,6 +167,12 @@ def put(A, i, j, value):  # pragma: no cover - replaced by the overload in compi
     raise NotImplementedError
 
 
+def stage(A, s, i, j):  # pragma: no cover - replaced by the overload in compiled code
+    """``A[s, i]`` of a stage array of one body (stages × state, or stages × 3), ``A[s, i, j]`` (lane ``j``)
+    of a block's: one element, without a view of stage ``s``."""
+    raise NotImplementedError
+
+
 def lanes(Y):  # pragma: no cover - replaced by the overload in compiled code
     """The lanes of a block (state × lanes); 1 for one body's state vector."""
     raise NotImplementedError
@@ -185,6 +191,13 @@ def _cell(A, i, j):
     if A.ndim == 1:
         return lambda A, i, j: A[i]
     return lambda A, i, j: A[i, j]
+
+
+@overload(stage, inline="always", jit_options={"cache": True})
+def _stage_cell(A, s, i, j):
+    if A.ndim == 2:
+        return lambda A, s, i, j: A[s, i]
+    return lambda A, s, i, j: A[s, i, j]
 
 
 @overload(put, inline="always", jit_options={"cache": True})
@@ -249,23 +262,23 @@ def _cf4_step(model, b0, t, h, Y, K, S, W, Q2):
     _stage(model, b0, t, Y, K[0], W[0])
     for j in range(n_lanes):
         qw, qx, qy, qz = _quaternion(Y, j)
-        q = rotate_right(qw, qx, qy, qz, 0.5 * h * cell(W[0], 0, j), 0.5 * h * cell(W[0], 1, j),
-                         0.5 * h * cell(W[0], 2, j))
+        q = rotate_right(qw, qx, qy, qz, 0.5 * h * stage(W, 0, 0, j), 0.5 * h * stage(W, 0, 1, j),
+                         0.5 * h * stage(W, 0, 2, j))
         _put_quaternion(S, j, q)
         _put_quaternion(Q2, j, q)
     _euclidean(Y, K[0], 0.5 * h, S)
     _stage(model, b0, t + 0.5 * h, S, K[1], W[1])
     for j in range(n_lanes):
         qw, qx, qy, qz = _quaternion(Y, j)
-        _put_quaternion(S, j, rotate_right(qw, qx, qy, qz, 0.5 * h * cell(W[1], 0, j), 0.5 * h * cell(W[1], 1, j),
-                                           0.5 * h * cell(W[1], 2, j)))
+        _put_quaternion(S, j, rotate_right(qw, qx, qy, qz, 0.5 * h * stage(W, 1, 0, j), 0.5 * h * stage(W, 1, 1, j),
+                                           0.5 * h * stage(W, 1, 2, j)))
     _euclidean(Y, K[1], 0.5 * h, S)
     _stage(model, b0, t + 0.5 * h, S, K[2], W[2])
     for j in range(n_lanes):
         qw, qx, qy, qz = _quaternion(Q2, j)
-        _put_quaternion(S, j, rotate_right(qw, qx, qy, qz, h * (cell(W[2], 0, j) - 0.5 * cell(W[0], 0, j)),
-                                           h * (cell(W[2], 1, j) - 0.5 * cell(W[0], 1, j)),
-                                           h * (cell(W[2], 2, j) - 0.5 * cell(W[0], 2, j))))
+        _put_quaternion(S, j, rotate_right(qw, qx, qy, qz, h * (stage(W, 2, 0, j) - 0.5 * stage(W, 0, 0, j)),
+                                           h * (stage(W, 2, 1, j) - 0.5 * stage(W, 0, 1, j)),
+                                           h * (stage(W, 2, 2, j) - 0.5 * stage(W, 0, 2, j))))
     _euclidean(Y, K[2], h, S)
     _stage(model, b0, t + h, S, K[3], W[3])
     for j in range(n_lanes):
@@ -276,8 +289,8 @@ def _cf4_step(model, b0, t, h, Y, K, S, W, Q2):
         _put_quaternion(Y, j, rotate_right(q[0], q[1], q[2], q[3], r2[0], r2[1], r2[2]))
     for i in range(4, Y.shape[0]):
         for j in range(n_lanes):
-            put(Y, i, j, cell(Y, i, j) + h / 6.0 * (cell(K[0], i, j) + 2.0 * cell(K[1], i, j)
-                                                     + 2.0 * cell(K[2], i, j) + cell(K[3], i, j)))
+            put(Y, i, j, cell(Y, i, j) + h / 6.0 * (stage(K, 0, i, j) + 2.0 * stage(K, 1, i, j)
+                                                     + 2.0 * stage(K, 2, i, j) + stage(K, 3, i, j)))
 
 
 @njit(cache=True)
@@ -285,9 +298,9 @@ def _combine(W, weights, h, j):
     """The rotation vector ``h Σₛ weights[s] ωₛ`` of lane ``j`` (rad)."""
     a, b, c, d = weights
     return (
-        h * (a * cell(W[0], 0, j) + b * cell(W[1], 0, j) + c * cell(W[2], 0, j) + d * cell(W[3], 0, j)),
-        h * (a * cell(W[0], 1, j) + b * cell(W[1], 1, j) + c * cell(W[2], 1, j) + d * cell(W[3], 1, j)),
-        h * (a * cell(W[0], 2, j) + b * cell(W[1], 2, j) + c * cell(W[2], 2, j) + d * cell(W[3], 2, j)),
+        h * (a * stage(W, 0, 0, j) + b * stage(W, 1, 0, j) + c * stage(W, 2, 0, j) + d * stage(W, 3, 0, j)),
+        h * (a * stage(W, 0, 1, j) + b * stage(W, 1, 1, j) + c * stage(W, 2, 1, j) + d * stage(W, 3, 1, j)),
+        h * (a * stage(W, 0, 2, j) + b * stage(W, 1, 2, j) + c * stage(W, 2, 2, j) + d * stage(W, 3, 2, j)),
     )
 
 
