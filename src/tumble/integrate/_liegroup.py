@@ -32,7 +32,10 @@ A kernel that gives its right-hand side on one body's state in registers
 (``point_rates``: the rigid body) runs *fused* (:mod:`._fused`): the whole
 step of a lane, stages, exponentials, update and projection, on its seven
 values (:func:`point_step`), with the same operations in the same order as
-the stages over a block (:func:`_cf4_step`), which the other models run.
+the stages of :func:`_cf4_step`, which the other models run: over a block
+(state × lanes) of a batch, or over one body's state vector, as every other
+method runs a lone body (its arrays read through :func:`cell`, :func:`put` and
+:func:`stage`, which index either).
 """
 
 from __future__ import annotations
