@@ -270,12 +270,13 @@ FOLLOW_UP = {("README.md", "## Ten lines of Python"): _ten_lines,
              ("README.md", "## Exact motion, stability and the heavy top"): _exact_motion}
 
 
-#: The pages whose examples compile model kinds other than the rigid body's or run demos, sweeps or the CLI's
-#: commands: seconds to two minutes of CPU each on a cold Numba cache (the README's: 126 CPU s, measured).
+#: The pages whose examples compile model kinds other than the rigid body's, the rigid body's parallel batch
+#: driver (free_body, integrators), or run demos, sweeps or the CLI's commands: seconds to two minutes of CPU
+#: each on a cold Numba cache (the README's: 126 CPU s, measured).
 SLOW_PAGES = {"README.md", *(f"docs/{name}.md" for name in (
-    "chaos", "cli", "diver", "estimation", "flexible", "fluid", "frames", "gpu", "ins", "limits", "passive_stability",
-    "robot", "scenarios", "slosh", "spacecraft", "spacecraft_environment", "stability", "sweeps", "variable_inertia",
-    "viewer"))}
+    "chaos", "cli", "diver", "estimation", "flexible", "fluid", "frames", "free_body", "gpu", "ins", "integrators",
+    "limits", "passive_stability", "robot", "scenarios", "slosh", "spacecraft", "spacecraft_environment",
+    "stability", "sweeps", "variable_inertia", "viewer"))}
 
 
 def _page_id(page):

@@ -134,7 +134,10 @@ def sine_torque(t, q, omega):
     return np.array([0.1 * np.sin(t), 0.05 * np.cos(2.0 * t), -0.02])
 
 
-@pytest.mark.parametrize("torque", [None, sine_torque], ids=["torque-free", "time-dependent torque"])
+# The fast lane keeps the torque-free row: the Python torque compiles a reference dop853 path and an rk4 path
+# of its own (~8 CPU s on a cold cache).
+@pytest.mark.parametrize("torque", [None, pytest.param(sine_torque, marks=pytest.mark.slow)],
+                         ids=["torque-free", "time-dependent torque"])
 def test_rk4_converges_at_fourth_order(torque):
     t = np.array([0.0, 4.0])
     body = tumble.RigidBody(FULL)
@@ -248,7 +251,10 @@ BATCH_TORQUES = {
 }
 
 
-@pytest.mark.parametrize("torque", BATCH_TORQUES)
+# The fast lane keeps the torque-free batches: each torque type compiles a block driver and a batch driver
+# of its own (~7 CPU s on a cold cache).
+@pytest.mark.parametrize("torque", [name if name == "torque-free" else pytest.param(name, marks=pytest.mark.slow)
+                                    for name in BATCH_TORQUES])
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
 def test_batch_equals_single_runs(method, torque, random_batch):
     n = 5
@@ -294,11 +300,14 @@ def test_rk4_batch_across_blocks_equals_single_runs(torque, extra, random_batch)
         assert np.abs(state(batch)[:, k] - state(single)).max() <= TOL_BATCH
 
 
+# The fast lane keeps the torque-free rows: a torque compiles a block driver and a batch driver of its own.
+@pytest.mark.parametrize("torque", [None, pytest.param(torques.ConstantInertial(TAU), marks=pytest.mark.slow)],
+                         ids=["torque-free", "ConstantInertial"])
 @pytest.mark.parametrize("method", ["rk4", "dop853"])
-def test_batch_of_one_body_broadcasts_omega0_or_q0(method, random_batch):
+def test_batch_of_one_body_broadcasts_omega0_or_q0(method, torque, random_batch):
     n = 5
     _, omega0, q0 = random_batch(n)
-    kwargs = dict(t=np.linspace(0.0, 3.0, 4), **read_by(method, dt=1e-2), torque=torques.ConstantInertial(TAU))
+    kwargs = dict(t=np.linspace(0.0, 3.0, 4), **read_by(method, dt=1e-2), torque=torque)
     body = tumble.RigidBody(FULL)
     by_rate = tumble.simulate(body, omega0, q0=Q0, **kwargs)
     by_attitude = tumble.simulate([body] * n, OMEGA0, q0=q0, **kwargs)

@@ -98,6 +98,7 @@ def test_methods_are_registered_with_their_torque_support(name, torque):
 # -- order ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow  # each method's declared order is measured in the fast lane by tests/integrate/test_methods.py
 @pytest.mark.parametrize("method, torque, dts", [
     ("splitting2", "none", [0.2, 0.1, 0.05, 0.025, 0.0125]),
     ("splitting4", "none", [0.4, 0.2, 0.1, 0.05, 0.025]),
