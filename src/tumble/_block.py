@@ -21,7 +21,7 @@ driver (behind a pointer its step costs +16 … +60 %: the call boundary, five c
 lanes shares), and so do the fused rigid-body kernels (lanes as SIMD lanes in registers) and every kernel
 compiled for a GPU (``numba.cuda`` has no first-class functions).
 
-Numba internals this module relies on (checked by ``tests/test_block.py``, which runs a kind through a driver):
+Numba internals this module relies on (checked by ``tests/test__block.py``, which runs a kind through a driver):
 ``numba.experimental.function_type._get_jit_address`` and ``_get_wrapper_address`` (the compiled code of a
 dispatcher's one signature, looked up once per process), and the fields ``jit_addr``, ``c_addr`` and
 ``py_addr`` of the data model of :class:`numba.types.FunctionType`, which :func:`function_at` fills inside
