@@ -124,24 +124,30 @@ def torque_views(data, start, ints, at):
 
 
 class Kind(NamedTuple):
-    """A registered kind: ``pack(kernel) -> (data, ints)`` and its block functions (Python functions of the
-    signatures :data:`SIGNATURES`, compiled on first use)."""
+    """A registered kind: ``pack(kernel) -> (data, ints)`` and ``functions(kernel)``, its block functions for
+    that kernel (Python functions of the signatures :data:`SIGNATURES`, compiled on first use)."""
 
     pack: Callable[[Any], tuple[np.ndarray, np.ndarray]]
-    functions: tuple[Callable, Callable, Callable]
+    functions: Callable[[Any], tuple[Callable, Callable, Callable]]
 
 
 #: kernel class -> its :class:`Kind` (filled by the kernel modules at import).
 _KINDS: dict[type, Kind] = {}
 #: Python function -> its compiled dispatcher (a function shared by kinds compiles once).
 _COMPILED: dict[Callable, Any] = {}
-#: kernel class -> the addresses of its compiled functions (looked up once per process).
-_ADDRESSES: dict[type, np.ndarray] = {}
+#: (rhs, project, body rate) -> the addresses of their compiled code (looked up once per process).
+_ADDRESSES: dict[tuple, np.ndarray] = {}
 
 
 def register(cls: type, pack: Callable, rhs: Callable, project: Callable, body_rate: Callable) -> None:
     """Register the kernel class ``cls``: its ``pack`` and its block functions (see the module docstring)."""
-    _KINDS[cls] = Kind(pack, (rhs, project, body_rate))
+    _KINDS[cls] = Kind(pack, lambda kernel: (rhs, project, body_rate))
+
+
+def register_variants(cls: type, pack: Callable, functions: Callable) -> None:
+    """Register the kernel class ``cls`` whose block functions depend on the kernel: ``functions(kernel) ->
+    (rhs, project, body_rate)`` (a spacecraft with Python control laws keeps reference counts)."""
+    _KINDS[cls] = Kind(pack, functions)
 
 
 def compiled(function: Callable, ftype) -> Any:
@@ -152,18 +158,18 @@ def compiled(function: Callable, ftype) -> Any:
     return _COMPILED[function]
 
 
-def addresses(cls: type) -> np.ndarray:
-    """``[rhs's code, its C wrapper, project's …, body rate's …]`` (int64) of the registered class ``cls``,
+def addresses(functions: tuple[Callable, Callable, Callable]) -> np.ndarray:
+    """``[rhs's code, its C wrapper, project's …, body rate's …]`` (int64) of a kind's block ``functions``,
     compiled and looked up once per process."""
-    if cls not in _ADDRESSES:
+    if functions not in _ADDRESSES:
         from numba.experimental.function_type import _get_jit_address, _get_wrapper_address
 
         found = []
-        for function, ftype in zip(_KINDS[cls].functions, SIGNATURES):
+        for function, ftype in zip(functions, SIGNATURES):
             dispatcher = compiled(function, ftype)
             found += [lookup(dispatcher, ftype.signature) for lookup in (_get_jit_address, _get_wrapper_address)]
-        _ADDRESSES[cls] = np.array(found, dtype=np.int64)
-    return _ADDRESSES[cls]
+        _ADDRESSES[functions] = np.array(found, dtype=np.int64)
+    return _ADDRESSES[functions]
 
 
 def block_model(kernel) -> Any:
@@ -174,7 +180,7 @@ def block_model(kernel) -> Any:
     if kind is None:
         return kernel
     data, ints = kind.pack(kernel)
-    return BlockModel(addresses(type(kernel)), np.ascontiguousarray(data, dtype=np.float64),
+    return BlockModel(addresses(kind.functions(kernel)), np.ascontiguousarray(data, dtype=np.float64),
                       np.ascontiguousarray(ints, dtype=np.int64))
 
 
