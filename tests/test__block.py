@@ -12,6 +12,7 @@ import textwrap
 
 import numpy as np
 import pytest
+from helpers import assert_same_run
 
 import tumble
 from tumble import _block, _callback, torques
@@ -64,6 +65,15 @@ def test_a_block_through_the_pointers_is_the_inlined_block_bit_for_bit(model, to
         pointers = _block.block_model(kernel)
         assert type(pointers) is _block.BlockModel
         np.testing.assert_array_equal(block_path(pointers, method, y0), block_path(kernel, method, y0))
+
+
+def test_a_batch_of_two_blocks_runs_the_parallel_driver_through_the_pointers():
+    # 65 bodies: two blocks, run_batch (prange over the blocks); a FlexibleBody's block rounds as its lone body
+    model = flexible()
+    omega = np.array([0.3, 1.0, -0.4]) * (1.0 + 0.01 * np.arange(65))[:, None]
+    batch = tumble.simulate(model, omega, t=T, method="rk4", dt=0.05)
+    for i in (0, 63, 64):
+        assert_same_run(batch.member(i), tumble.simulate(model, omega[i], t=T, method="rk4", dt=0.05))
 
 
 def test_pack_and_unpack_give_the_kernel_back():
