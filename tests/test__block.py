@@ -35,16 +35,16 @@ def kirchhoff():
     return KirchhoffBody(tumble.RigidBody(INERTIA, mass=20.0), fluid)
 
 
-def block_path(kernel, method, y0):
+def block_path(kernel, method, y0, t=T, dt=0.05):
     """The path (outputs × bodies × state) of one block of ``y0`` (bodies × state) through ``_fixed.run_block``
     of ``method`` with ``kernel`` as it is given (a kind's own kernel: its overloads inlined into the driver)."""
     from tumble.integrate import METHODS
 
     driver = METHODS[method].driver
     y = np.array(y0)
-    out = np.empty((T.shape[0], *y.shape))
-    m, h = driver.plan(T, {"dt": 0.05, "max_steps": 10**6})
-    _fixed.run_block(driver.scheme, kernel, 0, y, T, m, h, out, np.zeros((y.shape[0], 5)))
+    out = np.empty((t.shape[0], *y.shape))
+    m, h = driver.plan(t, {"dt": dt, "max_steps": 10**6})
+    _fixed.run_block(driver.scheme, kernel, 0, y, t, m, h, out, np.zeros((y.shape[0], 5)))
     return out
 
 
@@ -65,6 +65,27 @@ def test_a_block_through_the_pointers_is_the_inlined_block_bit_for_bit(model, to
         pointers = _block.block_model(kernel)
         assert type(pointers) is _block.BlockModel
         np.testing.assert_array_equal(block_path(pointers, method, y0), block_path(kernel, method, y0))
+
+
+@pytest.mark.parametrize("method", ["rk4", "cf4"])
+@pytest.mark.parametrize("example, torque", [
+    ("variable", None),  # the torque-free variant (codes None)
+    ("variable", torques.ConstantBody([0.05, -0.02, 0.1])),
+    ("human", None),
+], ids=["variable", "variable-torque", "human"])
+def test_a_block_of_deformable_bodies_through_the_pointers_is_the_inlined_block(example, torque, method):
+    from tumble import _warmup
+    from tumble.simulate import _initial_values
+
+    model, state = getattr(_warmup, example)()
+    kernel = model.compile(torque, 0.0)
+    values, _ = _initial_values(model, state)
+    y0 = np.tile(model.initial_states(kernel, values, 0.0)[0], (3, 1))
+    y0[:, 4:7] *= np.array([[1.0], [1.01], [1.02]])  # three angular momenta
+    pointers = _block.block_model(kernel)
+    assert type(pointers) is _block.BlockModel
+    t = np.linspace(0.0, 0.5, 5)  # within the bodies' spline (0 … 1 s)
+    np.testing.assert_array_equal(block_path(pointers, method, y0, t, 0.01), block_path(kernel, method, y0, t, 0.01))
 
 
 def test_a_batch_of_two_blocks_runs_the_parallel_driver_through_the_pointers():

@@ -108,11 +108,35 @@ def matrix_view(typingctx, flat, start, rows, cols):
     return matrix(flat, types.intp, types.intp, types.intp), codegen
 
 
+@intrinsic
+def array_view(typingctx, flat, start, shape):
+    """``flat[start:start + prod(shape)]`` as a C-contiguous array of ``shape`` (a tuple of integers) sharing
+    its memory, made inline as :func:`matrix_view`."""
+    ndim = len(shape)
+    array = types.Array(types.float64, ndim, "C")
+
+    def codegen(context, builder, signature, args):
+        source = make_array(signature.args[0])(context, builder, args[0])
+        view = make_array(array)(context, builder)
+        itemsize = context.get_constant(types.intp, 8)
+        dims = [context.cast(builder, dim, kind, types.intp)
+                for dim, kind in zip(cgutils.unpack_tuple(builder, args[2]), signature.args[2])]
+        strides = [itemsize]
+        for dim in reversed(dims[1:]):
+            strides.insert(0, builder.mul(strides[0], dim))
+        populate_array(view, data=builder.gep(source.data, [args[1]]), shape=dims, strides=strides,
+                       itemsize=itemsize, meminfo=source.meminfo, parent=source.parent)
+        return impl_ret_borrowed(context, builder, array, view._getvalue())
+
+    return array(flat, types.intp, shape), codegen
+
+
 def torque_pieces(kernel) -> tuple[list[np.ndarray], list[int]]:
-    """A kernel's torque program (``params`` (rows, p), ``codes`` (c,)) as flat float pieces and the ints
-    ``[rows, p, c, codes…]`` that :func:`torque_views` reads back."""
+    """A kernel's torque program (``params`` (rows, p), ``codes`` (c,), or None: none) as flat float pieces and
+    the ints ``[rows, p, c, codes…]`` that :func:`torque_views` reads back."""
     rows, width = kernel.params.shape
-    return [kernel.params.ravel()], [rows, width, kernel.codes.shape[0], *kernel.codes]
+    codes = () if kernel.codes is None else kernel.codes
+    return [kernel.params.ravel()], [rows, width, len(codes), *codes]
 
 
 @njit(cache=True, inline="always")
