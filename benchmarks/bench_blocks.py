@@ -29,7 +29,8 @@ DT = 0.01
 
 
 def models(spacecraft: bool) -> dict:
-    """name -> (model, torque): the kinds moved to blocks, each with a torque program where it takes one."""
+    """name -> (model, torque): the kinds moved to blocks, each with a torque program where it takes one (the
+    deformable bodies' splines span the 10 s of :func:`steps`' runs)."""
     import tumble
     from tumble import torques
     from tumble.flexible import FlexibleBody, Mode
@@ -47,6 +48,14 @@ def models(spacecraft: bool) -> dict:
                                 Pendulum(mass=2.0, length=0.5, hinge=[0.3, -0.2, 0.4], damping=0.1)), torque),
         "KirchhoffBody": (KirchhoffBody(tumble.RigidBody(inertia, mass=20.0), fluid), None),
     }
+    from tumble.variable import Human, Motion, VariableBody
+
+    def growing(t):  # an inertia growing by 1 % a second, splined over the 10 s a block runs
+        return inertia * (1.0 + 0.01 * np.asarray(t))[:, None, None]
+
+    found["VariableBody"] = (VariableBody.from_functions(growing, t_span=(0.0, 10.0), dt=0.01), torque)
+    found["MovingHuman"] = (Human.de_leva().moving({"left_shoulder_abduction": Motion(np.pi, [(0.0, 10.0, 0.0)])},
+                                                   t_span=(0.0, 10.0)), None)
     if spacecraft:
         from tumble.spacecraft import MRPFeedback, Spacecraft, pyramid_wheels
 
