@@ -108,7 +108,8 @@ def test_pack_and_unpack_give_the_kernel_back():
 
 
 def test_a_kind_without_block_functions_keeps_its_own_kernel():
-    kernel = tumble.as_model(tumble.RigidBody(INERTIA)).compile(None, 0.0)  # the fused rigid-body kernels stay specialised
+    # the fused rigid-body kernels stay specialised
+    kernel = tumble.as_model(tumble.RigidBody(INERTIA)).compile(None, 0.0)
     assert _block.block_model(kernel) is kernel
 
 
