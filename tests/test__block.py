@@ -74,6 +74,16 @@ def test_a_block_through_the_pointers_is_the_inlined_block_bit_for_bit(model, to
     ("human", None),
 ], ids=["variable", "variable-torque", "human"])
 def test_a_block_of_deformable_bodies_through_the_pointers_is_the_inlined_block(example, torque, method):
+    assert_warmup_example_block(example, torque, method)
+
+
+def test_a_block_of_gimbaled_gyros_through_the_pointers_is_the_inlined_block():
+    assert_warmup_example_block("gimbaled_gyro", None, "rk4")  # a kind without body rates (no cf4)
+
+
+def assert_warmup_example_block(example, torque, method):
+    """A block of three of ``tumble warmup``'s example of a kind (its states 4…6 scaled by 1, 1.01, 1.02)
+    through the pointers and inlined: equal bit for bit over 0.5 s (within the deformable bodies' splines)."""
     from tumble import _warmup
     from tumble.simulate import _initial_values
 
@@ -81,10 +91,10 @@ def test_a_block_of_deformable_bodies_through_the_pointers_is_the_inlined_block(
     kernel = model.compile(torque, 0.0)
     values, _ = _initial_values(model, state)
     y0 = np.tile(model.initial_states(kernel, values, 0.0)[0], (3, 1))
-    y0[:, 4:7] *= np.array([[1.0], [1.01], [1.02]])  # three angular momenta
+    y0[:, 4:7] *= np.array([[1.0], [1.01], [1.02]])
     pointers = _block.block_model(kernel)
     assert type(pointers) is _block.BlockModel
-    t = np.linspace(0.0, 0.5, 5)  # within the bodies' spline (0 … 1 s)
+    t = np.linspace(0.0, 0.5, 5)
     np.testing.assert_array_equal(block_path(pointers, method, y0, t, 0.01), block_path(kernel, method, y0, t, 0.01))
 
 

@@ -163,8 +163,10 @@ _COMPILED: dict[Callable, Any] = {}
 _ADDRESSES: dict[tuple, np.ndarray] = {}
 
 
-def register(cls: type, pack: Callable, rhs: Callable, project: Callable, body_rate: Callable) -> None:
-    """Register the kernel class ``cls``: its ``pack`` and its block functions (see the module docstring)."""
+def register(cls: type, pack: Callable, rhs: Callable, project: Callable, body_rate: Callable | None) -> None:
+    """Register the kernel class ``cls``: its ``pack`` and its block functions (see the module docstring);
+    ``body_rate`` None for a kind without (its kernel does not provide ``"body_rate"``, so no method that needs
+    it runs the kind: the address is 0)."""
     _KINDS[cls] = Kind(pack, lambda kernel: (rhs, project, body_rate))
 
 
@@ -190,6 +192,9 @@ def addresses(functions: tuple[Callable, Callable, Callable]) -> np.ndarray:
 
         found = []
         for function, ftype in zip(functions, SIGNATURES):
+            if function is None:
+                found += [0, 0]
+                continue
             dispatcher = compiled(function, ftype)
             found += [lookup(dispatcher, ftype.signature) for lookup in (_get_jit_address, _get_wrapper_address)]
         _ADDRESSES[functions] = np.array(found, dtype=np.int64)
