@@ -29,8 +29,8 @@ SRC = Path(__file__).resolve().parents[1] / "src"
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("ground floor", ("tumble._quat", "tumble._vec", "tumble._validate", "tumble._inertia", "tumble._elliptic",
                       "tumble._free_flow", "tumble._gravity", "tumble._files", "tumble._cache", "tumble._compiling",
-                      "tumble._callback", "tumble._protocol", "tumble._version", "tumble._moved", "tumble.limits",
-                      "tumble._kinds")),
+                      "tumble._callback", "tumble._protocol", "tumble._block", "tumble._version", "tumble._moved",
+                      "tumble.limits", "tumble._kinds")),
     ("values", ("tumble.attitude", "tumble.dynamics", "tumble.rigid_body", "tumble.torques")),
     ("result", ("tumble._netcdf", "tumble.trajectory")),
     ("estimators", ("tumble.estimation",)),

@@ -29,6 +29,7 @@ import numpy as np
 from numba import njit, prange
 from numba.extending import overload
 
+from tumble import _block
 from tumble._validate import ValidationError
 from tumble.integrate._method import Driver
 
@@ -159,9 +160,12 @@ class FixedSteps(Driver):
     """The driver of a fixed-step method: ``scheme`` advanced by steps that land on every output time.
 
     Its plan is :func:`landing_steps` for the whole run (so a run that needs more than ``max_steps`` is
-    refused before it starts). A lone body runs on its state vector (:func:`run_one`); a batch runs in
-    blocks of :data:`LANES`, in parallel over the cores (:func:`run_batch`) unless ``serial`` or the batch is
-    one block (its one task runs on one core anyway, and the parallel driver is not compiled for it).
+    refused before it starts). A lone body runs on its state vector (:func:`run_one`, the kernel's
+    right-hand side inlined); a batch runs in blocks of :data:`LANES`, in parallel over the cores
+    (:func:`run_batch`) unless ``serial`` or the batch is one block (its one task runs on one core anyway, and
+    the parallel driver is not compiled for it). A batch of a kind with block functions runs as its
+    :class:`tumble._block.BlockModel` (:func:`tumble._block.block_model`, the one place of that choice): the
+    block drivers are then compiled once per method for all those kinds.
     """
 
     def __init__(self, scheme: NamedTuple) -> None:
@@ -178,7 +182,9 @@ class FixedSteps(Driver):
         t = t[lo:hi + 1]
         if y.shape[0] == 1:
             run_one(self.scheme, model, y, t, m, h, out, stats)
-        elif serial or y.shape[0] <= LANES:
+            return
+        model = _block.block_model(model)
+        if serial or y.shape[0] <= LANES:
             for k in range(-(-y.shape[0] // LANES)):
                 run_block(self.scheme, model, k, y, t, m, h, out, stats)
         else:

@@ -47,6 +47,7 @@ from numba import njit
 from numba.extending import overload
 
 from tumble import _protocol, _quat
+from tumble._block import body_rates
 from tumble._protocol import body_rate, evaluating, model_workspace, point_rates, project, quaternion_scale, rhs
 from tumble.integrate import _fixed, _fused
 from tumble.integrate._method import FIXED_STEP, Method
@@ -223,12 +224,29 @@ def _put(A, i, j, value):
 def _stage(model, b0, t, S, k, w):
     """Evaluate a stage at the stage state ``S``: ``k = f(t, S)`` and ``w = ω(S)`` (3 [× lanes])."""
     rhs(model, b0, t, S, k)
-    for j in range(lanes(S)):
-        w1, w2, w3 = body_rate(model, S, j)
-        put(w, 0, j, w1)
-        put(w, 1, j, w2)
-        put(w, 2, j, w3)
+    stage_rates(model, S, w)
 
+
+def stage_rates(model, S, w):  # pragma: no cover - replaced by the overload in compiled code
+    """``w[:, j] = body_rate(model, S, j)`` of every lane ``j`` (3 [× lanes]): one call of the kind's
+    function for a :class:`tumble._block.BlockModel` (:func:`tumble._block.body_rates`), a loop over the lanes
+    otherwise."""
+    raise NotImplementedError
+
+
+@overload(stage_rates, inline="always", jit_options={"cache": True})
+def _stage_rates(model, S, w):
+    if _protocol.implemented(body_rates, model):
+        return lambda model, S, w: body_rates(model, S, w)
+
+    def impl(model, S, w):
+        for j in range(lanes(S)):
+            w1, w2, w3 = body_rate(model, S, j)
+            put(w, 0, j, w1)
+            put(w, 1, j, w2)
+            put(w, 2, j, w3)
+
+    return impl
 
 
 

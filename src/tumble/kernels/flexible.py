@@ -24,7 +24,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from tumble import _protocol, _quat, torques
+from tumble import _block, _protocol, _quat, torques
+from tumble._block import matrix_view
 from tumble._vec import cross, matvec
 
 
@@ -91,6 +92,35 @@ def derivative(model, t, y, out):
     out[0], out[1], out[2], out[3] = 0.5 * d[0], 0.5 * d[1], 0.5 * d[2], 0.5 * d[3]
     out[4], out[5], out[6] = a1, a2, a3
 
+
+def pack(model) -> tuple[np.ndarray, np.ndarray]:
+    """``(data, ints)`` of the kernel for its block functions (:mod:`tumble._block`): ``inertia``,
+    ``inverse_hub``, ``participation``, ``damping``, ``stiffness`` and the torque parameters, flat, one after
+    another; ``[m, the torque program's sizes and codes]``."""
+    floats, ints = _block.torque_pieces(model)
+    pieces = [model.inertia, model.inverse_hub, model.participation, model.damping, model.stiffness]
+    return (np.concatenate([p.ravel() for p in pieces] + floats),
+            np.array([model.stiffness.shape[0], *ints], dtype=np.int64))
+
+
+@njit(cache=True)
+def unpack(data, ints):
+    """The :class:`FlexibleModel` whose arrays are views of :func:`pack`'s ``data`` and ``ints``."""
+    m = ints[0]
+    a = 18 + 3 * m
+    params, codes = _block.torque_views(data, a + 2 * m, ints, 1)
+    return FlexibleModel(matrix_view(data, 0, 3, 3), matrix_view(data, 9, 3, 3), matrix_view(data, 18, m, 3),
+                         data[a:a + m], data[a + m:a + 2 * m], params, codes)
+
+
+def block_rhs(t, Y, OUT, data, ints):
+    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`)."""
+    model = unpack(data, ints)
+    for j in range(Y.shape[1]):
+        derivative(model, t, Y[:, j], OUT[:, j])
+
+
+_block.register(FlexibleModel, pack, block_rhs, _block.quaternion_project, _block.rate_at_4)
 
 
 @_protocol.implements(_protocol.rhs, FlexibleModel, inline=True)

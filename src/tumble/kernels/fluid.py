@@ -25,7 +25,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from tumble import _protocol, _quat
+from tumble import _block, _protocol, _quat
+from tumble._block import matrix_view
 from tumble._vec import cross
 
 STATE_SIZE = 13
@@ -97,6 +98,35 @@ def _rate_of_state(model, y):
     """``ω = W[0:3] [K; P]`` of one state vector."""
     w1, w2, w3, _, _, _ = velocities(model.mobility, y[4], y[5], y[6], y[7], y[8], y[9])
     return w1, w2, w3
+
+
+def pack(model) -> tuple[np.ndarray, np.ndarray]:
+    """``(data, ints)`` of the kernel for its block functions (:mod:`tumble._block`): the mobility, flat; no
+    ints."""
+    return model.mobility.ravel(), np.empty(0, dtype=np.int64)
+
+
+@njit(cache=True)
+def unpack(data, ints):
+    """The :class:`KirchhoffModel` whose mobility is a view of :func:`pack`'s ``data``."""
+    return KirchhoffModel(matrix_view(data, 0, 6, 6))
+
+
+def block_rhs(t, Y, OUT, data, ints):
+    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`)."""
+    model = unpack(data, ints)
+    for j in range(Y.shape[1]):
+        derivative(model, t, Y[:, j], OUT[:, j])
+
+
+def block_body_rate(Y, W, data, ints):
+    """``W[:, j] = ω`` of every lane of the block ``Y`` (:data:`tumble._block.BODY_RATE`)."""
+    model = unpack(data, ints)
+    for j in range(Y.shape[1]):
+        W[0, j], W[1, j], W[2, j] = _rate_of_lane(model, Y, j)
+
+
+_block.register(KirchhoffModel, pack, block_rhs, _block.quaternion_project, block_body_rate)
 
 
 @_protocol.implements(_protocol.rhs, KirchhoffModel, inline=True)

@@ -23,7 +23,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from tumble import _protocol, _quat
+from tumble import _block, _protocol, _quat
+from tumble._block import matrix_view
 
 STATE_SIZE = 8
 
@@ -91,3 +92,23 @@ def _gimbal_project(model, b0, t, Y):
 @_protocol.implements(_protocol.state_size, GimbalModel)
 def _gimbal_state_size(model):
     return lambda model: STATE_SIZE
+
+
+def pack(model) -> tuple[np.ndarray, np.ndarray]:
+    """``(data, ints)`` of the kernel for its block functions (:mod:`tumble._block`): ``params`` flat, and its
+    shape."""
+    return model.params.ravel(), np.array(model.params.shape, dtype=np.int64)
+
+
+@njit(cache=True)
+def unpack(data, ints):
+    """The :class:`GimbalModel` whose ``params`` are a view of :func:`pack`'s ``data``."""
+    return GimbalModel(matrix_view(data, 0, ints[0], ints[1]))
+
+
+def block_rhs(t, Y, OUT, data, ints):
+    """The right-hand side of a block (:data:`tumble._block.RHS`)."""
+    _protocol.rhs(unpack(data, ints), 0, t, Y, OUT)
+
+
+_block.register(GimbalModel, pack, block_rhs, _block.quaternion_project, None)

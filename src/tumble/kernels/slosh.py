@@ -27,7 +27,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from tumble import _protocol, _quat, torques
+from tumble import _block, _protocol, _quat, torques
+from tumble._block import matrix_view
 from tumble._vec import cross, matvec
 
 STATE_SIZE = 13
@@ -118,6 +119,38 @@ def project_state(y):
     along = y[10] * y[7] + y[11] * y[8] + y[12] * y[9]
     y[10], y[11], y[12] = y[10] - along * y[7], y[11] - along * y[8], y[12] - along * y[9]
 
+
+def pack(model) -> tuple[np.ndarray, np.ndarray]:
+    """``(data, ints)`` of the kernel for its block functions (:mod:`tumble._block`): ``inertia``, ``inverse``,
+    ``hinge``, ``constants`` and the torque parameters, flat, one after another; the torque program's sizes and
+    codes."""
+    floats, ints = _block.torque_pieces(model)
+    pieces = [model.inertia, model.inverse, model.hinge, model.constants]
+    return np.concatenate([p.ravel() for p in pieces] + floats), np.array(ints, dtype=np.int64)
+
+
+@njit(cache=True)
+def unpack(data, ints):
+    """The :class:`SloshModel` whose arrays are views of :func:`pack`'s ``data`` and ``ints``."""
+    params, codes = _block.torque_views(data, 24, ints, 0)
+    return SloshModel(matrix_view(data, 0, 3, 3), matrix_view(data, 9, 3, 3), data[18:21], data[21:24], params,
+                      codes)
+
+
+def block_rhs(t, Y, OUT, data, ints):
+    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`)."""
+    model = unpack(data, ints)
+    for j in range(Y.shape[1]):
+        derivative(model, t, Y[:, j], OUT[:, j])
+
+
+def block_project(t, Y, data, ints):
+    """:func:`project_state` of every lane of the block ``Y`` (:data:`tumble._block.PROJECT`)."""
+    for j in range(Y.shape[1]):
+        project_state(Y[:, j])
+
+
+_block.register(SloshModel, pack, block_rhs, block_project, _block.rate_at_4)
 
 
 @_protocol.implements(_protocol.rhs, SloshModel, inline=True)

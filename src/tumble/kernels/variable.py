@@ -27,7 +27,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, types
 
-from tumble import _protocol, _quat, torques
+from tumble import _block, _protocol, _quat, torques
+from tumble._block import array_view
 
 STATE_SIZE = 8
 
@@ -185,3 +186,59 @@ def _variable_body_rate(model, Y, j):
                                                 Y[0], Y[1], Y[2], Y[3], Y[4], Y[5], Y[6])
     return lambda model, Y, j: angular_rate(model.breaks, model.coefficients, Y[7, j],
                                             Y[0, j], Y[1, j], Y[2, j], Y[3, j], Y[4, j], Y[5, j], Y[6, j])
+
+
+# Blocks behind function pointers (tumble._block): two variants of the right-hand side, as the kernel type has two
+# (``codes`` None: torque-free); the projection and the body rate read no torque and serve both.
+
+
+def pack(model) -> tuple[np.ndarray, np.ndarray]:
+    """``(data, ints)`` of the kernel for its block functions (:mod:`tumble._block`): ``breaks``,
+    ``coefficients`` and the torque parameters, flat, one after another; ``[m, the torque program's sizes and
+    codes]``."""
+    floats, ints = _block.torque_pieces(model)
+    return (np.concatenate([model.breaks, model.coefficients.ravel()] + floats),
+            np.array([model.breaks.shape[0], *ints], dtype=np.int64))
+
+
+@njit(cache=True)
+def unpack(data, ints):
+    """The :class:`VariableModel` with a torque program whose arrays are views of :func:`pack`'s."""
+    m = ints[0]
+    params, codes = _block.torque_views(data, m + 36 * (m - 1), ints, 1)
+    return VariableModel(data[:m], array_view(data, m, (m - 1, 4, 9)), params, codes)
+
+
+@njit(cache=True)
+def unpack_free(data, ints):
+    """The torque-free :class:`VariableModel` whose arrays are views of :func:`pack`'s."""
+    m = ints[0]
+    params, _ = _block.torque_views(data, m + 36 * (m - 1), ints, 1)
+    return VariableModel(data[:m], array_view(data, m, (m - 1, 4, 9)), params, None)
+
+
+def block_rhs(t, Y, OUT, data, ints):
+    """The right-hand side of a block (:data:`tumble._block.RHS`) under a torque program."""
+    _protocol.rhs(unpack(data, ints), 0, t, Y, OUT)
+
+
+def block_rhs_free(t, Y, OUT, data, ints):
+    """The right-hand side of a block of torque-free bodies (:data:`tumble._block.RHS`)."""
+    _protocol.rhs(unpack_free(data, ints), 0, t, Y, OUT)
+
+
+def block_project(t, Y, data, ints):
+    """``q ← q/|q|`` and the clock ``s ← t`` of every lane (:data:`tumble._block.PROJECT`)."""
+    _protocol.project(unpack_free(data, ints), 0, t, Y)
+
+
+def block_body_rate(Y, W, data, ints):
+    """``W[:, j] = ω`` of every lane (:data:`tumble._block.BODY_RATE`)."""
+    model = unpack_free(data, ints)
+    for j in range(Y.shape[1]):
+        W[0, j], W[1, j], W[2, j] = _protocol.body_rate(model, Y, j)
+
+
+_block.register_variants(
+    VariableModel, pack,
+    lambda model: (block_rhs_free if model.codes is None else block_rhs, block_project, block_body_rate))

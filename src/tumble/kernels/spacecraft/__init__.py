@@ -58,8 +58,9 @@ import collections
 import numpy as np
 from numba import njit, types
 from numba.extending import overload
+from numba.np.unsafe.ndarray import to_fixed_tuple
 
-from tumble import _protocol, torques
+from tumble import _block, _protocol, torques
 from tumble.kernels.spacecraft._assembly import assemble as _assemble
 from tumble.kernels.spacecraft._base import Program, inline
 from tumble.kernels.spacecraft._layout import (ABSENT, AUX_ACTUATOR, AUX_CORE, AUX_DIPOLE_COMMAND, AUX_ENERGY,
@@ -273,3 +274,58 @@ def initialise(model, t, y):
     """Apply the discrete updates of the start time ``t`` (s) to the state vector ``y``: the sensors' first
     readings, the commands held from the first sample, the PWPF triggers."""
     _sample(model, t, y)
+
+
+# Blocks behind function pointers (tumble._block): a batch of spacecraft runs the block drivers compiled once per
+# method; the assembled right-hand side and discrete updates of a block compile once, in these functions, for every
+# method. Two variants, as the kernel type has two (``python_calls``): without and with a Python function.
+
+_PART_KINDS = len(PARTS)  # a global: a compile-time constant, the length of the tuple of the parts' fields
+
+
+def _pack_flat(model) -> tuple[np.ndarray, np.ndarray]:
+    """``(data, ints)``: the spacecraft's ``data`` itself and its int64 fields (``route``, ``size``, ``aux_size``,
+    ``torque_at``, ``torque_terms``, then each kind of :data:`PARTS`)."""
+    scalars = [model.route, model.size, model.aux_size, model.torque_at, model.torque_terms]
+    return model.data, np.array(scalars + [getattr(model, kind) for kind in PARTS], dtype=np.int64)
+
+
+@njit(cache=True)
+def _unpack(data, ints):
+    """The :class:`SpacecraftModel` without Python functions whose fields are :func:`_pack_flat`'s."""
+    return SpacecraftModel(data, ints[0], ints[1], ints[2], ints[3], ints[4], None,
+                           *to_fixed_tuple(ints[5:], _PART_KINDS))
+
+
+@njit(cache=True)
+def _unpack_calling(data, ints):
+    """The :class:`SpacecraftModel` with a Python function (``python_calls`` 1) whose fields are
+    :func:`_pack_flat`'s."""
+    return SpacecraftModel(data, ints[0], ints[1], ints[2], ints[3], ints[4], 1,
+                           *to_fixed_tuple(ints[5:], _PART_KINDS))
+
+
+def block_rhs(t, Y, OUT, data, ints):
+    """The right-hand side of a block of spacecraft (:data:`tumble._block.RHS`)."""
+    _protocol.rhs(_unpack(data, ints), 0, t, Y, OUT)
+
+
+def block_project(t, Y, data, ints):
+    """The projection and discrete updates of a block of spacecraft (:data:`tumble._block.PROJECT`)."""
+    _protocol.project(_unpack(data, ints), 0, t, Y)
+
+
+def block_rhs_calling(t, Y, OUT, data, ints):
+    """:func:`block_rhs` of a spacecraft with a Python function."""
+    _protocol.rhs(_unpack_calling(data, ints), 0, t, Y, OUT)
+
+
+def block_project_calling(t, Y, data, ints):
+    """:func:`block_project` of a spacecraft with a Python function."""
+    _protocol.project(_unpack_calling(data, ints), 0, t, Y)
+
+
+_block.register_variants(
+    SpacecraftModel, _pack_flat,
+    lambda model: ((block_rhs_calling, block_project_calling, _block.rate_at_4) if model.python_calls
+                   else (block_rhs, block_project, _block.rate_at_4)))
