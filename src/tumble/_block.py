@@ -152,7 +152,7 @@ class Kind(NamedTuple):
     that kernel (Python functions of the signatures :data:`SIGNATURES`, compiled on first use)."""
 
     pack: Callable[[Any], tuple[np.ndarray, np.ndarray]]
-    functions: Callable[[Any], tuple[Callable, Callable, Callable]]
+    functions: Callable[[Any], tuple[Callable, Callable, Callable | None]]
 
 
 #: kernel class -> its :class:`Kind` (filled by the kernel modules at import).
@@ -184,7 +184,7 @@ def compiled(function: Callable, ftype) -> Any:
     return _COMPILED[function]
 
 
-def addresses(functions: tuple[Callable, Callable, Callable]) -> np.ndarray:
+def addresses(functions: tuple[Callable, Callable, Callable | None]) -> np.ndarray:
     """``[rhs's code, its C wrapper, project's …, body rate's …]`` (int64) of a kind's block ``functions``,
     compiled and looked up once per process."""
     if functions not in _ADDRESSES:
