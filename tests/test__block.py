@@ -48,6 +48,7 @@ def block_path(kernel, method, y0, t=T, dt=0.05):
     return out
 
 
+@pytest.mark.slow  # compiles kinds other than the rigid body's (the fast lane's rule: docs/architecture.md)
 @pytest.mark.parametrize("method", ["rk4", "cf4"])
 @pytest.mark.parametrize("model, torque", [
     (flexible(), torques.ConstantBody([0.05, -0.02, 0.1])),
@@ -67,6 +68,7 @@ def test_a_block_through_the_pointers_is_the_inlined_block_bit_for_bit(model, to
         np.testing.assert_array_equal(block_path(pointers, method, y0), block_path(kernel, method, y0))
 
 
+@pytest.mark.slow  # compiles kinds other than the rigid body's (the fast lane's rule: docs/architecture.md)
 @pytest.mark.parametrize("method", ["rk4", "cf4"])
 @pytest.mark.parametrize("example, torque", [
     ("variable", None),  # the torque-free variant (codes None)
@@ -77,6 +79,7 @@ def test_a_block_of_deformable_bodies_through_the_pointers_is_the_inlined_block(
     assert_warmup_example_block(example, torque, method)
 
 
+@pytest.mark.slow  # compiles kinds other than the rigid body's (the fast lane's rule: docs/architecture.md)
 def test_a_block_of_gimbaled_gyros_through_the_pointers_is_the_inlined_block():
     assert_warmup_example_block("gimbaled_gyro", None, "rk4")  # a kind without body rates (no cf4)
 
@@ -98,6 +101,7 @@ def assert_warmup_example_block(example, torque, method):
     np.testing.assert_array_equal(block_path(pointers, method, y0, t, 0.01), block_path(kernel, method, y0, t, 0.01))
 
 
+@pytest.mark.slow  # compiles kinds other than the rigid body's (the fast lane's rule: docs/architecture.md)
 def test_a_batch_of_two_blocks_runs_the_parallel_driver_through_the_pointers():
     # 65 bodies: two blocks, run_batch (prange over the blocks); a FlexibleBody's block rounds as its lone body
     model = flexible()
@@ -107,6 +111,7 @@ def test_a_batch_of_two_blocks_runs_the_parallel_driver_through_the_pointers():
         assert_same_run(batch.member(i), tumble.simulate(model, omega[i], t=T, method="rk4", dt=0.05))
 
 
+@pytest.mark.slow  # compiles kinds other than the rigid body's (the fast lane's rule: docs/architecture.md)
 def test_pack_and_unpack_give_the_kernel_back():
     from tumble.kernels import flexible as kernels
 
@@ -156,6 +161,7 @@ COUNT = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow  # compiles kinds other than the rigid body's (the fast lane's rule: docs/architecture.md)
 def test_a_second_kind_compiles_its_functions_and_no_driver_and_a_second_method_no_function():
     done = subprocess.run([sys.executable, "-c", COUNT], capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
