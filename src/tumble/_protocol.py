@@ -77,12 +77,14 @@ through :func:`model_workspace` (the model's share of a method's workspace:
 ``(S,)`` or ``()``) and :func:`evaluating` (the kernel that evaluates in it).
 
 The integrators call these generic functions; Numba picks the implementation
-from the model's type when it compiles the integrator, so each model gets its
-own fully inlined integrator, and the compiled code is cached on disk. (Passing
-functions as arguments instead would defeat the disk cache, and a run-time
-switch on a model code costs 2–3× in the inner loop.) Adding a model is one
-kernel file under :mod:`tumble.kernels` and one model file above the engine
-(``docs/architecture.md``).
+from the model's type when it compiles the integrator, so a lone body of each
+model gets its own fully inlined integrator, and the compiled code is cached
+on disk. (A run-time switch on a model code costs 2–3× in the inner loop.) A
+batch of a kind that registers its block functions runs through one driver
+per method instead, calling them through function pointers
+(:mod:`tumble._block`), where a block of lanes shares the cost of each call.
+Adding a model is one kernel file under :mod:`tumble.kernels` and one model
+file above the engine (``docs/architecture.md``).
 """
 
 from __future__ import annotations
