@@ -14,7 +14,9 @@ C-contiguous; ``data``, ``ints`` the kind's packed parameters)::
 :mod:`tumble.integrate._fixed`, with a method's scheme) is typed and compiled once for all of them, and a kind
 compiles only its own functions, once, for every method. Each rebuilds the kind's kernel NamedTuple from views
 of ``data`` and ``ints`` (:func:`matrix_view`) and calls the kind's own ``derivative``: the same arithmetic in
-the same order as the inlined path, so results are equal bit for bit.
+the same order as the inlined path, so results are equal bit for bit. The functions take no member index: a
+registered kind's kernel is one for every member of its batch (its own ``rhs`` ignores ``b0``, as the kernels of
+those kinds do); a kind whose members have rows of their own (the rigid body's) keeps its own kernel.
 
 Where it does not apply (named in :func:`block_model`): a lone body keeps the right-hand side inlined into its
 driver (behind a pointer its step costs +16 … +60 %: the call boundary, five calls a step, which a block of 64
