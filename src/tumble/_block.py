@@ -265,6 +265,14 @@ def quaternion_project(t, Y, data, ints):
     _protocol.normalize_quaternions(Y)
 
 
+@njit(cache=True, inline="always")
+def lane_rates(model, Y, W):
+    """``W[:, j] = body_rate(model, Y, j)``, the body rate (rad/s, body axes) of every lane ``j`` of the block
+    ``Y``, by the kind's own ``body_rate``: the body of a kind's ``BODY_RATE`` function after its ``unpack``."""
+    for j in range(Y.shape[1]):
+        W[0, j], W[1, j], W[2, j] = _protocol.body_rate(model, Y, j)
+
+
 def rate_at_4(Y, W, data, ints):
     """``body_rate`` of a kind that stores ``(ω₁, ω₂, ω₃)`` at ``Y[4:7]``."""
     for j in range(Y.shape[1]):

@@ -114,10 +114,8 @@ def unpack(data, ints):
 
 
 def block_rhs(t, Y, OUT, data, ints):
-    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`)."""
-    model = unpack(data, ints)
-    for j in range(Y.shape[1]):
-        derivative(model, t, Y[:, j], OUT[:, j])
+    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`): the kind's own ``rhs``."""
+    _protocol.rhs(unpack(data, ints), 0, t, Y, OUT)
 
 
 _block.register(FlexibleModel, pack, block_rhs, _block.quaternion_project, _block.rate_at_4)

@@ -113,17 +113,13 @@ def unpack(data, ints):
 
 
 def block_rhs(t, Y, OUT, data, ints):
-    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`)."""
-    model = unpack(data, ints)
-    for j in range(Y.shape[1]):
-        derivative(model, t, Y[:, j], OUT[:, j])
+    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`): the kind's own ``rhs``."""
+    _protocol.rhs(unpack(data, ints), 0, t, Y, OUT)
 
 
 def block_body_rate(Y, W, data, ints):
     """``W[:, j] = ω`` of every lane of the block ``Y`` (:data:`tumble._block.BODY_RATE`)."""
-    model = unpack(data, ints)
-    for j in range(Y.shape[1]):
-        W[0, j], W[1, j], W[2, j] = _rate_of_lane(model, Y, j)
+    _block.lane_rates(unpack(data, ints), Y, W)
 
 
 _block.register(KirchhoffModel, pack, block_rhs, _block.quaternion_project, block_body_rate)

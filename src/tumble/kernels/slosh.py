@@ -138,16 +138,14 @@ def unpack(data, ints):
 
 
 def block_rhs(t, Y, OUT, data, ints):
-    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`)."""
-    model = unpack(data, ints)
-    for j in range(Y.shape[1]):
-        derivative(model, t, Y[:, j], OUT[:, j])
+    """``OUT[:, j] = dy/dt`` of every lane of the block ``Y`` (:data:`tumble._block.RHS`): the kind's own ``rhs``."""
+    _protocol.rhs(unpack(data, ints), 0, t, Y, OUT)
 
 
 def block_project(t, Y, data, ints):
-    """:func:`project_state` of every lane of the block ``Y`` (:data:`tumble._block.PROJECT`)."""
-    for j in range(Y.shape[1]):
-        project_state(Y[:, j])
+    """:func:`project_state` of every lane of the block ``Y`` (:data:`tumble._block.PROJECT`): the kind's own
+    ``project``."""
+    _protocol.project(unpack(data, ints), 0, t, Y)
 
 
 _block.register(SloshModel, pack, block_rhs, block_project, _block.rate_at_4)

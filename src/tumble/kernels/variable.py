@@ -234,9 +234,7 @@ def block_project(t, Y, data, ints):
 
 def block_body_rate(Y, W, data, ints):
     """``W[:, j] = ω`` of every lane (:data:`tumble._block.BODY_RATE`)."""
-    model = unpack_free(data, ints)
-    for j in range(Y.shape[1]):
-        W[0, j], W[1, j], W[2, j] = _protocol.body_rate(model, Y, j)
+    _block.lane_rates(unpack_free(data, ints), Y, W)
 
 
 _block.register_variants(
